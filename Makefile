@@ -1,0 +1,97 @@
+# Weathering: particle-driven weathering masks.
+#   make          build build/weathering (installs missing Debian packages first)
+#   make test     build and run the test suite
+#   make run      run the shipped default scene
+#   make bench    benchmarks (speed and memory targets)
+# BUILD=dir puts every build product in another folder.
+
+BUILD ?= build
+CC ?= cc
+SCENE ?= xml_scenes/building.xml
+
+# Debian packages the build, the tests and the viewer need.
+DEB_PACKAGES := gcc make pkg-config libopenexr-dev libxml2-dev libxml2-utils \
+    libosmesa6-dev libglfw3-dev libgl-dev libassimp-dev libcglm-dev libpng-dev xvfb xauth
+
+CFLAGS ?= -O2 -g
+WARN := -std=c11 -Wall -Wextra -pedantic -Wshadow -Wstrict-prototypes
+DEFS := -D_POSIX_C_SOURCE=200809L
+FPFLAGS := -fno-math-errno -ffp-contract=fast
+INCLUDES := -Isrc -I$(BUILD)/gen -I/usr/include/OpenEXR -I/usr/include/libxml2
+ALL_CFLAGS = $(WARN) $(DEFS) $(FPFLAGS) $(INCLUDES) $(CFLAGS) -MMD -MP -pthread
+LIBS := -lOpenEXRCore-3_1 -lxml2 -lassimp -lOSMesa -lpng -lm -lpthread
+
+LIB_SRC := $(filter-out src/cli.c,$(wildcard src/*.c))
+LIB_OBJ := $(LIB_SRC:src/%.c=$(BUILD)/obj/%.o)
+CLI_OBJ := $(BUILD)/obj/cli.o
+TEST_SRC := $(wildcard tests/test_*.c)
+TEST_BIN := $(TEST_SRC:tests/%.c=$(BUILD)/tests/%)
+TEST_SUPPORT_OBJ := $(BUILD)/obj/tests/ensure.o
+BENCH_SRC := $(wildcard tests/bench/bench_*.c)
+BENCH_BIN := $(BENCH_SRC:tests/bench/%.c=$(BUILD)/bench/%)
+SHADERS := $(wildcard shaders/*.glsl)
+
+.PHONY: all deps test run bench clean
+all: $(BUILD)/weathering
+
+# Installs whatever Debian package is missing (apt-get update first), as root or
+# through sudo. Checked on every make: dpkg -s is quick.
+deps:
+	@missing=""; for p in $(DEB_PACKAGES); do \
+	    dpkg -s $$p >/dev/null 2>&1 || missing="$$missing $$p"; done; \
+	if [ -n "$$missing" ]; then \
+	    echo "installing missing Debian packages:$$missing"; \
+	    sudo=""; [ "$$(id -u)" -eq 0 ] || sudo=sudo; \
+	    $$sudo apt-get update -q && \
+	    DEBIAN_FRONTEND=noninteractive $$sudo apt-get install -y -q $$missing; \
+	fi
+
+$(BUILD)/obj/%.o: src/%.c | deps
+	@mkdir -p $(dir $@)
+	$(CC) $(ALL_CFLAGS) -c $< -o $@
+
+$(BUILD)/obj/tests/%.o: tests/%.c | deps
+	@mkdir -p $(dir $@)
+	$(CC) $(ALL_CFLAGS) -Itests -c $< -o $@
+
+# GLSL sources are compiled into the binaries (build/gen/shaders.h).
+$(BUILD)/gen/shaders.h: $(SHADERS) shaders/embed.sh
+	@mkdir -p $(dir $@)
+	sh shaders/embed.sh $@ $(SHADERS)
+
+$(LIB_OBJ): $(BUILD)/gen/shaders.h
+
+$(BUILD)/obj/bench/%.o: tests/bench/%.c | deps
+	@mkdir -p $(dir $@)
+	$(CC) $(ALL_CFLAGS) -Itests -c $< -o $@
+
+$(BUILD)/bench/%: $(BUILD)/obj/bench/%.o $(BUILD)/libweathering.a
+	@mkdir -p $(dir $@)
+	$(CC) $(ALL_CFLAGS) -o $@ $^ $(LIBS)
+
+$(BUILD)/libweathering.a: $(LIB_OBJ)
+	@mkdir -p $(dir $@)
+	rm -f $@
+	ar rcs $@ $^
+
+$(BUILD)/weathering: $(CLI_OBJ) $(BUILD)/libweathering.a
+	$(CC) $(ALL_CFLAGS) -o $@ $^ $(LIBS)
+
+$(BUILD)/tests/%: $(BUILD)/obj/tests/%.o $(TEST_SUPPORT_OBJ) $(BUILD)/libweathering.a
+	@mkdir -p $(dir $@)
+	$(CC) $(ALL_CFLAGS) -o $@ $^ $(LIBS)
+
+test: $(BUILD)/weathering $(TEST_BIN)
+	WX_BUILD=$(BUILD) WX_TESTS=tests tests/run.sh $(BUILD)/tests
+
+# Each benchmark prints its table; targets are checked here, never in make test.
+bench: $(BUILD)/weathering $(BENCH_BIN)
+	@for b in $(BENCH_BIN); do echo "== $$b"; GALLIUM_DRIVER=llvmpipe WX_BUILD=$(BUILD) $$b || exit 1; done
+
+run: $(BUILD)/weathering
+	$(BUILD)/weathering info $(SCENE)
+
+clean:
+	rm -rf $(BUILD)
+
+-include $(wildcard $(BUILD)/obj/*.d $(BUILD)/obj/tests/*.d $(BUILD)/obj/bench/*.d)

@@ -1,0 +1,71 @@
+// pipeline.h: the phases of a run (bake, simulate, gather) and what they share:
+// the run options of the command line, the output folder rules of DESIGN
+// section 6, and the statistics written by --stats.
+#ifndef WX_PIPELINE_H
+#define WX_PIPELINE_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "error.h"
+#include "scene.h"
+
+/// Options shared by every phase (command line: --out, --seed, --threads, -q, --stats).
+typedef struct wx_run_options {
+    char out_dir[WX_PATH_MAX]; ///< the output folder; exists once wx_output_prepare ran
+    uint64_t seed;             ///< the scene's seed unless --seed was given
+    int threads;               ///< worker threads, >= 1 (default: all cores)
+    bool quiet;                ///< -q: no progress bars, no notes on stderr
+    const char *stats_path;    ///< --stats FILE.json, or NULL
+} wx_run_options;
+
+/// Counters of a simulation (the pinned keys of --stats).
+typedef struct wx_sim_stats {
+    int64_t particles_emitted;
+    int64_t particle_steps;
+    int64_t collisions;
+    int64_t absorbed;
+    int64_t settled;
+    int64_t escaped;
+    int64_t alive;
+    double dirt_initial_surface;
+    double dirt_emitted;
+    double dirt_final_surface;
+    double dirt_in_flight;
+    double dirt_escaped;
+} wx_sim_stats;
+
+/// Wall-clock seconds per phase.
+typedef struct wx_phase_times {
+    double load;
+    double bake;
+    double simulate;
+    double gather;
+    double total;
+} wx_phase_times;
+
+/// Default run options for a scene: out/<scene name>/, the scene's seed, all cores.
+void wx_run_options_default(const wx_scene *scene, wx_run_options *opts);
+
+/// Number of online processors (at least 1).
+int wx_cpu_count(void);
+
+/// Creates the output folder (and its parents) and checks it is a folder.
+wx_result wx_output_prepare(const wx_run_options *opts, wx_error *err);
+
+/// Joins the output folder and a plain file name into `path`. Fails (WX_BAD_INPUT)
+/// when the result would be one of the scene's input files (a map, a mesh, the
+/// scene itself): inputs are never overwritten.
+wx_result wx_output_path(const wx_scene *scene, const wx_run_options *opts, const char *name,
+                         char path[WX_PATH_MAX], wx_error *err);
+
+/// For cameras given by <View> without map files in the scene, points their map
+/// paths at what `bake` wrote in the output folder (<camera>_depth.exr, ...), and
+/// checks those files exist (else: "run `weathering bake` first").
+wx_result wx_use_baked_maps(wx_scene *scene, const wx_run_options *opts, wx_error *err);
+
+/// Writes the --stats JSON atomically.
+wx_result wx_write_stats(const char *path, const wx_run_options *opts, const wx_sim_stats *stats,
+                         const wx_phase_times *times, wx_error *err);
+
+#endif

@@ -1,0 +1,160 @@
+// ensure.c: counters, reports and small helpers for the test programs.
+#include "ensure.h"
+
+#include <stdarg.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+int ensure_failed_checks;
+static int passed;
+static int failed;
+static char tmpdir[4096];
+
+void ensure_report(const char *file, int line, const char *what)
+{
+    fprintf(stderr, "%s:%d: ENSURE failed: %s\n", file, line, what);
+    ensure_failed_checks++;
+}
+
+void ensure_report_near(const char *file, int line, const char *what, double a, double b,
+                        double tol)
+{
+    fprintf(stderr, "%s:%d: ENSURE_NEAR failed: %s (%.9g vs %.9g, tolerance %.3g)\n", file,
+            line, what, a, b, tol);
+    ensure_failed_checks++;
+}
+
+void ensure_run(const char *name, void (*fn)(void))
+{
+    ensure_failed_checks = 0;
+    fn();
+    if (ensure_failed_checks == 0) {
+        passed++;
+        printf("  ok    %s\n", name);
+    } else {
+        failed++;
+        printf("  FAIL  %s\n", name);
+    }
+    fflush(stdout);
+}
+
+static void remove_tmpdir(void)
+{
+    if (tmpdir[0] != '\0' && getenv("WX_KEEP_TMP") == NULL) {
+        char cmd[4200];
+        snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmpdir);
+        if (system(cmd) != 0) {
+            fprintf(stderr, "could not remove %s\n", tmpdir);
+        }
+    }
+}
+
+int ensure_summary(void)
+{
+    printf("%d passed, %d failed\n", passed, failed);
+    return failed == 0 ? 0 : 1;
+}
+
+const char *ensure_build_dir(void)
+{
+    const char *b = getenv("WX_BUILD");
+    return b != NULL && b[0] != '\0' ? b : "build";
+}
+
+const char *ensure_tests_dir(void)
+{
+    const char *t = getenv("WX_TESTS");
+    return t != NULL && t[0] != '\0' ? t : "tests";
+}
+
+const char *ensure_tmpdir(void)
+{
+    if (tmpdir[0] == '\0') {
+        char parent[3800];
+        snprintf(parent, sizeof parent, "%s/tmp", ensure_build_dir());
+        mkdir(parent, 0777);
+        snprintf(tmpdir, sizeof tmpdir, "%s/testXXXXXX", parent);
+        if (mkdtemp(tmpdir) == NULL) {
+            perror("mkdtemp");
+            exit(1);
+        }
+        atexit(remove_tmpdir);
+    }
+    return tmpdir;
+}
+
+int ensure_shell(char *out, size_t cap, const char *fmt, ...)
+{
+    char cmd[16384];
+    va_list args;
+    va_start(args, fmt);
+    vsnprintf(cmd, sizeof cmd, fmt, args);
+    va_end(args);
+    char full[16500];
+    snprintf(full, sizeof full, "( %s ) 2>&1", cmd);
+    FILE *pipe = popen(full, "r");
+    if (pipe == NULL) {
+        return -1;
+    }
+    size_t used = 0;
+    char buf[4096];
+    size_t n;
+    while ((n = fread(buf, 1, sizeof buf, pipe)) > 0) {
+        if (out != NULL && used + 1 < cap) {
+            size_t take = n < cap - 1 - used ? n : cap - 1 - used;
+            memcpy(out + used, buf, take);
+            used += take;
+        }
+    }
+    if (out != NULL && cap > 0) {
+        out[used] = '\0';
+    }
+    int status = pclose(pipe);
+    if (status == -1 || !WIFEXITED(status)) {
+        return -1;
+    }
+    return WEXITSTATUS(status);
+}
+
+const char *ensure_write_file(const char *dir, const char *name, const char *text)
+{
+    static char paths[8][4096];
+    static int next;
+    char *path = paths[next];
+    next = (next + 1) % 8;
+    snprintf(path, 4096, "%s/%s", dir, name);
+    FILE *f = fopen(path, "wb");
+    if (f == NULL) {
+        perror(path);
+        exit(1);
+    }
+    fputs(text, f);
+    fclose(f);
+    return path;
+}
+
+char *ensure_read_file(const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    if (f == NULL) {
+        return NULL;
+    }
+    fseek(f, 0, SEEK_END);
+    long size = ftell(f);
+    fseek(f, 0, SEEK_SET);
+    char *text = malloc((size_t)size + 1);
+    if (text != NULL) {
+        size_t got = fread(text, 1, (size_t)size, f);
+        text[got] = '\0';
+    }
+    fclose(f);
+    return text;
+}
+
+bool ensure_contains(const char *haystack, const char *needle)
+{
+    return haystack != NULL && strstr(haystack, needle) != NULL;
+}

@@ -1,0 +1,69 @@
+// ensure.h: the test harness. Each tests/test_<module>.c is its own program:
+//
+//   TEST(exr_round_trip) { ... ENSURE(x == 1); ENSURE_NEAR(d, 2.0, 1e-6); }
+//   int main(void) { RUN(exr_round_trip); return ensure_summary(); }
+//
+// A failed ENSURE prints file:line and the condition and ends that test; the
+// summary prints "N passed, M failed" and returns the exit status. tests/run.sh
+// runs every test program and adds up their counts.
+#ifndef WX_ENSURE_H
+#define WX_ENSURE_H
+
+#include <math.h>
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdio.h>
+
+extern int ensure_failed_checks; // failed checks in the running test
+
+void ensure_report(const char *file, int line, const char *what);
+void ensure_report_near(const char *file, int line, const char *what, double a, double b,
+                        double tol);
+void ensure_run(const char *name, void (*fn)(void));
+int ensure_summary(void);
+
+#define TEST(name) static void name(void)
+#define RUN(name) ensure_run(#name, name)
+
+#define ENSURE(cond)                                                                         \
+    do {                                                                                     \
+        if (!(cond)) {                                                                       \
+            ensure_report(__FILE__, __LINE__, #cond);                                        \
+            return;                                                                          \
+        }                                                                                    \
+    } while (0)
+
+#define ENSURE_NEAR(a, b, tol)                                                               \
+    do {                                                                                     \
+        double ensure_a_ = (double)(a), ensure_b_ = (double)(b);                             \
+        if (!(fabs(ensure_a_ - ensure_b_) <= (double)(tol))) {                               \
+            ensure_report_near(__FILE__, __LINE__, #a " ~ " #b, ensure_a_, ensure_b_,       \
+                               (double)(tol));                                               \
+            return;                                                                          \
+        }                                                                                    \
+    } while (0)
+
+/// Folder of the built programs ($WX_BUILD, default "build").
+const char *ensure_build_dir(void);
+
+/// Folder of the repository's tests/ (source data such as tests/bad/).
+const char *ensure_tests_dir(void);
+
+/// A new empty folder for this test program under $WX_BUILD/tmp; removed at exit.
+const char *ensure_tmpdir(void);
+
+/// Runs a shell command with stdout and stderr captured into `out` (truncated to
+/// cap-1 characters). Returns the exit status, or -1 when it did not exit.
+int ensure_shell(char *out, size_t cap, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+
+/// Writes `text` to `dir/name` and returns the full path (static buffer ring of 8).
+const char *ensure_write_file(const char *dir, const char *name, const char *text);
+
+/// Reads a whole file into a malloc'd NUL-terminated string (NULL on failure).
+char *ensure_read_file(const char *path);
+
+/// True when `haystack` contains `needle`.
+bool ensure_contains(const char *haystack, const char *needle);
+
+#endif
