@@ -1,0 +1,147 @@
+// test_pipeline.c: output folder rules, atomic files and the --stats JSON.
+#include <dirent.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "atomic_file.h"
+#include "ensure.h"
+#include "pipeline.h"
+
+static int count_hidden_files(const char *dir)
+{
+    DIR *d = opendir(dir);
+    int n = 0;
+    struct dirent *e;
+    while (d != NULL && (e = readdir(d)) != NULL) {
+        n += e->d_name[0] == '.' && strcmp(e->d_name, ".") != 0 && strcmp(e->d_name, "..") != 0;
+    }
+    if (d != NULL) {
+        closedir(d);
+    }
+    return n;
+}
+
+TEST(output_folder_is_created_with_parents)
+{
+    wx_run_options opts = { 0 };
+    snprintf(opts.out_dir, sizeof opts.out_dir, "%s/a/b/c", ensure_tmpdir());
+    ENSURE(wx_output_prepare(&opts, NULL) == WX_OK);
+    struct stat st;
+    ENSURE(stat(opts.out_dir, &st) == 0 && S_ISDIR(st.st_mode));
+    // Again: an existing folder is fine.
+    ENSURE(wx_output_prepare(&opts, NULL) == WX_OK);
+    // A file in the way is bad input.
+    const char *file = ensure_write_file(ensure_tmpdir(), "plain", "x");
+    snprintf(opts.out_dir, sizeof opts.out_dir, "%s", file);
+    wx_error err;
+    ENSURE(wx_output_prepare(&opts, &err) == WX_BAD_INPUT);
+    ENSURE(ensure_contains(err.message, "not a folder"));
+}
+
+TEST(default_options_follow_the_scene)
+{
+    wx_scene scene = { 0 };
+    snprintf(scene.name, sizeof scene.name, "house");
+    scene.seed = 42;
+    wx_run_options opts;
+    wx_run_options_default(&scene, &opts);
+    ENSURE(strcmp(opts.out_dir, "out/house") == 0);
+    ENSURE(opts.seed == 42);
+    ENSURE(opts.threads >= 1);
+    ENSURE(!opts.quiet);
+}
+
+TEST(an_input_file_is_never_an_output)
+{
+    const char *dir = ensure_tmpdir();
+    wx_scene scene = { 0 };
+    wx_scene_camera cam = { 0 };
+    scene.cameras = &cam;
+    scene.camera_count = 1;
+    snprintf(scene.path, sizeof scene.path, "%s", ensure_write_file(dir, "s.xml", "<x/>"));
+    snprintf(cam.depth_path, sizeof cam.depth_path, "%s",
+             ensure_write_file(dir, "front_depth.exr", "not really"));
+    wx_run_options opts = { 0 };
+    snprintf(opts.out_dir, sizeof opts.out_dir, "%s", dir);
+    char path[WX_PATH_MAX];
+    wx_error err;
+    ENSURE(wx_output_path(&scene, &opts, "front_depth.exr", path, &err) == WX_BAD_INPUT);
+    ENSURE(ensure_contains(err.message, "would be overwritten"));
+    ENSURE(wx_output_path(&scene, &opts, "s.xml", path, &err) == WX_BAD_INPUT);
+    ENSURE(wx_output_path(&scene, &opts, "mask.exr", path, &err) == WX_OK);
+    ENSURE(ensure_contains(path, "/mask.exr"));
+    ENSURE(wx_output_path(&scene, &opts, "../mask.exr", path, &err) == WX_BAD_INPUT);
+    ENSURE(wx_output_path(&scene, &opts, "..", path, &err) == WX_BAD_INPUT);
+}
+
+TEST(atomic_write_replaces_whole_and_leaves_no_temporary)
+{
+    char dir[4200];
+    snprintf(dir, sizeof dir, "%s/atomic", ensure_tmpdir());
+    ENSURE(mkdir(dir, 0777) == 0);
+    char path[4300];
+    snprintf(path, sizeof path, "%s/data.bin", dir);
+    ENSURE(wx_write_file_atomic(path, "first version", 13, NULL) == WX_OK);
+    ENSURE(wx_write_file_atomic(path, "second", 6, NULL) == WX_OK);
+    char *text = ensure_read_file(path);
+    ENSURE(text != NULL && strcmp(text, "second") == 0);
+    free(text);
+    ENSURE(count_hidden_files(dir) == 0);
+    char tmp[WX_PATH_MAX];
+    wx_temp_path(path, tmp);
+    ENSURE(ensure_contains(tmp, "/.data.bin.tmp"));
+    // A folder that does not exist: failure, nothing left behind.
+    char missing[4400];
+    snprintf(missing, sizeof missing, "%s/none/data.bin", dir);
+    wx_error err;
+    ENSURE(wx_write_file_atomic(missing, "x", 1, &err) == WX_FAIL);
+    ENSURE(ensure_contains(err.message, missing));
+}
+
+TEST(stats_json_has_the_pinned_keys_and_values)
+{
+    char path[4200];
+    snprintf(path, sizeof path, "%s/stats.json", ensure_tmpdir());
+    wx_run_options opts = { .threads = 2, .seed = 9 };
+    wx_sim_stats stats = { .particles_emitted = 100, .particle_steps = 5000, .collisions = 40,
+                           .absorbed = 10, .settled = 20, .escaped = 30, .alive = 40,
+                           .dirt_initial_surface = 1.5, .dirt_emitted = 100,
+                           .dirt_final_surface = 60, .dirt_in_flight = 11.5,
+                           .dirt_escaped = 30 };
+    wx_phase_times times = { .load = 0.25, .simulate = 1.5, .total = 2 };
+    ENSURE(wx_write_stats(path, &opts, &stats, &times, NULL) == WX_OK);
+    char *json = ensure_read_file(path);
+    ENSURE(json != NULL);
+    ENSURE(ensure_contains(json, "\"particles_emitted\": 100,"));
+    ENSURE(ensure_contains(json, "\"particle_steps\": 5000,"));
+    ENSURE(ensure_contains(json, "\"collisions\": 40,"));
+    ENSURE(ensure_contains(json, "\"absorbed\": 10,"));
+    ENSURE(ensure_contains(json, "\"settled\": 20,"));
+    ENSURE(ensure_contains(json, "\"escaped\": 30,"));
+    ENSURE(ensure_contains(json, "\"alive\": 40,"));
+    ENSURE(ensure_contains(json, "\"initial_surface\": 1.5,"));
+    ENSURE(ensure_contains(json, "\"in_flight\": 11.5,"));
+    ENSURE(ensure_contains(json, "\"simulate\": 1.500000,"));
+    ENSURE(ensure_contains(json, "\"threads\": 2,"));
+    ENSURE(ensure_contains(json, "\"seed\": 9\n"));
+    free(json);
+    // Valid JSON according to an independent parser, when python3 is there.
+    char out[512];
+    int status = ensure_shell(out, sizeof out,
+                              "command -v python3 >/dev/null || exit 0; python3 -c "
+                              "\"import json,sys; d=json.load(open(sys.argv[1])); "
+                              "assert d['dirt']['emitted']==100\" %s",
+                              path);
+    ENSURE(status == 0);
+}
+
+int main(void)
+{
+    RUN(output_folder_is_created_with_parents);
+    RUN(default_options_follow_the_scene);
+    RUN(an_input_file_is_never_an_output);
+    RUN(atomic_write_replaces_whole_and_leaves_no_temporary);
+    RUN(stats_json_has_the_pinned_keys_and_values);
+    return ensure_summary();
+}
