@@ -53,9 +53,18 @@ wx_result wx_exr_read_header(const char *path, wx_image *out, wx_error *err);
 /// Each entry may list alternatives separated by '|' ("R|Z"): the first one the
 /// file has is read and its name stored in out->channel_names[i]. A missing
 /// channel, a size over the limits, a truncated or corrupt file, or a file that
-/// is not an EXR give WX_BAD_INPUT with a message naming the file.
+/// is not an EXR give WX_BAD_INPUT with a message naming the file. Only the first
+/// part of a file is read, scanline only (tiled and deep files are refused). The
+/// image is the data window: its origin, when not (0, 0), is dropped.
 wx_result wx_exr_read(const char *path, const char *const *wanted, int wanted_count,
                       wx_image *out, wx_error *err);
+
+/// Like wx_exr_read, but into one malloc'd buffer of wanted_count floats per texel,
+/// interleaved in `wanted` order: channel c of texel (i, j) is at
+/// (j*width + i)*wanted_count + c. The caller frees *out_texels with free().
+wx_result wx_exr_read_interleaved(const char *path, const char *const *wanted, int wanted_count,
+                                  float **out_texels, int *out_width, int *out_height,
+                                  wx_error *err);
 
 /// Writes every channel of `image` as float32 with ZIP compression, plus its
 /// attributes, atomically (temporary ".<name>.tmp<pid>" beside it, then rename).
