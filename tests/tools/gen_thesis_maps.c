@@ -3,9 +3,9 @@
 // standing on a 6 m square slab, seen by a front and a top camera, and an output
 // camera at the front. The maps are ray-cast analytically, so they are exact.
 //
-//   make && cc -std=c11 -D_POSIX_C_SOURCE=200809L -Isrc -I/usr/include/OpenEXR \
-//      tests/tools/gen_thesis_maps.c build/libweathering.a -lOpenEXRCore-3_1 -lxml2 -lm \
-//      -o build/gen_thesis_maps && build/gen_thesis_maps maps
+//   cc -std=c11 -O2 -D_POSIX_C_SOURCE=200809L -Isrc -I/usr/include/OpenEXR \
+//      tests/tools/gen_thesis_maps.c src/camera.c src/exr_io.c src/error.c src/atomic_file.c \
+//      -lOpenEXRCore-3_1 -lm -o build/gen_thesis_maps && build/gen_thesis_maps maps
 // It prints the matrices to paste into the scene.
 #include <math.h>
 #include <stdio.h>
@@ -62,7 +62,7 @@ static void print_matrix(const char *name, const float m[16])
 {
     printf("        <%s matrix=\"", name);
     for (int k = 0; k < 16; ++k) {
-        printf("%.9g%s", m[k], k < 15 ? " " : "");
+        printf("%.9g%s", m[k] + 0.0f, k < 15 ? " " : "");
     }
     printf("\"/>\n");
 }
