@@ -1,0 +1,772 @@
+// test_scene.c: the scene file (DESIGN section 3): defaults, every attribute,
+// camera matrices, the bad scenes of tests/bad/, entity attacks, and the schema.
+#include <dirent.h>
+#include <errno.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "ensure.h"
+#include "exr_io.h"
+#include "scene.h"
+
+// The matrices of tests/data: a camera at z = 10 looking along -Z over a
+// 4 x 4 m frame centred on the origin (u = x/4 + 1/2, v = y/4 + 1/2, d = 10 - z).
+static const float front_wtc[16] = { 0.25f, 0, 0, 0, 0,    0.25f, 0,  0,
+                                     0,     0, -1, 0, 0.5f, 0.5f, 10, 1 };
+static const float front_ctw[16] = { 4, 0, 0, 0, 0, 4, 0, 0, 0, 0, -1, 0, -2, -2, 10, 1 };
+
+static const char *data_path(const char *name)
+{
+    static char paths[4][4096];
+    static int next;
+    char *path = paths[next];
+    next = (next + 1) % 4;
+    snprintf(path, 4096, "%s/data/%s", ensure_tests_dir(), name);
+    return path;
+}
+
+// A W x H map with channels R, G, B (depth 5, normal +Z...: values do not
+// matter to the scene loader, only the size).
+static bool write_map(const char *path, int width, int height)
+{
+    static const char *const names[3] = { "R", "G", "B" };
+    wx_image image;
+    wx_error err;
+    memset(&image, 0, sizeof image);
+    if (wx_image_alloc(&image, width, height, 3, names, &err) != WX_OK) {
+        fprintf(stderr, "%s\n", err.message);
+        return false;
+    }
+    for (int i = 0; i < width * height; ++i) {
+        image.channels[0][i] = 5.0f;
+        image.channels[2][i] = 1.0f;
+    }
+    wx_result r = wx_exr_write(path, &image, &err);
+    wx_image_free(&image);
+    if (r != WX_OK) {
+        fprintf(stderr, "%s\n", err.message);
+    }
+    return r == WX_OK;
+}
+
+static bool map_size(const char *path, int *width, int *height)
+{
+    wx_image header;
+    wx_error err;
+    memset(&header, 0, sizeof header);
+    wx_result r = wx_exr_read_header(path, &header, &err);
+    *width = header.width;
+    *height = header.height;
+    wx_image_free(&header);
+    return r == WX_OK;
+}
+
+static bool matrices_near(const float *a, const float *b, float tol)
+{
+    for (int i = 0; i < 16; ++i) {
+        if (!(fabsf(a[i] - b[i]) <= tol)) {
+            return false;
+        }
+    }
+    return true;
+}
+
+// The committed maps of tests/data (WX_REGEN_TEST_DATA=1 writes them again).
+TEST(data_maps)
+{
+    if (getenv("WX_REGEN_TEST_DATA") != NULL) {
+        ENSURE(write_map(data_path("map4.exr"), 4, 4));
+        ENSURE(write_map(data_path("map8.exr"), 8, 8));
+    }
+    int w, h;
+    ENSURE(map_size(data_path("map4.exr"), &w, &h));
+    ENSURE(w == 4 && h == 4);
+    ENSURE(map_size(data_path("map8.exr"), &w, &h));
+    ENSURE(w == 8 && h == 8);
+}
+
+// A scene in the thesis' format: only the collider; everything else defaults.
+TEST(thesis_minimal_defaults)
+{
+    wx_scene s;
+    wx_error err;
+    wx_result r = wx_scene_load(data_path("thesis_minimal.xml"), &s, &err);
+    if (r != WX_OK) {
+        fprintf(stderr, "%s\n", err.message);
+    }
+    ENSURE(r == WX_OK);
+    char dir[4096];
+    snprintf(dir, sizeof dir, "%s/data", ensure_tests_dir());
+    ENSURE(strcmp(s.dir, dir) == 0);
+    ENSURE(strcmp(s.name, "thesis_minimal") == 0);
+    ENSURE(strcmp(s.path, data_path("thesis_minimal.xml")) == 0);
+    ENSURE(s.bbox_size == 100.0f);
+    ENSURE(s.bbox_center[0] == 0.0f && s.bbox_center[1] == 0.0f && s.bbox_center[2] == 0.0f);
+    ENSURE(s.time_step == 0.01);
+    ENSURE(s.steps == 1000);
+    ENSURE(s.seed == 1);
+    ENSURE_NEAR(wx_scene_duration(&s), 10.0, 1e-12);
+    ENSURE(s.collider.resilience == 0.5f && s.collider.friction == 0.8f);
+    ENSURE(s.collider.adherence == 1.0f && s.collider.deposit == 1.0f);
+    ENSURE(s.collider.erosion == 1.0f);
+    ENSURE(s.field_count == 0 && s.fields == NULL);
+    ENSURE(s.emitter_count == 0 && s.emitters == NULL);
+    ENSURE(s.mesh_count == 0);
+    ENSURE(s.camera_count == 1 && s.input_count == 1 && s.output_index == -1);
+    const wx_scene_camera *c = &s.cameras[0];
+    ENSURE(strcmp(c->name, "front") == 0 && !c->is_output && !c->has_view);
+    ENSURE(c->camera.width == 4 && c->camera.height == 4);
+    ENSURE(matrices_near(c->camera.wtc, front_wtc, 0.0f));
+    ENSURE(matrices_near(c->camera.ctw, front_ctw, 0.0f));
+    ENSURE(strcmp(c->depth_path, data_path("map4.exr")) == 0);
+    ENSURE(strcmp(c->dirt_path, data_path("map4.exr")) == 0);
+    ENSURE(c->line == 9);
+    wx_scene_free(&s);
+    ENSURE(s.cameras == NULL && s.camera_count == 0);
+}
+
+// Each element with no optional attribute takes the defaults of DESIGN section 3.
+TEST(element_defaults)
+{
+    wx_scene s;
+    wx_error err;
+    wx_result r = wx_scene_load(data_path("defaults.xml"), &s, &err);
+    if (r != WX_OK) {
+        fprintf(stderr, "%s\n", err.message);
+    }
+    ENSURE(r == WX_OK);
+    ENSURE(s.bbox_size == 100.0f && s.time_step == 0.01 && s.steps == 1000 && s.seed == 1);
+
+    ENSURE(s.field_count == 3);
+    ENSURE(s.fields[0].kind == WX_FIELD_GRAVITY && s.fields[0].strength == 9.8f);
+    ENSURE(s.fields[0].line == 10);
+    ENSURE(s.fields[1].kind == WX_FIELD_WIND && s.fields[1].strength == 0.0f);
+    ENSURE(s.fields[1].dir[0] == 1.0f && s.fields[1].dir[1] == 0.0f && s.fields[1].dir[2] == 0.0f);
+    ENSURE(s.fields[2].kind == WX_FIELD_TURBULENCE && s.fields[2].strength == 0.0f);
+    ENSURE(s.fields[2].frequency == 1.0f && s.fields[2].octaves == 4);
+
+    ENSURE(s.emitter_count == 2);
+    for (int i = 0; i < 2; ++i) {
+        const wx_emitter *e = &s.emitters[i];
+        ENSURE(e->name[0] == '\0');
+        ENSURE(e->center[0] == 0.0f && e->center[1] == 0.0f && e->center[2] == 0.0f);
+        ENSURE(e->rate == 1000.0 && e->start == 0.0);
+        ENSURE_NEAR(e->end, 10.0, 1e-12); // steps * timeStep = 1000 * 0.01
+        ENSURE(e->speed == 1.0f && e->mass == 1.0f && e->dirt == 1.0f);
+        ENSURE(e->max_collisions == 100);
+    }
+    ENSURE(s.emitters[0].kind == WX_EMITTER_POINT && s.emitters[0].radius == 0.0f);
+    ENSURE(s.emitters[1].kind == WX_EMITTER_HEMISPHERE && s.emitters[1].radius == 1.0f);
+
+    ENSURE(s.camera_count == 2 && s.input_count == 1 && s.output_index == 1);
+    const wx_scene_camera *in = &s.cameras[0];
+    // CTWMatrix absent: derived from WTCMatrix.
+    ENSURE(matrices_near(in->camera.ctw, front_ctw, 1e-5f));
+    const wx_scene_camera *out = &s.cameras[1];
+    ENSURE(out->is_output && strcmp(out->name, "out") == 0);
+    ENSURE(out->camera.width == 8 && out->camera.height == 8);
+    ENSURE(strcmp(out->output_file, "mask.exr") == 0);
+    ENSURE(out->output_width == 8 && out->output_height == 8);
+    // 2 output texels: the frame is 4 m wide over 8 texels.
+    ENSURE_NEAR(out->radius, 1.0, 1e-6);
+    ENSURE(out->second_pass == WX_SECOND_PASS_MEAN && !out->normalize);
+    ENSURE(out->impact_path[0] == '\0' && out->dirt_path[0] == '\0');
+
+    ENSURE(s.mesh_count == 1 && s.meshes[0].surface_count == 1);
+    ENSURE(strcmp(s.meshes[0].path, data_path("box.obj")) == 0);
+    const wx_surface *sf = &s.meshes[0].surfaces[0];
+    ENSURE(strcmp(sf->material, "*") == 0);
+    ENSURE(sf->absorption == 0.0f && sf->bounce == 0.0f && sf->dirt == 0.0f);
+    ENSURE(sf->deposit == 0.0f && sf->erosion == 0.0f && sf->colors == WX_COLOR_NONE);
+    wx_scene_free(&s);
+}
+
+// Every element and attribute, in an unusual order, parsed to the right values.
+TEST(full_scene)
+{
+    wx_scene s;
+    wx_error err;
+    wx_result r = wx_scene_load(data_path("full.xml"), &s, &err);
+    if (r != WX_OK) {
+        fprintf(stderr, "%s\n", err.message);
+    }
+    ENSURE(r == WX_OK);
+    ENSURE(strcmp(s.name, "full") == 0);
+    ENSURE(s.bbox_size == 50.0f);
+    ENSURE(s.bbox_center[0] == 1.0f && s.bbox_center[1] == 2.5f && s.bbox_center[2] == -3.0f);
+    ENSURE(s.time_step == 0.02 && s.steps == 500);
+    ENSURE(s.seed == UINT64_MAX);
+    ENSURE(s.collider.resilience == 0.25f && s.collider.friction == 0.75f);
+    ENSURE(s.collider.adherence == 2.0f && s.collider.deposit == 0.5f);
+    ENSURE(s.collider.erosion == 1.5f);
+
+    ENSURE(s.field_count == 4);
+    ENSURE(s.fields[0].kind == WX_FIELD_WIND && s.fields[0].strength == 2.0f);
+    ENSURE_NEAR(s.fields[0].dir[0], 0.6, 1e-7); // (3, 0, 4) normalised
+    ENSURE_NEAR(s.fields[0].dir[1], 0.0, 1e-7);
+    ENSURE_NEAR(s.fields[0].dir[2], 0.8, 1e-7);
+    ENSURE(s.fields[1].kind == WX_FIELD_GRAVITY && s.fields[1].strength == 3.7f);
+    ENSURE(s.fields[2].kind == WX_FIELD_TURBULENCE && s.fields[2].strength == 0.5f);
+    ENSURE(s.fields[2].frequency == 0.25f && s.fields[2].octaves == 6);
+    ENSURE(s.fields[3].kind == WX_FIELD_WIND && s.fields[3].dir[2] == -1.0f);
+
+    ENSURE(s.emitter_count == 2);
+    const wx_emitter *p1 = &s.emitters[0];
+    ENSURE(p1->kind == WX_EMITTER_POINT && strcmp(p1->name, "p1") == 0);
+    ENSURE(p1->center[0] == 1.0f && p1->center[1] == 5.0f && p1->center[2] == -2.0f);
+    ENSURE(p1->rate == 250.0 && p1->start == 0.5 && p1->end == 2.0);
+    ENSURE(p1->speed == 3.0f && p1->mass == 2.0f && p1->dirt == 0.5f);
+    ENSURE(p1->max_collisions == 7);
+    const wx_emitter *sky = &s.emitters[1];
+    ENSURE(sky->kind == WX_EMITTER_HEMISPHERE && strcmp(sky->name, "sky") == 0);
+    ENSURE(sky->center[1] == 1.0f && sky->radius == 20.0f);
+    ENSURE(sky->rate == 5000.0 && sky->start == 1.0 && sky->end == 9.5);
+    ENSURE(sky->speed == 2.0f && sky->mass == 0.5f && sky->dirt == 1.5f);
+    ENSURE(sky->max_collisions == 50);
+
+    ENSURE(s.camera_count == 4 && s.input_count == 3 && s.output_index == 3);
+    const wx_scene_camera *front = &s.cameras[0];
+    ENSURE(!front->is_output && !front->has_view);
+    ENSURE(matrices_near(front->camera.wtc, front_wtc, 0.0f));
+    ENSURE(matrices_near(front->camera.ctw, front_ctw, 0.0f));
+    ENSURE(strcmp(front->normal_path, data_path("map4.exr")) == 0);
+    ENSURE(strcmp(front->impact_path, data_path("map4.exr")) == 0);
+
+    const wx_scene_camera *side = &s.cameras[1];
+    ENSURE(strcmp(side->name, "side.cam-1") == 0 && side->has_view && !side->is_output);
+    ENSURE(side->view.eye[0] == 10.0f && side->view.up[1] == 1.0f);
+    ENSURE(side->view.width_ws == 4.0f && side->view.height_ws == 2.0f);
+    ENSURE(side->view.width_px == 8 && side->view.height_px == 4);
+    ENSURE(side->camera.width == 8 && side->camera.height == 4);
+    ENSURE(side->depth_path[0] == '\0' && side->dirt_path[0] == '\0');
+
+    const wx_scene_camera *top = &s.cameras[2];
+    ENSURE(top->has_view && top->view.up[2] == -1.0f);
+    ENSURE(top->view.width_px == 8 && top->view.height_px == 8); // "8" means 8 x 8
+    ENSURE(strcmp(top->dirt_path, data_path("map8.exr")) == 0);
+
+    const wx_scene_camera *out = &s.cameras[3];
+    ENSURE(out->is_output && strcmp(out->output_file, "dirt_mask.exr") == 0);
+    ENSURE(out->output_width == 8 && out->output_height == 8);
+    ENSURE(out->radius == 0.25f && out->second_pass == WX_SECOND_PASS_SUM && out->normalize);
+    ENSURE(out->camera.width == 8 && out->camera.height == 8);
+
+    ENSURE(s.mesh_count == 2);
+    ENSURE(s.meshes[0].surface_count == 2 && s.meshes[1].surface_count == 0);
+    const wx_surface *wall = &s.meshes[0].surfaces[0];
+    ENSURE(strcmp(wall->material, "wall") == 0);
+    ENSURE(wall->absorption == 0.25f && wall->bounce == 0.5f && wall->dirt == 2.0f);
+    ENSURE(wall->deposit == 0.75f && wall->erosion == 0.125f && wall->colors == WX_COLOR_IMPACT);
+    const wx_surface *rest = &s.meshes[0].surfaces[1];
+    ENSURE(strcmp(rest->material, "*") == 0 && rest->absorption == 1.0f);
+    ENSURE(rest->erosion == 1.0f && rest->colors == WX_COLOR_DIRT);
+    wx_scene_free(&s);
+}
+
+// View cameras: world points land where they were worked out by hand.
+TEST(view_camera_matrices)
+{
+    const char *dir = ensure_tmpdir();
+    const char *path = ensure_write_file(
+        dir, "view.xml",
+        "<Weathering>\n"
+        "  <Collider><ProjectedMaps>\n"
+        "    <Ortho cameraName=\"side\">\n"
+        "      <View eye=\"10 0 0\" target=\"0 0 0\" width=\"4\" height=\"2\"\n"
+        "            resolution=\"8 4\"/>\n"
+        "    </Ortho>\n"
+        "    <Ortho cameraName=\"front\" out=\"true\">\n"
+        "      <View eye=\"0 0 10\" target=\"0 0 0\" up=\"0 1 0\" width=\"4\" height=\"2\"\n"
+        "            resolution=\"8 4\"/>\n"
+        "    </Ortho>\n"
+        "  </ProjectedMaps></Collider>\n"
+        "</Weathering>\n");
+    wx_scene s;
+    wx_error err;
+    wx_result r = wx_scene_load(path, &s, &err);
+    if (r != WX_OK) {
+        fprintf(stderr, "%s\n", err.message);
+    }
+    ENSURE(r == WX_OK);
+    ENSURE(strcmp(s.name, "view") == 0 && strcmp(s.dir, dir) == 0);
+    // side: looks along -X, so right = forward x up = -Z, up = +Y, d = 10 - x.
+    // (2, 0.5, -1): u = 1/4 + 1/2, v = 0.5/2 + 1/2, d = 8.
+    const wx_camera *side = &s.cameras[0].camera;
+    float uvd[3];
+    wx_camera_world_to_map(side, (const float[3]){ 2.0f, 0.5f, -1.0f }, uvd);
+    ENSURE_NEAR(uvd[0], 0.75, 1e-6);
+    ENSURE_NEAR(uvd[1], 0.75, 1e-6);
+    ENSURE_NEAR(uvd[2], 8.0, 1e-5);
+    // (2, -0.5, 1): u = -1/4 + 1/2, v = -0.5/2 + 1/2.
+    wx_camera_world_to_map(side, (const float[3]){ 2.0f, -0.5f, 1.0f }, uvd);
+    ENSURE_NEAR(uvd[0], 0.25, 1e-6);
+    ENSURE_NEAR(uvd[1], 0.25, 1e-6);
+    ENSURE_NEAR(uvd[2], 8.0, 1e-5);
+    ENSURE(s.cameras[0].camera.width == 8 && s.cameras[0].camera.height == 4);
+    // front: looks along -Z: (1, 0.5, 3) -> u = 0.75, v = 0.75, d = 7.
+    const wx_scene_camera *out = &s.cameras[1];
+    wx_camera_world_to_map(&out->camera, (const float[3]){ 1.0f, 0.5f, 3.0f }, uvd);
+    ENSURE_NEAR(uvd[0], 0.75, 1e-6);
+    ENSURE_NEAR(uvd[1], 0.75, 1e-6);
+    ENSURE_NEAR(uvd[2], 7.0, 1e-5);
+    // No <OutputMap>: mask.exr at the View's resolution, radius 2 texels = 2 * 4/8 m.
+    ENSURE(out->is_output && strcmp(out->output_file, "mask.exr") == 0);
+    ENSURE(out->output_width == 8 && out->output_height == 4);
+    ENSURE_NEAR(out->radius, 1.0, 1e-6);
+    ENSURE(out->depth_path[0] == '\0');
+    wx_scene_free(&s);
+}
+
+// A camera rotated to look down -Y: u = x/4 + 1/2, v = -z/4 + 1/2, d = 10 - y.
+static const char *const top_wtc = "0.25 0 0 0  0 0 -1 0  0 -0.25 0 0  0.5 0.5 10 1";
+static const char *const top_ctw = "4 0 0 0  0 0 -4 0  0 -1 0 0  -2 10 2 1";
+static const float top_ctw_values[16] = { 4, 0, 0, 0, 0, 0, -4, 0, 0, -1, 0, 0, -2, 10, 2, 1 };
+static const float top_wtc_values[16] = { 0.25f, 0, 0, 0,     0,    0,  -1, 0,
+                                          0,     -0.25f, 0, 0, 0.5f, 0.5f, 10, 1 };
+
+static const char *matrix_scene(const char *name, const char *wtc, const char *ctw)
+{
+    const char *dir = ensure_tmpdir();
+    char maps[4][64];
+    for (int k = 0; k < 4; ++k) {
+        snprintf(maps[k], sizeof maps[k], "%s_%d.exr", name, k);
+        char path[4200];
+        snprintf(path, sizeof path, "%s/%s", dir, maps[k]);
+        if (!write_map(path, 16, 8)) {
+            return NULL;
+        }
+    }
+    char text[4096];
+    snprintf(text, sizeof text,
+             "<Weathering>\n"
+             "  <Collider>\n"
+             "    <ProjectedMaps>\n"
+             "      <Ortho cameraName=\"top\">\n"
+             "%s%s%s"
+             "%s%s%s"
+             "        <DepthMap file=\"%s\"/>\n"
+             "        <NormalMap file=\"%s\"/>\n"
+             "        <ImpactMap file=\"%s\"/>\n"
+             "        <DirtMap file=\"%s\"/>\n"
+             "      </Ortho>\n"
+             "    </ProjectedMaps>\n"
+             "  </Collider>\n"
+             "</Weathering>\n",
+             wtc != NULL ? "        <WTCMatrix matrix=\"" : "", wtc != NULL ? wtc : "",
+             wtc != NULL ? "\"/>\n" : "", ctw != NULL ? "        <CTWMatrix matrix=\"" : "",
+             ctw != NULL ? ctw : "", ctw != NULL ? "\"/>\n" : "", maps[0], maps[1], maps[2],
+             maps[3]);
+    char file[128];
+    snprintf(file, sizeof file, "%s.xml", name);
+    return ensure_write_file(dir, file, text);
+}
+
+// CTWMatrix absent: the inverse of WTCMatrix; WTCMatrix absent: the inverse of CTW.
+TEST(ctw_derived_when_absent)
+{
+    const char *path = matrix_scene("wtc_only", top_wtc, NULL);
+    ENSURE(path != NULL);
+    wx_scene s;
+    wx_error err;
+    wx_result r = wx_scene_load(path, &s, &err);
+    if (r != WX_OK) {
+        fprintf(stderr, "%s\n", err.message);
+    }
+    ENSURE(r == WX_OK);
+    const wx_camera *cam = &s.cameras[0].camera;
+    ENSURE(matrices_near(cam->wtc, top_wtc_values, 0.0f));
+    ENSURE(matrices_near(cam->ctw, top_ctw_values, 1e-5f));
+    ENSURE(cam->width == 16 && cam->height == 8);
+    // Map centre at depth 3 is the world point (0, 7, 0).
+    float p[3];
+    wx_camera_map_to_world(cam, (const float[3]){ 0.5f, 0.5f, 3.0f }, p);
+    ENSURE_NEAR(p[0], 0.0, 1e-5);
+    ENSURE_NEAR(p[1], 7.0, 1e-5);
+    ENSURE_NEAR(p[2], 0.0, 1e-5);
+    wx_scene_free(&s);
+
+    path = matrix_scene("ctw_only", NULL, top_ctw);
+    ENSURE(path != NULL);
+    r = wx_scene_load(path, &s, &err);
+    ENSURE(r == WX_OK);
+    ENSURE(matrices_near(s.cameras[0].camera.wtc, top_wtc_values, 1e-6f));
+    ENSURE(matrices_near(s.cameras[0].camera.ctw, top_ctw_values, 0.0f));
+    wx_scene_free(&s);
+
+    // Both given, printed with a few digits: within the tolerance.
+    path = matrix_scene("both_rounded", "0.250001 0 0 0  0 0 -1 0  0 -0.25 0 0  0.5 0.5 10 1",
+                        top_ctw);
+    ENSURE(path != NULL);
+    r = wx_scene_load(path, &s, &err);
+    ENSURE(r == WX_OK);
+    wx_scene_free(&s);
+}
+
+TEST(ctw_not_inverse_is_an_error)
+{
+    const char *path =
+        matrix_scene("not_inverse", top_wtc, "4 0 0 0  0 0 -4 0  0 -1 0 0  -2 10 3 1");
+    ENSURE(path != NULL);
+    wx_scene s;
+    wx_error err;
+    ENSURE(wx_scene_load(path, &s, &err) == WX_BAD_INPUT);
+    char expected[4200];
+    snprintf(expected, sizeof expected, "%s:6: <CTWMatrix> of camera 'top' is not the inverse",
+             path);
+    if (!ensure_contains(err.message, expected)) {
+        fprintf(stderr, "got: %s\n", err.message);
+    }
+    ENSURE(strncmp(err.message, expected, strlen(expected)) == 0);
+    ENSURE(s.cameras == NULL && s.camera_count == 0); // left empty
+    wx_scene_free(&s);                                // and safe to free
+}
+
+static int compare_names(const void *a, const void *b)
+{
+    return strcmp(*(const char *const *)a, *(const char *const *)b);
+}
+
+// Reads "<!-- expect: LINE: substring -->" from the first line of a bad scene.
+static bool read_expectation(const char *path, int *line, char *substring, size_t cap)
+{
+    char *text = ensure_read_file(path);
+    if (text == NULL) {
+        return false;
+    }
+    const char *prefix = "<!-- expect: ";
+    bool ok = false;
+    if (strncmp(text, prefix, strlen(prefix)) == 0) {
+        char *rest = text + strlen(prefix);
+        char *colon;
+        long n = strtol(rest, &colon, 10);
+        char *end = strstr(rest, " -->");
+        char *newline = strchr(rest, '\n');
+        if (colon != rest && colon[0] == ':' && colon[1] == ' ' && end != NULL &&
+            (newline == NULL || end < newline)) {
+            *line = (int)n;
+            snprintf(substring, cap, "%.*s", (int)(end - (colon + 2)), colon + 2);
+            ok = true;
+        }
+    }
+    free(text);
+    return ok;
+}
+
+// Every tests/bad/*.xml fails with WX_BAD_INPUT, "path:LINE:" and its substring.
+TEST(bad_scenes)
+{
+    char dir_path[4096];
+    snprintf(dir_path, sizeof dir_path, "%s/bad", ensure_tests_dir());
+    DIR *dir = opendir(dir_path);
+    ENSURE(dir != NULL);
+    char *names[256];
+    int count = 0;
+    struct dirent *entry;
+    while ((entry = readdir(dir)) != NULL && count < 256) {
+        size_t len = strlen(entry->d_name);
+        if (len > 4 && strcmp(entry->d_name + len - 4, ".xml") == 0) {
+            names[count++] = strdup(entry->d_name);
+        }
+    }
+    closedir(dir);
+    qsort(names, (size_t)count, sizeof names[0], compare_names);
+    int failures = 0;
+    for (int i = 0; i < count; ++i) {
+        char path[4400];
+        snprintf(path, sizeof path, "%s/%s", dir_path, names[i]);
+        int line;
+        char substring[512];
+        if (!read_expectation(path, &line, substring, sizeof substring)) {
+            fprintf(stderr, "%s: no '<!-- expect: LINE: substring -->' first line\n", path);
+            failures++;
+            continue;
+        }
+        wx_scene s;
+        wx_error err;
+        memset(&err, 0, sizeof err);
+        wx_result r = wx_scene_load(path, &s, &err);
+        char prefix[4500];
+        snprintf(prefix, sizeof prefix, "%s:%d: ", path, line);
+        bool ok = r == WX_BAD_INPUT && strncmp(err.message, prefix, strlen(prefix)) == 0 &&
+                  ensure_contains(err.message, substring);
+        if (!ok) {
+            fprintf(stderr, "%s: expected WX_BAD_INPUT with \"%s...%s\", got %d: %s\n", names[i],
+                    prefix, substring, (int)r, err.message);
+            failures++;
+        }
+        ENSURE(s.cameras == NULL && s.fields == NULL && s.emitters == NULL && s.meshes == NULL);
+        wx_scene_free(&s);
+    }
+    for (int i = 0; i < count; ++i) {
+        free(names[i]);
+    }
+    ENSURE(count >= 12);
+    ENSURE(failures == 0);
+}
+
+static double seconds_now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+// "Billion laughs": refused at the first entity declaration, in well under 1 s.
+TEST(entity_bomb_refused_quickly)
+{
+    char text[4096] = "<?xml version=\"1.0\"?>\n<!DOCTYPE Weathering [\n"
+                      "  <!ENTITY lol \"lol\">\n";
+    for (int i = 1; i <= 9; ++i) {
+        char decl[256];
+        snprintf(decl, sizeof decl, "  <!ENTITY lol%d \"", i);
+        strcat(text, decl);
+        for (int k = 0; k < 10; ++k) {
+            if (i == 1) {
+                snprintf(decl, sizeof decl, "&lol;");
+            } else {
+                snprintf(decl, sizeof decl, "&lol%d;", i - 1);
+            }
+            strcat(text, decl);
+        }
+        strcat(text, "\">\n");
+    }
+    strcat(text, "]>\n<Weathering><Solver>&lol9;</Solver>\n"
+                 "<Emitters><PointEmitter name=\"&lol9;\"/></Emitters></Weathering>\n");
+    const char *path = ensure_write_file(ensure_tmpdir(), "bomb.xml", text);
+    wx_scene s;
+    wx_error err;
+    double t0 = seconds_now();
+    wx_result r = wx_scene_load(path, &s, &err);
+    double elapsed = seconds_now() - t0;
+    ENSURE(r == WX_BAD_INPUT);
+    ENSURE(elapsed < 1.0);
+    char expected[4200];
+    snprintf(expected, sizeof expected, "%s:3: entity declarations are not allowed", path);
+    ENSURE(strncmp(err.message, expected, strlen(expected)) == 0);
+    ENSURE(!ensure_contains(err.message, "lollol"));
+    wx_scene_free(&s);
+}
+
+// An external entity is refused and the file it names is never read.
+TEST(external_entity_refused)
+{
+    const char *dir = ensure_tmpdir();
+    const char *secret = ensure_write_file(dir, "secret.txt", "TOPSECRET-7f3a");
+    char abs_secret[8192];
+    if (secret[0] == '/') {
+        snprintf(abs_secret, sizeof abs_secret, "%s", secret);
+    } else {
+        char cwd[4096];
+        ENSURE(getcwd(cwd, sizeof cwd) != NULL);
+        snprintf(abs_secret, sizeof abs_secret, "%s/%s", cwd, secret);
+    }
+    const char *forms[3] = {
+        "<Weathering><Solver>&xxe;</Solver></Weathering>\n",
+        "<Weathering><Emitters><PointEmitter name=\"&xxe;\"/></Emitters></Weathering>\n",
+        "<Weathering>%xxe;</Weathering>\n",
+    };
+    for (int i = 0; i < 3; ++i) {
+        char text[16384];
+        snprintf(text, sizeof text,
+                 "<?xml version=\"1.0\"?>\n<!DOCTYPE Weathering [\n"
+                 "  <!ENTITY %sxxe SYSTEM \"file://%s\">\n]>\n%s",
+                 i == 2 ? "% " : "", abs_secret, forms[i]);
+        const char *path = ensure_write_file(dir, "xxe.xml", text);
+        wx_scene s;
+        wx_error err;
+        memset(&err, 0, sizeof err);
+        ENSURE(wx_scene_load(path, &s, &err) == WX_BAD_INPUT);
+        ENSURE(ensure_contains(err.message, "entity declarations are not allowed"));
+        ENSURE(!ensure_contains(err.message, "TOPSECRET"));
+        wx_scene_free(&s);
+    }
+    // /etc/passwd, as in the classic attack.
+    const char *path = ensure_write_file(
+        dir, "passwd.xml",
+        "<!DOCTYPE Weathering [ <!ENTITY xxe SYSTEM \"file:///etc/passwd\"> ]>\n"
+        "<Weathering><Solver>&xxe;</Solver></Weathering>\n");
+    wx_scene s;
+    wx_error err;
+    ENSURE(wx_scene_load(path, &s, &err) == WX_BAD_INPUT);
+    ENSURE(!ensure_contains(err.message, "root:"));
+}
+
+TEST(missing_scene_file)
+{
+    wx_scene s;
+    wx_error err;
+    ENSURE(wx_scene_load("tests/data/no_such_scene.xml", &s, &err) == WX_BAD_INPUT);
+    ENSURE(strcmp(err.message,
+                  "tests/data/no_such_scene.xml: cannot open (No such file or directory)") == 0);
+    ENSURE(s.cameras == NULL);
+    wx_scene_free(&s);
+    ENSURE(wx_scene_load(ensure_tmpdir(), &s, &err) == WX_BAD_INPUT); // a folder
+    ENSURE(ensure_contains(err.message, "cannot open"));
+}
+
+// Absolute map paths stay as they are; relative ones resolve against the scene.
+TEST(absolute_and_relative_paths)
+{
+    const char *dir = ensure_tmpdir();
+    char cwd[4096];
+    ENSURE(getcwd(cwd, sizeof cwd) != NULL);
+    char abs_map[8400];
+    snprintf(abs_map, sizeof abs_map, "%s/%s", cwd, data_path("map4.exr"));
+    ENSURE(write_map(ensure_write_file(dir, "rel.exr", ""), 4, 4));
+    char text[20000];
+    snprintf(text, sizeof text,
+             "<Weathering><Collider><ProjectedMaps><Ortho cameraName=\"c\">\n"
+             "<WTCMatrix matrix=\"1 0 0 0 0 1 0 0 0 0 1 0 0 0 0 1\"/>\n"
+             "<DepthMap file=\"%s\"/><NormalMap file=\"rel.exr\"/>\n"
+             "<ImpactMap file=\"./rel.exr\"/><DirtMap file=\"%s\"/>\n"
+             "</Ortho></ProjectedMaps></Collider></Weathering>\n",
+             abs_map, abs_map);
+    const char *path = ensure_write_file(dir, "paths.scene.xml", text);
+    wx_scene s;
+    wx_error err;
+    wx_result r = wx_scene_load(path, &s, &err);
+    if (r != WX_OK) {
+        fprintf(stderr, "%s\n", err.message);
+    }
+    ENSURE(r == WX_OK);
+    ENSURE(strcmp(s.name, "paths.scene") == 0);
+    ENSURE(strcmp(s.cameras[0].depth_path, abs_map) == 0);
+    char expected[8400];
+    snprintf(expected, sizeof expected, "%s/rel.exr", dir);
+    ENSURE(strcmp(s.cameras[0].normal_path, expected) == 0);
+    snprintf(expected, sizeof expected, "%s/./rel.exr", dir);
+    ENSURE(strcmp(s.cameras[0].impact_path, expected) == 0);
+    wx_scene_free(&s);
+}
+
+// Every shipped scene loads.
+TEST(shipped_scenes_load)
+{
+    DIR *dir = opendir("xml_scenes");
+    ENSURE(dir != NULL);
+    int failures = 0, count = 0;
+    struct dirent *entry;
+    while ((entry = readdir(dir)) != NULL) {
+        size_t len = strlen(entry->d_name);
+        if (len <= 4 || strcmp(entry->d_name + len - 4, ".xml") != 0) {
+            continue;
+        }
+        char path[4200];
+        snprintf(path, sizeof path, "xml_scenes/%s", entry->d_name);
+        wx_scene s;
+        wx_error err;
+        if (wx_scene_load(path, &s, &err) != WX_OK) {
+            fprintf(stderr, "%s\n", err.message);
+            failures++;
+        }
+        wx_scene_free(&s);
+        count++;
+    }
+    closedir(dir);
+    if (count == 0) {
+        printf("        (no scene in xml_scenes: skipped)\n");
+    }
+    ENSURE(failures == 0);
+}
+
+static bool have_xmllint(void)
+{
+    char out[256];
+    return ensure_shell(out, sizeof out, "command -v xmllint") == 0;
+}
+
+static bool validates(const char *path)
+{
+    char out[8192];
+    int status = ensure_shell(out, sizeof out,
+                              "xmllint --noout --schema xml_scenes/weathering.xsd '%s'", path);
+    if (status != 0) {
+        fprintf(stderr, "%s does not validate:\n%s", path, out);
+    }
+    return status == 0;
+}
+
+// Every shipped scene (xml_scenes/*.xml) and the good scenes of this test
+// validate against the schema.
+TEST(schema_accepts_good_scenes)
+{
+    if (!have_xmllint()) {
+        printf("        (xmllint not installed: skipped)\n");
+        return;
+    }
+    char out[4096];
+    ENSURE(ensure_shell(out, sizeof out, "xmllint --noout xml_scenes/weathering.xsd") == 0);
+    int failures = 0;
+    DIR *dir = opendir("xml_scenes");
+    ENSURE(dir != NULL);
+    struct dirent *entry;
+    while ((entry = readdir(dir)) != NULL) {
+        size_t len = strlen(entry->d_name);
+        if (len > 4 && strcmp(entry->d_name + len - 4, ".xml") == 0) {
+            char path[4200];
+            snprintf(path, sizeof path, "xml_scenes/%s", entry->d_name);
+            failures += !validates(path);
+        }
+    }
+    closedir(dir);
+    static const char *const good[] = { "thesis_minimal.xml", "defaults.xml", "full.xml" };
+    for (size_t i = 0; i < sizeof good / sizeof good[0]; ++i) {
+        failures += !validates(data_path(good[i]));
+    }
+    ENSURE(failures == 0);
+}
+
+// The schema also describes the ranges: some bad scenes fail validation too.
+TEST(schema_rejects_bad_values)
+{
+    if (!have_xmllint()) {
+        printf("        (xmllint not installed: skipped)\n");
+        return;
+    }
+    static const char *const invalid[] = {
+        "unknown_element",    "unknown_attribute",      "not_a_number",
+        "nan",                "inf",                    "negative_size",
+        "matrix_15_numbers",  "camera_name_folder",     "probability_above_one",
+        "duplicate_solver",   "text_content",           "missing_collider",
+        "bad_boolean",        "octaves_out_of_range",   "steps_not_integer",
+        "duplicate_camera",   "output_file_folder",     "resolution_too_large",
+        "duplicate_material", "duplicate_emitter_name", "mass_zero",
+        "wrong_root",         "missing_required_attribute",
+        "collider_friction_above_one",
+    };
+    int failures = 0;
+    for (size_t i = 0; i < sizeof invalid / sizeof invalid[0]; ++i) {
+        char out[8192];
+        int status =
+            ensure_shell(out, sizeof out, "xmllint --noout --schema %s %s/bad/%s.xml",
+                         "xml_scenes/weathering.xsd", ensure_tests_dir(), invalid[i]);
+        if (status == 0) {
+            fprintf(stderr, "tests/bad/%s.xml validates against the schema\n", invalid[i]);
+            failures++;
+        }
+    }
+    ENSURE(failures == 0);
+}
+
+int main(void)
+{
+    RUN(data_maps);
+    RUN(thesis_minimal_defaults);
+    RUN(element_defaults);
+    RUN(full_scene);
+    RUN(view_camera_matrices);
+    RUN(ctw_derived_when_absent);
+    RUN(ctw_not_inverse_is_an_error);
+    RUN(bad_scenes);
+    RUN(entity_bomb_refused_quickly);
+    RUN(external_entity_refused);
+    RUN(missing_scene_file);
+    RUN(absolute_and_relative_paths);
+    RUN(shipped_scenes_load);
+    RUN(schema_accepts_good_scenes);
+    RUN(schema_rejects_bad_values);
+    return ensure_summary();
+}
