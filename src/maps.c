@@ -98,7 +98,11 @@ wx_result wx_maps_load(wx_maps *maps, unsigned which, const char *depth_path,
         }
     }
     if (result == WX_OK && wanted(which, WX_MAPS_DIRT)) {
-        static const char *const channels[] = {"R", "G", "B"};
+        // A dirt map that `simulate` wrote keeps the dirt it started from in
+        // "initialDirt": a new simulation starts from that, not from its result.
+        const char *const channels[] = {
+            wanted(which, WX_MAPS_INITIAL_DIRT) ? "initialDirt|R" : "R", "G", "B"
+        };
         result = need_path(dirt_path, "dirt", err);
         wx_image *image = NULL;
         if (result == WX_OK) {

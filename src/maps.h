@@ -29,7 +29,13 @@ enum {
     WX_MAPS_IMPACT = 1 << 2,
     WX_MAPS_DIRT = 1 << 3,
     WX_MAPS_ALL = 15,
+    /// With WX_MAPS_DIRT: read the dirt plane from channel "initialDirt" when the
+    /// file has it (a dirt map written by `simulate`), else from R.
+    WX_MAPS_INITIAL_DIRT = 1 << 4,
 };
+
+/// Name of the channel in which a simulated dirt map keeps its initial dirt.
+#define WX_INITIAL_DIRT_CHANNEL "initialDirt"
 
 /// Loads the maps selected by `which` from the given paths (NULL or "" for a map
 /// not wanted). Depth reads channel R or Z, normal R G B, impact R G, dirt R G B.

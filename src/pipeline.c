@@ -83,6 +83,9 @@ wx_result wx_output_path(const wx_scene *scene, const wx_run_options *opts, cons
     bool is_input = same_file(&st, scene->path);
     for (int c = 0; c < scene->camera_count && !is_input; ++c) {
         const wx_scene_camera *cam = &scene->cameras[c];
+        if (cam->maps_in_output) {
+            continue; // baked by us: a later phase may write the next stage over them
+        }
         is_input = same_file(&st, cam->depth_path) || same_file(&st, cam->normal_path) ||
                    same_file(&st, cam->impact_path) || same_file(&st, cam->dirt_path);
     }
@@ -106,6 +109,7 @@ wx_result wx_use_baked_maps(wx_scene *scene, const wx_run_options *opts, wx_erro
         if (!cam->has_view || cam->depth_path[0] != '\0') {
             continue;
         }
+        cam->maps_in_output = true;
         char *paths[4] = { cam->depth_path, cam->normal_path, cam->impact_path, cam->dirt_path };
         int count = cam->is_output ? 2 : 4;
         for (int k = 0; k < count; ++k) {

@@ -54,14 +54,16 @@ int wx_cpu_count(void);
 wx_result wx_output_prepare(const wx_run_options *opts, wx_error *err);
 
 /// Joins the output folder and a plain file name into `path`. Fails (WX_BAD_INPUT)
-/// when the result would be one of the scene's input files (a map, a mesh, the
-/// scene itself): inputs are never overwritten.
+/// when the result would be one of the scene's input files (a map or a mesh the
+/// scene names, the scene itself): inputs are never overwritten. Maps this
+/// program baked into the output folder (maps_in_output) are not inputs.
 wx_result wx_output_path(const wx_scene *scene, const wx_run_options *opts, const char *name,
                          char path[WX_PATH_MAX], wx_error *err);
 
 /// For cameras given by <View> without map files in the scene, points their map
 /// paths at what `bake` wrote in the output folder (<camera>_depth.exr, ...), and
-/// checks those files exist (else: "run `weathering bake` first").
+/// checks those files exist (else: "run `weathering bake` first"); marks them
+/// maps_in_output.
 wx_result wx_use_baked_maps(wx_scene *scene, const wx_run_options *opts, wx_error *err);
 
 /// Writes the --stats JSON atomically.

@@ -76,6 +76,9 @@ typedef struct wx_scene_camera {
     char normal_path[WX_PATH_MAX];
     char impact_path[WX_PATH_MAX];
     char dirt_path[WX_PATH_MAX];
+    /// The map paths point at maps this program wrote into the output folder
+    /// (`bake`), not at files the scene names: later phases may replace them.
+    bool maps_in_output;
     /// Output camera only (<OutputMap>).
     char output_file[256];   ///< base name in the output folder, default "mask.exr"
     int output_width;
