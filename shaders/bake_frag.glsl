@@ -1,0 +1,46 @@
+// bake_frag.glsl: the four maps of DESIGN section 2 in one pass (src/bake.c).
+//   attachment 0 (RGBA32F): d, world normal x y z (unit, facing the camera)
+//   attachment 1 (RGBA32F): absorption, bounce, deposit, erosion
+//   attachment 2 (R32F):    initial dirt density per square metre
+// d is computed here from the interpolated position, in float, not read back
+// from the depth buffer.
+#version 450 core
+
+in vec3 v_position;
+in vec3 v_normal;
+in vec4 v_color;
+flat in vec4 v_material_a; // absorption, bounce, dirt, deposit
+flat in vec2 v_material_b; // erosion, vertex colour use
+
+uniform vec4 u_depth_row;  // d = dot(position, xyz) + w
+uniform vec3 u_view_dir;   // unit viewing direction (towards larger d)
+
+layout(location = 0) out vec4 o_depth_normal;
+layout(location = 1) out vec4 o_impact_dirt;
+layout(location = 2) out float o_dirt_density;
+
+const float COLORS_IMPACT = 1.0; // wx_color_use
+const float COLORS_DIRT = 2.0;
+
+void main()
+{
+    float d = dot(v_position, u_depth_row.xyz) + u_depth_row.w;
+    vec3 n = v_normal;
+    float len = length(n);
+    if (!(len > 1e-6)) {
+        // No usable vertex normal: the triangle's own plane.
+        n = cross(dFdx(v_position), dFdy(v_position));
+        len = length(n);
+    }
+    n = len > 0.0 ? n / len : -u_view_dir;
+    if (dot(n, u_view_dir) > 0.0) {
+        n = -n;
+    }
+    o_depth_normal = vec4(d, n);
+
+    vec2 impact = v_material_b.y == COLORS_IMPACT ? v_color.rg : v_material_a.xy;
+    vec3 dirt = v_material_b.y == COLORS_DIRT ? v_color.rgb
+                                              : vec3(v_material_a.z, v_material_a.w, v_material_b.x);
+    o_impact_dirt = vec4(impact, dirt.y, dirt.z);
+    o_dirt_density = dirt.x;
+}
