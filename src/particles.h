@@ -1,0 +1,86 @@
+// particles.h: the live particles as a structure of arrays (thesis 4.8.3), and the
+// counter-based random stream every particle draws from.
+//
+// The arrays the step loop streams through (position, velocity, 1/mass) are kept
+// apart from the ones only a collision touches (load, identity, collision count,
+// last slide). Dead particles are removed in O(1) by moving the last one into
+// their slot. Every array holds `capacity` entries, a multiple of
+// WX_PARTICLE_BLOCK, so the step loop can run whole blocks past `count`.
+#ifndef WX_PARTICLES_H
+#define WX_PARTICLES_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "error.h"
+
+/// Particles are stepped in blocks of this many (arrays are padded to it).
+#define WX_PARTICLE_BLOCK 16
+
+/// last_cam value of a particle whose last impact was not a slide.
+#define WX_NO_SLIDE 0xFF
+
+typedef struct wx_particles {
+    int64_t count;
+    int64_t capacity;
+    // Hot: read and written by every step.
+    float *x, *y, *z;
+    float *vx, *vy, *vz;
+    float *inv_mass;
+    // Cold: touched on emission, collision and removal.
+    double *load;             ///< dirt carried
+    uint64_t *id;             ///< emitter index << 48 | serial number within it
+    uint32_t *collisions_left; ///< hits before the particle settles (>= 1 while alive)
+    uint32_t *last_texel;     ///< texel of the last slide hit (when last_cam != WX_NO_SLIDE)
+    uint32_t *last_step;      ///< step of the last slide hit
+    uint8_t *last_cam;        ///< camera of the last slide hit, or WX_NO_SLIDE
+} wx_particles;
+
+/// Bytes stored per particle slot (all arrays).
+#define WX_PARTICLE_BYTES (7 * 4 + 8 + 8 + 4 + 4 + 4 + 1)
+
+/// Frees every array; the struct is zeroed.
+void wx_particles_free(wx_particles *p);
+
+/// Makes room for at least `needed` particles (growing by half again). Returns
+/// false when out of memory (the particles are unchanged).
+bool wx_particles_reserve(wx_particles *p, int64_t needed);
+
+/// Appends one particle (capacity must be reserved). Returns its index.
+int64_t wx_particles_push(wx_particles *p, const float pos[3], const float vel[3], float mass,
+                          double load, uint64_t id, uint32_t max_collisions);
+
+/// Removes particle i by moving the last particle into its slot.
+void wx_particles_remove(wx_particles *p, int64_t i);
+
+/// The particle id of serial number `serial` of emitter `emitter`.
+static inline uint64_t wx_particle_id(uint32_t emitter, uint64_t serial)
+{
+    return ((uint64_t)emitter << 48) | (serial & ((UINT64_C(1) << 48) - 1));
+}
+
+/// SplitMix64 finaliser: a bijective 64-bit mix.
+static inline uint64_t wx_mix64(uint64_t z)
+{
+    z = (z ^ (z >> 30)) * UINT64_C(0xbf58476d1ce4e5b9);
+    z = (z ^ (z >> 27)) * UINT64_C(0x94d049bb133111eb);
+    return z ^ (z >> 31);
+}
+
+/// Counter-based random stream: a uniform float in [0, 1) that depends only on
+/// the seed, the particle id and the counter (no state, so any thread, any
+/// order, gives the same number).
+static inline float wx_particle_random(uint64_t seed, uint64_t id, uint64_t counter)
+{
+    uint64_t h = wx_mix64(seed ^ wx_mix64(id ^ wx_mix64(counter + UINT64_C(0x9e3779b97f4a7c15))));
+    return (float)(h >> 40) * (1.0f / 16777216.0f);
+}
+
+/// Counters of a particle's stream: two draws at emission, two per collision.
+enum {
+    WX_RANDOM_EMIT_0 = 0,
+    WX_RANDOM_EMIT_1 = 1,
+    WX_RANDOM_COLLISION = 2, ///< + 2 * collision number (+ 0 absorption, + 1 bounce)
+};
+
+#endif

@@ -1,0 +1,986 @@
+// simulate.c: the particle solver (thesis 4.8.2) with the projected-maps
+// collider (4.8.4.1), the mechanical reaction (4.8.4.2) and the dirt exchange
+// (4.8.4.3), as pinned in DESIGN section 4; docs/physics.md explains the
+// choices.
+//
+// One step:
+//  1. in parallel, each thread steps a contiguous range of particles, a block
+//     of WX_PARTICLE_BLOCK at a time: forces and the Euler step (vectorised),
+//     the coarse collision test (vectorised), then for the few segments it does
+//     not clear, the swept test and the reaction. Dirt is not touched: each
+//     collision is recorded as an event, each death in a list;
+//  2. serially, in particle order, the events exchange dirt with the maps;
+//  3. dead particles are removed, highest index first (swap with the last);
+//  4. emitters emit up to the new time.
+#include "simulate.h"
+
+#include <math.h>
+#include <pthread.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "collider.h"
+#include "emitter.h"
+#include "exr_io.h"
+#include "force_field.h"
+#include "particles.h"
+#include "progress.h"
+
+enum {
+    DEFAULT_HIT_CAPACITY = 4096,
+    PSEUDO_EMITTER = 0xFFFF, ///< emitter index of particles added by wx_sim_spawn
+    CHUNK_ALIGN = 64,        ///< thread ranges start on multiples of this
+};
+
+// Event flags: the impact kind in the low bits.
+enum {
+    EVENT_KIND_MASK = 3,
+    EVENT_LINE = 4, ///< slide after a slide: spread over the Bresenham line
+    EVENT_DIES = 8, ///< absorbed or at maxCollisions: deposits all it carries
+};
+
+// One collision, applied to the dirt maps in the serial phase.
+typedef struct sim_event {
+    int64_t index;  ///< particle
+    uint32_t texel; ///< hit texel
+    uint32_t from;  ///< previous slide texel (EVENT_LINE)
+    float point[3];
+    uint8_t camera;
+    uint8_t flags;
+} sim_event;
+
+// A lane the first pass could not settle: its segment was not cleared by the
+// first camera, or it ends out of the box. The other cameras' coarse test runs
+// on these, 16 at a time; what is left goes to the swept test, in particle
+// order, with the maps' lines prefetched a few candidates ahead.
+typedef struct sim_candidate {
+    int64_t index;
+    float p0[3], p1[3], v[3];
+    uint32_t flags;
+} sim_candidate;
+
+enum {
+    CAND_CLEAR = 1,  ///< certainly no collision
+    CAND_OUT_A = 2,  ///< outside the first camera's frame
+    CAND_OUTBOX = 4, ///< ends outside the bounding box
+};
+
+static const uint32_t lane_bit[WX_PARTICLE_BLOCK] = {
+    1u << 0, 1u << 1, 1u << 2,  1u << 3,  1u << 4,  1u << 5,  1u << 6,  1u << 7,
+    1u << 8, 1u << 9, 1u << 10, 1u << 11, 1u << 12, 1u << 13, 1u << 14, 1u << 15,
+};
+
+typedef struct sim_worker {
+    struct wx_sim *sim;
+    int index;
+    pthread_t thread;
+    int64_t begin, end; ///< particle range of the current step
+    sim_event *events;
+    int64_t event_count, event_capacity;
+    int64_t *dead; ///< index << 1 | escaped, in increasing index order
+    int64_t dead_count, dead_capacity;
+    sim_candidate *cands;
+    int64_t cand_count, cand_capacity;
+    bool failed; ///< out of memory in this step
+    uint32_t credit[WX_COLLIDER_MAX_CAMERAS]; ///< lanes each camera cleared first
+} sim_worker;
+
+struct wx_sim {
+    const wx_scene *scene;
+    // Configuration.
+    uint64_t seed;
+    double dt;
+    float bbox_lo[3], bbox_hi[3];
+    wx_collider_params params;
+    int emitter_count;
+    const wx_emitter *emitters;
+    int64_t *emitted; ///< per emitter
+    uint64_t spawned;
+    // World.
+    wx_forces forces;
+    wx_collider collider;
+    int input_count;
+    int *input_camera; ///< scene camera index of each input camera
+    wx_maps *owned_maps;
+    const wx_maps *maps;
+    wx_dirt_map *dirt;
+    int camera_order[WX_COLLIDER_MAX_CAMERAS]; ///< coarse test order (speed only)
+    // State.
+    int64_t step;
+    wx_particles particles;
+    wx_sim_stats stats; ///< counters and the emitted / escaped / initial ledger
+    wx_hit_sample *hits;
+    int hit_capacity, hit_next, hit_count;
+    // Threads.
+    int thread_count;
+    sim_worker *workers;
+    pthread_mutex_t lock;
+    pthread_cond_t start, done;
+    uint64_t generation;
+    int pending;
+    bool quit;
+    bool pool_started;
+};
+
+// --- per-thread recording -------------------------------------------------------
+
+static bool push_event(sim_worker *w, const sim_event *e)
+{
+    if (w->event_count == w->event_capacity) {
+        int64_t capacity = w->event_capacity > 0 ? 2 * w->event_capacity : 1024;
+        sim_event *bigger = realloc(w->events, (size_t)capacity * sizeof *bigger);
+        if (bigger == NULL) {
+            w->failed = true;
+            return false;
+        }
+        w->events = bigger;
+        w->event_capacity = capacity;
+    }
+    w->events[w->event_count++] = *e;
+    return true;
+}
+
+static void push_candidate(sim_worker *w, const sim_candidate *c)
+{
+    if (w->cand_count == w->cand_capacity) {
+        int64_t capacity = w->cand_capacity > 0 ? 2 * w->cand_capacity : 1024;
+        sim_candidate *bigger = realloc(w->cands, (size_t)capacity * sizeof *bigger);
+        if (bigger == NULL) {
+            w->failed = true;
+            return;
+        }
+        w->cands = bigger;
+        w->cand_capacity = capacity;
+    }
+    w->cands[w->cand_count++] = *c;
+}
+
+static void push_dead(sim_worker *w, int64_t index, bool escaped)
+{
+    if (w->dead_count == w->dead_capacity) {
+        int64_t capacity = w->dead_capacity > 0 ? 2 * w->dead_capacity : 1024;
+        int64_t *bigger = realloc(w->dead, (size_t)capacity * sizeof *bigger);
+        if (bigger == NULL) {
+            w->failed = true;
+            return;
+        }
+        w->dead = bigger;
+        w->dead_capacity = capacity;
+    }
+    w->dead[w->dead_count++] = index << 1 | (escaped ? 1 : 0);
+}
+
+// --- the step of one particle range ------------------------------------------
+
+static inline bool inside_box(const wx_sim *sim, const float p[3])
+{
+    return p[0] >= sim->bbox_lo[0] && p[0] <= sim->bbox_hi[0] && p[1] >= sim->bbox_lo[1] &&
+           p[1] <= sim->bbox_hi[1] && p[2] >= sim->bbox_lo[2] && p[2] <= sim->bbox_hi[2];
+}
+
+// Forces and the semi-implicit Euler step of one block (DESIGN section 4; the
+// thesis' position formula, 3.2, has a typo): a = g + F/m, v += dt a, x += dt v.
+WX_HOT static void integrate_block(const wx_forces *restrict forces, float t, float dt,
+                                   const float *restrict x, const float *restrict y,
+                                   const float *restrict z, const float *restrict vx,
+                                   const float *restrict vy, const float *restrict vz,
+                                   const float *restrict inv_mass, float *restrict nx,
+                                   float *restrict ny, float *restrict nz, float *restrict nvx,
+                                   float *restrict nvy, float *restrict nvz,
+                                   const float *restrict lo, const float *restrict hi,
+                                   int *restrict inside)
+{
+    enum { B = WX_PARTICLE_BLOCK };
+    float fx[B], fy[B], fz[B];
+    wx_forces_block(forces, t, x, y, z, fx, fy, fz);
+    float gx = forces->gravity[0], gy = forces->gravity[1], gz = forces->gravity[2];
+    for (int k = 0; k < B; ++k) {
+        nvx[k] = vx[k] + dt * (gx + fx[k] * inv_mass[k]);
+        nvy[k] = vy[k] + dt * (gy + fy[k] * inv_mass[k]);
+        nvz[k] = vz[k] + dt * (gz + fz[k] * inv_mass[k]);
+        nx[k] = x[k] + dt * nvx[k];
+        ny[k] = y[k] + dt * nvy[k];
+        nz[k] = z[k] + dt * nvz[k];
+        inside[k] = (nx[k] >= lo[0]) & (nx[k] <= hi[0]) & (ny[k] >= lo[1]) & (ny[k] <= hi[1]) &
+                    (nz[k] >= lo[2]) & (nz[k] <= hi[2]);
+    }
+}
+
+// A segment the coarse test did not clear: the swept test, and on a hit the
+// Russian roulette, the reaction and the event.
+static void collide_one(wx_sim *sim, sim_worker *w, int64_t i, const float p0[3],
+                        const float p1[3], const float v[3])
+{
+    wx_particles *P = &sim->particles;
+    wx_hit hit;
+    if (!wx_collider_sweep(&sim->collider, p0, p1, &hit)) {
+        // The Euler step stands (already stored).
+        if (!inside_box(sim, p1)) {
+            push_dead(w, i, true);
+        }
+        return;
+    }
+    // Russian roulette on the impact map (thesis 4.8.4.2, Algorithm 2).
+    uint32_t left = P->collisions_left[i];
+    uint64_t counter = WX_RANDOM_COLLISION + 2 * (uint64_t)left;
+    float r_absorb = wx_particle_random(sim->seed, P->id[i], counter);
+    float r_bounce = wx_particle_random(sim->seed, P->id[i], counter + 1);
+    wx_impact kind = r_absorb < hit.absorption ? WX_IMPACT_ABSORB
+                     : r_bounce < hit.bounce   ? WX_IMPACT_BOUNCE
+                                               : WX_IMPACT_SLIDE;
+    left = left > 0 ? left - 1 : 0;
+    P->collisions_left[i] = left;
+    bool dies = kind == WX_IMPACT_ABSORB || left == 0;
+
+    sim_event e = { 0 };
+    e.index = i;
+    e.texel = hit.texel;
+    e.camera = (uint8_t)hit.camera;
+    e.flags = (uint8_t)kind;
+    memcpy(e.point, hit.point, sizeof e.point);
+    // Streaks: a slide that follows a slide of the previous step on the same map.
+    if (kind == WX_IMPACT_SLIDE && P->last_cam[i] == hit.camera &&
+        P->last_step[i] == (uint32_t)(sim->step - 1)) {
+        e.flags |= EVENT_LINE;
+        e.from = P->last_texel[i];
+    }
+    if (kind == WX_IMPACT_SLIDE) {
+        P->last_cam[i] = (uint8_t)hit.camera;
+        P->last_texel[i] = hit.texel;
+        P->last_step[i] = (uint32_t)sim->step;
+    } else {
+        P->last_cam[i] = WX_NO_SLIDE;
+    }
+    if (dies) {
+        e.flags |= EVENT_DIES;
+    }
+    if (!push_event(w, &e)) {
+        return;
+    }
+    if (dies) {
+        P->x[i] = hit.point[0];
+        P->y[i] = hit.point[1];
+        P->z[i] = hit.point[2];
+        push_dead(w, i, false);
+        return;
+    }
+
+    // Mechanical reaction (thesis 4.8.4.2): v = vn + vt on the hit normal;
+    // bounce v = -R vn, slide v = F vt.
+    const float *N = hit.normal;
+    float vn = v[0] * N[0] + v[1] * N[1] + v[2] * N[2];
+    float after[3];
+    for (int k = 0; k < 3; ++k) {
+        float normal_part = vn * N[k];
+        after[k] = kind == WX_IMPACT_BOUNCE ? -sim->params.resilience * normal_part
+                                            : sim->params.friction * (v[k] - normal_part);
+    }
+    // The particle is put back on the surface, slightly in front of it, and
+    // spends the rest of the step at its new velocity (swept too; a second
+    // contact in the same step stops it there without a second event).
+    float rest = (1.0f - hit.s) * (float)sim->dt;
+    float q1[3];
+    for (int k = 0; k < 3; ++k) {
+        q1[k] = hit.front[k] + rest * after[k];
+    }
+    float final[3];
+    wx_hit again;
+    if (!wx_collider_coarse_clear(&sim->collider, hit.front, q1) &&
+        wx_collider_sweep(&sim->collider, hit.front, q1, &again)) {
+        memcpy(final, again.front, sizeof final);
+    } else {
+        memcpy(final, q1, sizeof final);
+    }
+    if (kind == WX_IMPACT_SLIDE) {
+        // Adherence pulls a sliding particle onto the surface: v -= A N dt / m.
+        float pull = sim->params.adherence * (float)sim->dt * P->inv_mass[i];
+        for (int k = 0; k < 3; ++k) {
+            after[k] -= pull * N[k];
+        }
+    }
+    P->x[i] = final[0];
+    P->y[i] = final[1];
+    P->z[i] = final[2];
+    P->vx[i] = after[0];
+    P->vy[i] = after[1];
+    P->vz[i] = after[2];
+    if (!inside_box(sim, final)) {
+        push_dead(w, i, true);
+    }
+}
+
+// The other cameras' coarse test on the candidates the first camera left.
+static void coarse_rest(wx_sim *sim, sim_worker *w)
+{
+    enum { B = WX_PARTICLE_BLOCK };
+    int rest = sim->input_count > 0 ? sim->input_count - 1 : 0;
+    int64_t pending[B];
+    int m = 0;
+    for (int64_t j = 0; j <= w->cand_count; ++j) {
+        if (j < w->cand_count && !(w->cands[j].flags & CAND_CLEAR)) {
+            pending[m++] = j;
+        }
+        if (m == B || (j == w->cand_count && m > 0)) {
+            float x0[B], y0[B], z0[B], x1[B], y1[B], z1[B];
+            for (int k = 0; k < B; ++k) {
+                const sim_candidate *c = &w->cands[pending[k < m ? k : 0]];
+                x0[k] = c->p0[0];
+                y0[k] = c->p0[1];
+                z0[k] = c->p0[2];
+                x1[k] = c->p1[0];
+                y1[k] = c->p1[1];
+                z1[k] = c->p1[2];
+            }
+            uint32_t outside;
+            uint32_t clear = wx_collider_coarse_block(&sim->collider, sim->camera_order + 1, rest,
+                                                      w->credit, x0, y0, z0, x1, y1, z1,
+                                                      &outside);
+            for (int k = 0; k < m; ++k) {
+                sim_candidate *c = &w->cands[pending[k]];
+                bool out_all = (c->flags & CAND_OUT_A) && ((outside >> k) & 1u);
+                if (((clear >> k) & 1u) || out_all) {
+                    c->flags |= CAND_CLEAR;
+                }
+            }
+            m = 0;
+        }
+    }
+}
+
+static void step_range(wx_sim *sim, sim_worker *w)
+{
+    enum { B = WX_PARTICLE_BLOCK };
+    wx_particles *P = &sim->particles;
+    float t = (float)((double)sim->step * sim->dt);
+    float dt = (float)sim->dt;
+    int first = sim->input_count > 0 ? 1 : 0;
+    w->event_count = 0;
+    w->dead_count = 0;
+    w->cand_count = 0;
+    w->failed = false;
+    for (int64_t b = w->begin; b < w->end; b += B) {
+        float ox[B], oy[B], oz[B], nx[B], ny[B], nz[B], nvx[B], nvy[B], nvz[B];
+        int inside[B];
+        memcpy(ox, P->x + b, sizeof ox);
+        memcpy(oy, P->y + b, sizeof oy);
+        memcpy(oz, P->z + b, sizeof oz);
+        integrate_block(&sim->forces, t, dt, ox, oy, oz, P->vx + b, P->vy + b, P->vz + b,
+                        P->inv_mass + b, nx, ny, nz, nvx, nvy, nvz, sim->bbox_lo, sim->bbox_hi,
+                        inside);
+        // The camera that cleared most last step, on every lane.
+        uint32_t out_a;
+        uint32_t clear = wx_collider_coarse_block(&sim->collider, sim->camera_order, first,
+                                                  w->credit, ox, oy, oz, nx, ny, nz, &out_a);
+        // Every lane takes its Euler step (lanes past the end are padding);
+        // the candidates below redo what the collider changes.
+        memcpy(P->x + b, nx, sizeof nx);
+        memcpy(P->y + b, ny, sizeof ny);
+        memcpy(P->z + b, nz, sizeof nz);
+        memcpy(P->vx + b, nvx, sizeof nvx);
+        memcpy(P->vy + b, nvy, sizeof nvy);
+        memcpy(P->vz + b, nvz, sizeof nvz);
+        uint32_t outbox = 0;
+        for (int k = 0; k < B; ++k) {
+            outbox |= -(uint32_t)!inside[k] & lane_bit[k];
+        }
+        int lanes = w->end - b < B ? (int)(w->end - b) : B;
+        uint32_t valid = (1u << lanes) - 1u;
+        uint32_t special = (~clear | outbox) & valid;
+        while (special != 0) {
+            int k = __builtin_ctz(special);
+            special &= special - 1;
+            uint32_t flags = (((clear >> k) & 1u) ? CAND_CLEAR : 0) |
+                             (((out_a >> k) & 1u) ? CAND_OUT_A : 0) |
+                             (((outbox >> k) & 1u) ? CAND_OUTBOX : 0);
+            sim_candidate c = { b + k, { ox[k], oy[k], oz[k] }, { nx[k], ny[k], nz[k] },
+                                { nvx[k], nvy[k], nvz[k] }, flags };
+            push_candidate(w, &c);
+        }
+    }
+    coarse_rest(sim, w);
+    // What is left, in particle order (so events and deaths stay sorted).
+    enum { AHEAD = 8 };
+    for (int64_t j = 0; j < w->cand_count; ++j) {
+        if (j + AHEAD < w->cand_count && !(w->cands[j + AHEAD].flags & CAND_CLEAR)) {
+            wx_collider_prefetch(&sim->collider, w->cands[j + AHEAD].p1);
+        }
+        const sim_candidate *c = &w->cands[j];
+        if (!(c->flags & CAND_CLEAR)) {
+            collide_one(sim, w, c->index, c->p0, c->p1, c->v);
+        } else if (c->flags & CAND_OUTBOX) {
+            push_dead(w, c->index, true); // a free flight out of the box
+        }
+    }
+}
+
+// --- the thread pool -----------------------------------------------------------
+
+static void *worker_main(void *arg)
+{
+    sim_worker *w = arg;
+    wx_sim *sim = w->sim;
+    uint64_t seen = 0;
+    pthread_mutex_lock(&sim->lock);
+    for (;;) {
+        while (sim->generation == seen && !sim->quit) {
+            pthread_cond_wait(&sim->start, &sim->lock);
+        }
+        if (sim->quit) {
+            break;
+        }
+        seen = sim->generation;
+        pthread_mutex_unlock(&sim->lock);
+        step_range(sim, w);
+        pthread_mutex_lock(&sim->lock);
+        if (--sim->pending == 0) {
+            pthread_cond_signal(&sim->done);
+        }
+    }
+    pthread_mutex_unlock(&sim->lock);
+    return NULL;
+}
+
+static void run_workers(wx_sim *sim)
+{
+    int64_t n = sim->particles.count;
+    int T = sim->thread_count;
+    int64_t chunk = (n + T - 1) / T;
+    chunk = (chunk + CHUNK_ALIGN - 1) / CHUNK_ALIGN * CHUNK_ALIGN;
+    for (int t = 0; t < T; ++t) {
+        int64_t begin = (int64_t)t * chunk;
+        sim->workers[t].begin = begin < n ? begin : n;
+        sim->workers[t].end = begin + chunk < n ? begin + chunk : n;
+    }
+    if (T == 1) {
+        step_range(sim, &sim->workers[0]);
+        return;
+    }
+    pthread_mutex_lock(&sim->lock);
+    sim->pending = T - 1;
+    sim->generation++;
+    pthread_cond_broadcast(&sim->start);
+    pthread_mutex_unlock(&sim->lock);
+    step_range(sim, &sim->workers[0]);
+    pthread_mutex_lock(&sim->lock);
+    while (sim->pending > 0) {
+        pthread_cond_wait(&sim->done, &sim->lock);
+    }
+    pthread_mutex_unlock(&sim->lock);
+}
+
+// --- the serial phases -----------------------------------------------------------
+
+static void record_hit(wx_sim *sim, const sim_event *e)
+{
+    if (sim->hit_capacity == 0) {
+        return;
+    }
+    wx_hit_sample *h = &sim->hits[sim->hit_next];
+    memcpy(h->position, e->point, sizeof h->position);
+    h->camera = e->camera;
+    h->impact = (wx_impact)(e->flags & EVENT_KIND_MASK);
+    sim->hit_next = (sim->hit_next + 1) % sim->hit_capacity;
+    if (sim->hit_count < sim->hit_capacity) {
+        sim->hit_count++;
+    }
+}
+
+// Dirt exchange (thesis 4.8.4.3 as pinned in DESIGN section 4), in particle order.
+static void apply_events(wx_sim *sim)
+{
+    double *load = sim->particles.load;
+    for (int t = 0; t < sim->thread_count; ++t) {
+        const sim_worker *w = &sim->workers[t];
+        for (int64_t k = 0; k < w->event_count; ++k) {
+            if (k + 8 < w->event_count) {
+                const sim_event *ahead = &w->events[k + 8];
+                __builtin_prefetch(&sim->dirt[ahead->camera].texels[ahead->texel]);
+                __builtin_prefetch(&load[ahead->index]);
+            }
+            const sim_event *e = &w->events[k];
+            wx_dirt_map *map = &sim->dirt[e->camera];
+            double *p = &load[e->index];
+            if (e->flags & EVENT_LINE) {
+                wx_dirt_map_exchange_line(map, e->from, e->texel, p);
+            } else {
+                wx_dirt_map_exchange(map, e->texel, p);
+            }
+            if (e->flags & EVENT_DIES) {
+                wx_dirt_map_deposit_all(map, e->texel, p);
+                if ((e->flags & EVENT_KIND_MASK) == WX_IMPACT_ABSORB) {
+                    sim->stats.absorbed++;
+                } else {
+                    sim->stats.settled++;
+                }
+            }
+            sim->stats.collisions++;
+            record_hit(sim, e);
+        }
+    }
+}
+
+// The coarse test tries first the camera that cleared most segments in the last
+// step (it stops once a block is cleared). Only speed depends on this order.
+static void reorder_cameras(wx_sim *sim)
+{
+    uint64_t credit[WX_COLLIDER_MAX_CAMERAS] = { 0 };
+    for (int t = 0; t < sim->thread_count; ++t) {
+        for (int c = 0; c < sim->input_count; ++c) {
+            credit[c] += sim->workers[t].credit[c];
+            sim->workers[t].credit[c] = 0;
+        }
+    }
+    for (int a = 1; a < sim->input_count; ++a) { // insertion sort, most credit first
+        int c = sim->camera_order[a], b = a;
+        for (; b > 0 && credit[sim->camera_order[b - 1]] < credit[c]; --b) {
+            sim->camera_order[b] = sim->camera_order[b - 1];
+        }
+        sim->camera_order[b] = c;
+    }
+}
+
+static void remove_dead(wx_sim *sim)
+{
+    for (int t = 0; t < sim->thread_count; ++t) {
+        const sim_worker *w = &sim->workers[t];
+        for (int64_t k = 0; k < w->dead_count; ++k) {
+            if (w->dead[k] & 1) {
+                sim->stats.escaped++;
+                sim->stats.dirt_escaped += sim->particles.load[w->dead[k] >> 1];
+            }
+        }
+    }
+    // Highest index first, so the particle moved into a hole is always alive.
+    for (int t = sim->thread_count - 1; t >= 0; --t) {
+        const sim_worker *w = &sim->workers[t];
+        for (int64_t k = w->dead_count - 1; k >= 0; --k) {
+            wx_particles_remove(&sim->particles, w->dead[k] >> 1);
+        }
+    }
+}
+
+static uint32_t max_collisions_of(int value)
+{
+    return value >= 1 ? (uint32_t)value : 1u;
+}
+
+static wx_result emit(wx_sim *sim, double t, wx_error *err)
+{
+    for (int e = 0; e < sim->emitter_count; ++e) {
+        const wx_emitter *em = &sim->emitters[e];
+        int64_t target = wx_emitter_count_at(em, t);
+        int64_t count = target - sim->emitted[e];
+        if (count <= 0) {
+            continue;
+        }
+        if (!wx_particles_reserve(&sim->particles, sim->particles.count + count)) {
+            return wx_error_set(err, WX_FAIL, "out of memory (%lld particles)",
+                                (long long)(sim->particles.count + count));
+        }
+        for (int64_t k = 0; k < count; ++k) {
+            uint64_t id = wx_particle_id((uint32_t)e, (uint64_t)(sim->emitted[e] + k));
+            float pos[3], vel[3];
+            wx_emitter_sample(em, sim->seed, id, pos, vel);
+            wx_particles_push(&sim->particles, pos, vel, em->mass, em->dirt, id,
+                              max_collisions_of(em->max_collisions));
+            sim->stats.dirt_emitted += em->dirt;
+        }
+        sim->emitted[e] = target;
+        sim->stats.particles_emitted += count;
+    }
+    return WX_OK;
+}
+
+wx_result wx_sim_step(wx_sim *sim, wx_error *err)
+{
+    int64_t n = sim->particles.count;
+    if (n > 0) {
+        run_workers(sim);
+        for (int t = 0; t < sim->thread_count; ++t) {
+            if (sim->workers[t].failed) {
+                return wx_error_set(err, WX_FAIL, "out of memory (collision events)");
+            }
+        }
+        sim->stats.particle_steps += n;
+        apply_events(sim);
+        remove_dead(sim);
+        reorder_cameras(sim);
+    }
+    sim->step++;
+    return emit(sim, (double)sim->step * sim->dt, err);
+}
+
+// --- creation --------------------------------------------------------------------
+
+wx_sim_config wx_sim_default_config(const wx_scene *scene)
+{
+    wx_sim_config config;
+    memset(&config, 0, sizeof config);
+    config.seed = scene->seed;
+    return config;
+}
+
+static wx_result load_maps(wx_sim *sim, wx_error *err)
+{
+    const wx_scene *scene = sim->scene;
+    sim->owned_maps = calloc((size_t)(sim->input_count > 0 ? sim->input_count : 1),
+                             sizeof *sim->owned_maps);
+    if (sim->owned_maps == NULL) {
+        return wx_error_set(err, WX_FAIL, "out of memory (maps)");
+    }
+    for (int c = 0; c < sim->input_count; ++c) {
+        const wx_scene_camera *cam = &scene->cameras[sim->input_camera[c]];
+        if (cam->depth_path[0] == '\0') {
+            return wx_error_set(err, WX_BAD_INPUT,
+                                "%s: camera '%s' has no maps yet; run `weathering bake` first",
+                                scene->path, cam->name);
+        }
+        unsigned which = WX_MAPS_DEPTH | WX_MAPS_NORMAL | WX_MAPS_IMPACT;
+        if (cam->dirt_path[0] != '\0') {
+            // A dirt map that an earlier `simulate` wrote starts from the dirt it
+            // started from (channel initialDirt), so running again is repeatable.
+            which |= WX_MAPS_DIRT | WX_MAPS_INITIAL_DIRT;
+        }
+        wx_result r = wx_maps_load(&sim->owned_maps[c], which, cam->depth_path, cam->normal_path,
+                                   cam->impact_path, cam->dirt_path, err);
+        if (r != WX_OK) {
+            wx_error_prefix(err, "camera '%s'", cam->name);
+            return r;
+        }
+    }
+    sim->maps = sim->owned_maps;
+    return WX_OK;
+}
+
+static wx_result start_pool(wx_sim *sim, wx_error *err)
+{
+    sim->workers = calloc((size_t)sim->thread_count, sizeof *sim->workers);
+    if (sim->workers == NULL) {
+        return wx_error_set(err, WX_FAIL, "out of memory (threads)");
+    }
+    for (int t = 0; t < sim->thread_count; ++t) {
+        sim->workers[t].sim = sim;
+        sim->workers[t].index = t;
+    }
+    pthread_mutex_init(&sim->lock, NULL);
+    pthread_cond_init(&sim->start, NULL);
+    pthread_cond_init(&sim->done, NULL);
+    sim->pool_started = true;
+    for (int t = 1; t < sim->thread_count; ++t) {
+        if (pthread_create(&sim->workers[t].thread, NULL, worker_main, &sim->workers[t]) != 0) {
+            sim->thread_count = t; // the ones started are stopped by destroy
+            return wx_error_set(err, WX_FAIL, "cannot start simulation thread %d", t);
+        }
+    }
+    return WX_OK;
+}
+
+wx_result wx_sim_create(const wx_scene *scene, const wx_sim_config *config, wx_sim **out,
+                        wx_error *err)
+{
+    *out = NULL;
+    wx_sim *sim = calloc(1, sizeof *sim);
+    if (sim == NULL) {
+        return wx_error_set(err, WX_FAIL, "out of memory (simulation)");
+    }
+    sim->scene = scene;
+    sim->seed = config->seed;
+    sim->dt = scene->time_step;
+    sim->params = scene->collider;
+    for (int k = 0; k < 3; ++k) {
+        sim->bbox_lo[k] = scene->bbox_center[k] - 0.5f * scene->bbox_size;
+        sim->bbox_hi[k] = scene->bbox_center[k] + 0.5f * scene->bbox_size;
+    }
+    sim->emitter_count = scene->emitter_count;
+    sim->emitters = scene->emitters;
+    sim->thread_count = config->threads > 0 ? config->threads : wx_cpu_count();
+    sim->hit_capacity = config->hit_capacity > 0 ? config->hit_capacity : DEFAULT_HIT_CAPACITY;
+
+    wx_result r = WX_OK;
+    if (!(sim->dt > 0.0) || !isfinite(sim->dt)) {
+        r = wx_error_set(err, WX_BAD_INPUT, "%s: the time step must be positive", scene->path);
+    } else if (scene->emitter_count >= PSEUDO_EMITTER) {
+        r = wx_error_set(err, WX_BAD_INPUT, "%s: too many emitters (%d)", scene->path,
+                         scene->emitter_count);
+    }
+    if (r == WX_OK) {
+        sim->emitted = calloc((size_t)(scene->emitter_count + 1), sizeof *sim->emitted);
+        sim->input_camera = calloc((size_t)(scene->camera_count + 1), sizeof *sim->input_camera);
+        sim->hits = calloc((size_t)sim->hit_capacity, sizeof *sim->hits);
+        if (sim->emitted == NULL || sim->input_camera == NULL || sim->hits == NULL) {
+            r = wx_error_set(err, WX_FAIL, "out of memory (simulation)");
+        }
+    }
+    if (r == WX_OK) {
+        for (int c = 0; c < scene->camera_count; ++c) {
+            if (!scene->cameras[c].is_output) {
+                sim->input_camera[sim->input_count++] = c;
+            }
+        }
+        for (int c = 0; c < WX_COLLIDER_MAX_CAMERAS; ++c) {
+            sim->camera_order[c] = c;
+        }
+        r = wx_forces_init(&sim->forces, scene->fields, scene->field_count, sim->seed, err);
+    }
+    if (r == WX_OK) {
+        if (config->maps != NULL) {
+            sim->maps = config->maps;
+        } else {
+            r = load_maps(sim, err);
+        }
+    }
+    wx_camera *cameras = NULL;
+    if (r == WX_OK) {
+        cameras = calloc((size_t)(sim->input_count + 1), sizeof *cameras);
+        sim->dirt = calloc((size_t)(sim->input_count + 1), sizeof *sim->dirt);
+        if (cameras == NULL || sim->dirt == NULL) {
+            r = wx_error_set(err, WX_FAIL, "out of memory (simulation)");
+        }
+    }
+    if (r == WX_OK) {
+        for (int c = 0; c < sim->input_count; ++c) {
+            cameras[c] = scene->cameras[sim->input_camera[c]].camera;
+        }
+        r = wx_collider_init(&sim->collider, cameras, sim->maps, sim->input_count,
+                             config->nearest_depth, err);
+    }
+    free(cameras);
+    for (int c = 0; r == WX_OK && c < sim->input_count; ++c) {
+        const wx_maps *m = &sim->maps[c];
+        r = wx_dirt_map_init(&sim->dirt[c], m->width, m->height, m->dirt, m->deposit,
+                             m->erosion, scene->collider.deposit, scene->collider.erosion,
+                             sim->collider.cameras[c].depth, err);
+        if (r == WX_OK) {
+            sim->stats.dirt_initial_surface += wx_dirt_map_total(&sim->dirt[c]);
+        }
+    }
+    if (r == WX_OK) {
+        r = start_pool(sim, err);
+    }
+    if (r != WX_OK) {
+        wx_sim_destroy(sim);
+        return r;
+    }
+    *out = sim;
+    return WX_OK;
+}
+
+void wx_sim_destroy(wx_sim *sim)
+{
+    if (sim == NULL) {
+        return;
+    }
+    if (sim->pool_started) {
+        pthread_mutex_lock(&sim->lock);
+        sim->quit = true;
+        pthread_cond_broadcast(&sim->start);
+        pthread_mutex_unlock(&sim->lock);
+        for (int t = 1; t < sim->thread_count; ++t) {
+            pthread_join(sim->workers[t].thread, NULL);
+        }
+        pthread_mutex_destroy(&sim->lock);
+        pthread_cond_destroy(&sim->start);
+        pthread_cond_destroy(&sim->done);
+    }
+    if (sim->workers != NULL) {
+        for (int t = 0; t < sim->thread_count; ++t) {
+            free(sim->workers[t].events);
+            free(sim->workers[t].dead);
+            free(sim->workers[t].cands);
+        }
+        free(sim->workers);
+    }
+    if (sim->dirt != NULL) {
+        for (int c = 0; c < sim->input_count; ++c) {
+            wx_dirt_map_free(&sim->dirt[c]);
+        }
+        free(sim->dirt);
+    }
+    wx_collider_free(&sim->collider);
+    if (sim->owned_maps != NULL) {
+        for (int c = 0; c < sim->input_count; ++c) {
+            wx_maps_free(&sim->owned_maps[c]);
+        }
+        free(sim->owned_maps);
+    }
+    wx_forces_free(&sim->forces);
+    wx_particles_free(&sim->particles);
+    free(sim->emitted);
+    free(sim->input_camera);
+    free(sim->hits);
+    free(sim);
+}
+
+// --- access -----------------------------------------------------------------------
+
+int64_t wx_sim_step_count(const wx_sim *sim)
+{
+    return sim->step;
+}
+
+double wx_sim_time(const wx_sim *sim)
+{
+    return (double)sim->step * sim->dt;
+}
+
+void wx_sim_particles(const wx_sim *sim, wx_particle_view *view)
+{
+    const wx_particles *P = &sim->particles;
+    view->count = P->count;
+    view->x = P->x;
+    view->y = P->y;
+    view->z = P->z;
+    view->vx = P->vx;
+    view->vy = P->vy;
+    view->vz = P->vz;
+    view->load = P->load;
+}
+
+int wx_sim_recent_hits(const wx_sim *sim, wx_hit_sample *out, int max)
+{
+    int n = sim->hit_count < max ? sim->hit_count : max;
+    // The newest n, oldest first.
+    int first = sim->hit_next - n;
+    if (first < 0) {
+        first += sim->hit_capacity;
+    }
+    for (int k = 0; k < n; ++k) {
+        out[k] = sim->hits[(first + k) % sim->hit_capacity];
+    }
+    return n;
+}
+
+void wx_sim_get_stats(const wx_sim *sim, wx_sim_stats *stats)
+{
+    *stats = sim->stats;
+    stats->alive = sim->particles.count;
+    stats->dirt_final_surface = 0.0;
+    for (int c = 0; c < sim->input_count; ++c) {
+        stats->dirt_final_surface += wx_dirt_map_total(&sim->dirt[c]);
+    }
+    stats->dirt_in_flight = 0.0;
+    for (int64_t i = 0; i < sim->particles.count; ++i) {
+        stats->dirt_in_flight += sim->particles.load[i];
+    }
+}
+
+int wx_sim_input_count(const wx_sim *sim)
+{
+    return sim->input_count;
+}
+
+const wx_dirt_map *wx_sim_dirt_map(const wx_sim *sim, int input)
+{
+    return &sim->dirt[input];
+}
+
+wx_result wx_sim_spawn(wx_sim *sim, const float position[3], const float velocity[3],
+                       float mass, double load, int max_collisions, wx_error *err)
+{
+    if (!(mass > 0.0f) || !isfinite(mass)) {
+        return wx_error_set(err, WX_BAD_INPUT, "particle mass must be positive");
+    }
+    if (!wx_particles_reserve(&sim->particles, sim->particles.count + 1)) {
+        return wx_error_set(err, WX_FAIL, "out of memory (particles)");
+    }
+    uint64_t id = wx_particle_id(PSEUDO_EMITTER, sim->spawned++);
+    wx_particles_push(&sim->particles, position, velocity, mass, load, id,
+                      max_collisions_of(max_collisions));
+    sim->stats.particles_emitted++;
+    sim->stats.dirt_emitted += load;
+    return WX_OK;
+}
+
+// --- output -----------------------------------------------------------------------
+
+static wx_result write_one(const wx_sim *sim, const wx_run_options *opts, int c, wx_image *image,
+                           wx_image *header, wx_error *err)
+{
+    const wx_scene_camera *cam = &sim->scene->cameras[sim->input_camera[c]];
+    const wx_dirt_map *map = &sim->dirt[c];
+    const wx_maps *maps = &sim->maps[c];
+    char name[300];
+    snprintf(name, sizeof name, "%s_dirt.exr", cam->name);
+    char path[WX_PATH_MAX];
+    wx_result r = wx_output_path(sim->scene, opts, name, path, err);
+    if (r != WX_OK) {
+        return r;
+    }
+    // R G B keep the dirt map layout (R now the simulated dirt); initialDirt is
+    // the dirt the simulation started from, which a later `simulate` reads.
+    static const char *const channels[4] = { "R", "G", "B", WX_INITIAL_DIRT_CHANNEL };
+    r = wx_image_alloc(image, map->width, map->height, 4, channels, err);
+    if (r != WX_OK) {
+        return r;
+    }
+    size_t texels = (size_t)map->width * (size_t)map->height;
+    for (size_t t = 0; t < texels; ++t) {
+        image->channels[0][t] = (float)map->texels[t].dirt;
+        image->channels[1][t] = maps->deposit != NULL ? maps->deposit[t] : 0.0f;
+        image->channels[2][t] = maps->erosion != NULL ? maps->erosion[t] : 0.0f;
+        image->channels[3][t] = maps->dirt != NULL ? maps->dirt[t] : 0.0f;
+    }
+    // The input dirt map's header travels with it.
+    if (cam->dirt_path[0] != '\0' && wx_exr_read_header(cam->dirt_path, header, err) == WX_OK) {
+        for (int a = 0; a < header->attr_count && image->attr_count < WX_IMAGE_MAX_ATTRS; ++a) {
+            image->attrs[image->attr_count++] = header->attrs[a];
+        }
+    }
+    wx_image_free(header);
+    if (wx_image_find_attr(image, "WTCMatrix") == NULL) {
+        wx_image_set_m44f(image, "WTCMatrix", cam->camera.wtc);
+    }
+    if (wx_image_find_attr(image, "CTWMatrix") == NULL) {
+        wx_image_set_m44f(image, "CTWMatrix", cam->camera.ctw);
+    }
+    if (wx_image_find_attr(image, "cameraName") == NULL) {
+        wx_image_set_string(image, "cameraName", cam->name);
+    }
+    r = wx_exr_write(path, image, err);
+    wx_image_free(image);
+    return r;
+}
+
+wx_result wx_sim_write_dirt_maps(const wx_sim *sim, const wx_run_options *opts, wx_error *err)
+{
+    // Images carry their attributes inline (tens of kilobytes): not on the stack.
+    wx_image *images = calloc(2, sizeof *images);
+    if (images == NULL) {
+        return wx_error_set(err, WX_FAIL, "out of memory (dirt maps)");
+    }
+    wx_result r = WX_OK;
+    for (int c = 0; c < sim->input_count && r == WX_OK; ++c) {
+        r = write_one(sim, opts, c, &images[0], &images[1], err);
+    }
+    free(images);
+    return r;
+}
+
+wx_result wx_simulate_scene(const wx_scene *scene, const wx_run_options *opts,
+                            wx_sim_stats *stats, wx_error *err)
+{
+    wx_sim_config config = wx_sim_default_config(scene);
+    config.seed = opts->seed;
+    config.threads = opts->threads;
+    wx_sim *sim = NULL;
+    wx_result r = wx_sim_create(scene, &config, &sim, err);
+    if (r != WX_OK) {
+        return r;
+    }
+    wx_progress progress;
+    wx_progress_begin(&progress, "simulate", scene->steps, opts->quiet);
+    for (int64_t s = 0; s < scene->steps && r == WX_OK; ++s) {
+        r = wx_sim_step(sim, err);
+        wx_progress_update(&progress, s + 1);
+    }
+    wx_progress_end(&progress);
+    if (r == WX_OK) {
+        r = wx_sim_write_dirt_maps(sim, opts, err);
+    }
+    if (stats != NULL) {
+        wx_sim_get_stats(sim, stats);
+    }
+    wx_sim_destroy(sim);
+    return r;
+}

@@ -1,0 +1,175 @@
+// test_emitter.c: emission counts and start states (DESIGN section 3).
+#include <math.h>
+#include <string.h>
+
+#include "emitter.h"
+#include "ensure.h"
+#include "particles.h"
+#include "sim_fixture.h"
+#include "simulate.h"
+
+static wx_emitter point_emitter(double rate, double start, double end, float speed)
+{
+    wx_emitter e;
+    memset(&e, 0, sizeof e);
+    e.kind = WX_EMITTER_POINT;
+    e.rate = rate;
+    e.start = start;
+    e.end = end;
+    e.speed = speed;
+    e.mass = 1;
+    e.dirt = 1;
+    e.max_collisions = 100;
+    return e;
+}
+
+// floor(rate * (t - start)), t clipped to [start, end]; worked out by hand.
+TEST(emission_count_is_floor_of_rate_times_time)
+{
+    wx_emitter e = point_emitter(1000, 0.05, 1.0, 1);
+    ENSURE(wx_emitter_count_at(&e, 0.0) == 0);
+    ENSURE(wx_emitter_count_at(&e, 0.05) == 0);
+    ENSURE(wx_emitter_count_at(&e, 0.0505) == 0);   // 0.5
+    ENSURE(wx_emitter_count_at(&e, 0.0515) == 1);   // 1.5
+    ENSURE(wx_emitter_count_at(&e, 29 * 0.01) == 240); // 1000*0.24, decimal time step
+    ENSURE(wx_emitter_count_at(&e, 0.5) == 450);
+    ENSURE(wx_emitter_count_at(&e, 1.0) == 950);
+    ENSURE(wx_emitter_count_at(&e, 7.0) == 950); // rate * (end - start) in all
+    wx_emitter slow = point_emitter(333, 0, 1e30, 1);
+    ENSURE(wx_emitter_count_at(&slow, 0.1) == 33);  // 33.3
+    ENSURE(wx_emitter_count_at(&slow, 0.3) == 99);  // 99.9
+    ENSURE(wx_emitter_count_at(&slow, 1.0) == 333);
+}
+
+// The simulation emits exactly that many, step after step.
+TEST(simulation_emits_floor_counts)
+{
+    fx_scene f;
+    fx_scene_init(&f);
+    wx_emitter *e = fx_emitter(&f, WX_EMITTER_POINT, 0, 0, 0);
+    e->rate = 333;
+    e->start = 0.1;
+    e->end = 0.75;
+    wx_sim_config cfg = wx_sim_default_config(&f.scene);
+    cfg.threads = 1;
+    wx_sim *sim = NULL;
+    wx_error err;
+    ENSURE(wx_sim_create(&f.scene, &cfg, &sim, &err) == WX_OK);
+    int ok = 1;
+    for (int k = 1; k <= 100; ++k) {
+        ENSURE(wx_sim_step(sim, &err) == WX_OK);
+        wx_sim_stats st;
+        wx_sim_get_stats(sim, &st);
+        double t = k * 0.01;
+        double until = t < 0.75 ? t : 0.75;
+        int64_t expect = until > 0.1 ? (int64_t)floor(333 * (until - 0.1) + 1e-9) : 0;
+        ok &= st.particles_emitted == expect;
+        if (k == 30) {
+            ok &= st.particles_emitted == 66; // 333 * 0.2 = 66.6
+        }
+    }
+    wx_sim_stats st;
+    wx_sim_get_stats(sim, &st);
+    wx_sim_destroy(sim);
+    ENSURE(ok);
+    ENSURE(st.particles_emitted == 216); // floor(333 * 0.65) = floor(216.45)
+    ENSURE(st.alive == 216);             // no gravity, no cameras: nobody leaves
+    ENSURE_NEAR(st.dirt_emitted, 216.0, 0.0);
+}
+
+// Uniform directions: every component averages 0 and its square 1/3.
+TEST(point_emitter_directions_are_uniform)
+{
+    wx_emitter e = point_emitter(1, 0, 1, 2.0f);
+    e.center[0] = 1;
+    e.center[1] = 2;
+    e.center[2] = 3;
+    enum { N = 200000 };
+    double mean[3] = { 0 }, square[3] = { 0 };
+    int bad = 0;
+    for (int i = 0; i < N; ++i) {
+        float p[3], v[3];
+        wx_emitter_sample(&e, 7, wx_particle_id(0, (uint64_t)i), p, v);
+        bad += p[0] != 1 || p[1] != 2 || p[2] != 3;
+        double len = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+        bad += fabs(len - 2.0) > 1e-5;
+        for (int k = 0; k < 3; ++k) {
+            mean[k] += v[k] / 2.0 / N;
+            square[k] += v[k] * v[k] / 4.0 / N;
+        }
+    }
+    ENSURE(bad == 0);
+    for (int k = 0; k < 3; ++k) {
+        ENSURE_NEAR(mean[k], 0.0, 0.006); // 5 sigma of 1/sqrt(3N)
+        ENSURE_NEAR(square[k], 1.0 / 3.0, 0.004);
+    }
+    // Half the directions in each half-space through the centre, for any axis.
+    int upper = 0;
+    for (int i = 0; i < N; ++i) {
+        float p[3], v[3];
+        wx_emitter_sample(&e, 7, wx_particle_id(0, (uint64_t)i), p, v);
+        upper += v[0] + v[1] + v[2] > 0;
+    }
+    ENSURE_NEAR(upper / (double)N, 0.5, 0.006);
+}
+
+TEST(point_emitter_speed_zero_drops_at_rest)
+{
+    wx_emitter e = point_emitter(1, 0, 1, 0.0f);
+    float p[3], v[3];
+    wx_emitter_sample(&e, 1, wx_particle_id(0, 5), p, v);
+    ENSURE(v[0] == 0 && v[1] == 0 && v[2] == 0);
+}
+
+// Sky dome: on the sphere of radius r above the centre, moving towards it; the
+// height of a uniform point on the hemisphere averages 1/2.
+TEST(hemisphere_emitter_rains_towards_its_centre)
+{
+    wx_emitter e = point_emitter(1, 0, 1, 3.0f);
+    e.kind = WX_EMITTER_HEMISPHERE;
+    e.radius = 20;
+    e.center[1] = -1;
+    enum { N = 100000 };
+    double mean_y = 0, mean_x = 0;
+    int bad = 0;
+    for (int i = 0; i < N; ++i) {
+        float p[3], v[3];
+        wx_emitter_sample(&e, 3, wx_particle_id(2, (uint64_t)i), p, v);
+        float d[3] = { p[0] / 20, (p[1] + 1) / 20, p[2] / 20 };
+        bad += !(d[1] > 0);
+        bad += fabs(sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) - 1) > 1e-5;
+        for (int k = 0; k < 3; ++k) {
+            bad += fabsf(v[k] + 3.0f * d[k]) > 1e-4f;
+        }
+        mean_y += d[1] / N;
+        mean_x += d[0] / N;
+    }
+    ENSURE(bad == 0);
+    ENSURE_NEAR(mean_y, 0.5, 0.005);
+    ENSURE_NEAR(mean_x, 0.0, 0.007);
+}
+
+// A particle's start depends only on seed and id.
+TEST(samples_depend_on_seed_and_id_only)
+{
+    wx_emitter e = point_emitter(1, 0, 1, 1.0f);
+    float p1[3], v1[3], p2[3], v2[3], p3[3], v3[3], p4[3], v4[3];
+    wx_emitter_sample(&e, 9, wx_particle_id(1, 42), p1, v1);
+    wx_emitter_sample(&e, 9, wx_particle_id(1, 43), p3, v3);
+    wx_emitter_sample(&e, 9, wx_particle_id(1, 42), p2, v2);
+    wx_emitter_sample(&e, 10, wx_particle_id(1, 42), p4, v4);
+    ENSURE(memcmp(v1, v2, sizeof v1) == 0);
+    ENSURE(memcmp(v1, v3, sizeof v1) != 0);
+    ENSURE(memcmp(v1, v4, sizeof v1) != 0);
+}
+
+int main(void)
+{
+    RUN(emission_count_is_floor_of_rate_times_time);
+    RUN(simulation_emits_floor_counts);
+    RUN(point_emitter_directions_are_uniform);
+    RUN(point_emitter_speed_zero_drops_at_rest);
+    RUN(hemisphere_emitter_rains_towards_its_centre);
+    RUN(samples_depend_on_seed_and_id_only);
+    return ensure_summary();
+}
