@@ -11,9 +11,12 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "bake.h"
+#include "gather.h"
 #include "pipeline.h"
 #include "progress.h"
 #include "scene.h"
+#include "simulate.h"
 
 #define WX_VERSION "0.1.0"
 
@@ -37,8 +40,16 @@ typedef struct command {
 } command;
 
 static int command_info(const cli_args *args);
+static int command_bake(const cli_args *args);
+static int command_simulate(const cli_args *args);
+static int command_gather(const cli_args *args);
+static int command_run(const cli_args *args);
 
 static const command commands[] = {
+    { "run", command_run, "bake what needs baking, simulate, gather: the whole job" },
+    { "bake", command_bake, "render the maps of <View> cameras from the scene's meshes" },
+    { "simulate", command_simulate, "fly the particles; write <camera>_dirt.exr" },
+    { "gather", command_gather, "turn the dirt maps into the output camera's mask" },
     { "info", command_info, "validate a scene and print what it holds" },
 };
 enum { COMMAND_COUNT = sizeof commands / sizeof commands[0] };
@@ -329,6 +340,115 @@ static int command_info(const cli_args *args)
     printf("output folder: %s\n", opts.out_dir);
     wx_scene_free(&scene);
     return 0;
+}
+
+// --- bake, simulate, gather, run ------------------------------------------------
+
+typedef enum phase {
+    PHASE_BAKE = 1 << 0,
+    PHASE_SIMULATE = 1 << 1,
+    PHASE_GATHER = 1 << 2,
+} phase;
+
+// True when some <View> camera has no map files in the scene; marks those
+// cameras' maps as the output folder's own (bake is about to write them there).
+static bool needs_bake(wx_scene *scene)
+{
+    bool any = false;
+    for (int c = 0; c < scene->camera_count; ++c) {
+        wx_scene_camera *cam = &scene->cameras[c];
+        if (cam->has_view && cam->depth_path[0] == '\0') {
+            cam->maps_in_output = true;
+            any = true;
+        }
+    }
+    return any;
+}
+
+static int report(wx_result r, const wx_error *err)
+{
+    if (r != WX_OK) {
+        fprintf(stderr, "weathering: %s\n", err->message);
+    }
+    return r;
+}
+
+// Runs the phases in `phases` in order, in one process; a phase that is not run
+// reads what an earlier command left in the output folder.
+static int run_phases(const cli_args *args, unsigned phases)
+{
+    double start = wx_now_s();
+    wx_phase_times times = { 0 };
+    wx_sim_stats stats = { 0 };
+    wx_scene scene;
+    wx_run_options opts;
+    int status = load_scene(args, &scene, &opts);
+    if (status != WX_OK) {
+        return status;
+    }
+    wx_error err;
+    wx_result r = WX_OK;
+    if ((phases & PHASE_GATHER) && scene.output_index < 0) {
+        r = wx_error_set(&err, WX_BAD_INPUT,
+                         "%s: has no output camera (<Ortho out=\"true\">); `%s` needs one",
+                         scene.path, args->command);
+    }
+    if (r == WX_OK) {
+        r = wx_output_prepare(&opts, &err);
+    }
+    times.load = wx_now_s() - start;
+    if (r == WX_OK && (phases & PHASE_BAKE)) {
+        double t0 = wx_now_s();
+        if (needs_bake(&scene)) {
+            r = wx_bake_scene(&scene, &opts, &err);
+        } else if (phases == PHASE_BAKE && !opts.quiet) {
+            fprintf(stderr, "weathering: %s: every camera has its maps; nothing to bake\n",
+                    scene.path);
+        }
+        times.bake = wx_now_s() - t0;
+    } else if (r == WX_OK) {
+        r = wx_use_baked_maps(&scene, &opts, &err);
+    }
+    if (r == WX_OK && (phases & PHASE_SIMULATE)) {
+        double t0 = wx_now_s();
+        r = wx_simulate_scene(&scene, &opts, &stats, &err);
+        times.simulate = wx_now_s() - t0;
+    }
+    if (r == WX_OK && (phases & PHASE_GATHER)) {
+        double t0 = wx_now_s();
+        r = wx_gather_scene(&scene, &opts, &err);
+        times.gather = wx_now_s() - t0;
+    }
+    times.total = wx_now_s() - start;
+    if (r == WX_OK && opts.stats_path != NULL) {
+        r = wx_write_stats(opts.stats_path, &opts, &stats, &times, &err);
+    }
+    if (r == WX_OK && !opts.quiet) {
+        fprintf(stderr, "weathering: %s done in %.2f s; outputs in %s\n", args->command,
+                times.total, opts.out_dir);
+    }
+    wx_scene_free(&scene);
+    return report(r, &err);
+}
+
+static int command_bake(const cli_args *args)
+{
+    return run_phases(args, PHASE_BAKE);
+}
+
+static int command_simulate(const cli_args *args)
+{
+    return run_phases(args, PHASE_SIMULATE);
+}
+
+static int command_gather(const cli_args *args)
+{
+    return run_phases(args, PHASE_GATHER);
+}
+
+static int command_run(const cli_args *args)
+{
+    return run_phases(args, PHASE_BAKE | PHASE_SIMULATE | PHASE_GATHER);
 }
 
 int main(int argc, char **argv)
