@@ -30,9 +30,15 @@ TEST_SUPPORT_OBJ := $(BUILD)/obj/tests/ensure.o
 BENCH_SRC := $(wildcard tests/bench/bench_*.c)
 BENCH_BIN := $(BENCH_SRC:tests/bench/%.c=$(BUILD)/bench/%)
 SHADERS := $(wildcard shaders/*.glsl)
+VIEWER_SRC := $(wildcard viewer/*.c)
+VIEWER_OBJ := $(VIEWER_SRC:viewer/%.c=$(BUILD)/obj/viewer/%.o)
+VIEWER_BIN := $(if $(VIEWER_SRC),$(BUILD)/weathering-viewer)
+# The viewer draws with the system's GL (GLFW); it never links OSMesa, and runs
+# `weathering bake` in a child process when a scene's maps are still to bake.
+VIEWER_LIBS := -lglfw -lGL -lOpenEXRCore-3_1 -lxml2 -lpng -lm -lpthread
 
 .PHONY: all deps test run bench clean
-all: $(BUILD)/weathering
+all: $(BUILD)/weathering $(VIEWER_BIN)
 
 # Installs whatever Debian package is missing (apt-get update first), as root or
 # through sudo. Checked on every make: dpkg -s is quick.
@@ -61,6 +67,13 @@ $(BUILD)/gen/shaders.h: $(SHADERS) shaders/embed.sh
 
 $(LIB_OBJ): $(BUILD)/gen/shaders.h
 
+$(BUILD)/obj/viewer/%.o: viewer/%.c $(BUILD)/gen/shaders.h | deps
+	@mkdir -p $(dir $@)
+	$(CC) $(ALL_CFLAGS) -Iviewer -c $< -o $@
+
+$(BUILD)/weathering-viewer: $(VIEWER_OBJ) $(BUILD)/libweathering.a
+	$(CC) $(ALL_CFLAGS) -o $@ $^ $(VIEWER_LIBS)
+
 $(BUILD)/obj/bench/%.o: tests/bench/%.c | deps
 	@mkdir -p $(dir $@)
 	$(CC) $(ALL_CFLAGS) -Itests -c $< -o $@
@@ -81,7 +94,7 @@ $(BUILD)/tests/%: $(BUILD)/obj/tests/%.o $(TEST_SUPPORT_OBJ) $(BUILD)/libweather
 	@mkdir -p $(dir $@)
 	$(CC) $(ALL_CFLAGS) -o $@ $^ $(LIBS)
 
-test: $(BUILD)/weathering $(TEST_BIN)
+test: $(BUILD)/weathering $(VIEWER_BIN) $(TEST_BIN)
 	WX_BUILD=$(BUILD) WX_TESTS=tests tests/run.sh $(BUILD)/tests
 
 # Each benchmark prints its table; targets are checked here, never in make test.
@@ -94,4 +107,4 @@ run: $(BUILD)/weathering
 clean:
 	rm -rf $(BUILD)
 
--include $(wildcard $(BUILD)/obj/*.d $(BUILD)/obj/tests/*.d $(BUILD)/obj/bench/*.d)
+-include $(wildcard $(BUILD)/obj/*.d $(BUILD)/obj/tests/*.d $(BUILD)/obj/bench/*.d $(BUILD)/obj/viewer/*.d)

@@ -1,0 +1,41 @@
+// palette.h: the viewer's colours, as 8-bit sRGB triples so that a screenshot
+// holds them exactly (tests/test_viewer.c looks for the camera colours).
+//
+// Input camera k is drawn in VW_CAMERA_COLORS[k % VW_CAMERA_COLOR_COUNT]: its
+// frame rectangle exactly, its depth samples shaded by their normal. The output
+// camera is white.
+#ifndef VW_PALETTE_H
+#define VW_PALETTE_H
+
+#include <stdint.h>
+
+enum { VW_CAMERA_COLOR_COUNT = 8 };
+
+static const uint8_t VW_CAMERA_COLORS[VW_CAMERA_COLOR_COUNT][3] = {
+    { 77, 153, 255 },  // blue
+    { 77, 217, 77 },   // green
+    { 242, 89, 204 },  // magenta
+    { 242, 230, 77 },  // yellow
+    { 77, 230, 230 },  // cyan
+    { 255, 128, 51 },  // orange
+    { 179, 128, 255 }, // violet
+    { 153, 204, 102 }, // olive
+};
+
+static const uint8_t VW_OUTPUT_COLOR[3] = { 255, 255, 255 };
+static const uint8_t VW_BACKGROUND_COLOR[3] = { 20, 23, 28 };
+static const uint8_t VW_BBOX_COLOR[3] = { 110, 110, 125 };
+static const uint8_t VW_EMITTER_COLOR[3] = { 255, 160, 160 };
+
+/// Particles: clean (load 0) to dirty (load >= the largest emitter dirt).
+static const uint8_t VW_PARTICLE_CLEAN_COLOR[3] = { 190, 225, 255 };
+static const uint8_t VW_PARTICLE_DIRTY_COLOR[3] = { 150, 100, 50 };
+
+/// Hit points by what the particle did: absorbed, bounced, slid.
+static const uint8_t VW_HIT_COLORS[3][3] = {
+    { 255, 40, 40 },   // absorbed (or settled)
+    { 255, 255, 170 }, // bounced
+    { 170, 255, 200 }, // slid
+};
+
+#endif
