@@ -23,17 +23,14 @@ static void use_material(writer *w, const char *name)
     }
 }
 
-// An axis-aligned box from (x0,y0,z0) to (x1,y1,z1), faces wound counter-clockwise
-// seen from outside.
-static void box(writer *w, const char *material, double x0, double y0, double z0, double x1,
-                double y1, double z1)
+// A hexahedron from its 8 corners, corner k being the (x bit 0, y bit 1, z bit 2)
+// corner of the box it deforms; faces wound counter-clockwise seen from outside.
+static void hexahedron(writer *w, const char *material, double corner[8][3])
 {
     use_material(w, material);
-    double xs[2] = { x0, x1 }, ys[2] = { y0, y1 }, zs[2] = { z0, z1 };
     for (int k = 0; k < 8; ++k) {
-        fprintf(w->obj, "v %.4f %.4f %.4f\n", xs[k & 1], ys[(k >> 1) & 1], zs[(k >> 2) & 1]);
+        fprintf(w->obj, "v %.4f %.4f %.4f\n", corner[k][0], corner[k][1], corner[k][2]);
     }
-    // Vertex k has x bit 0, y bit 1, z bit 2. Quads (outward CCW):
     static const int quads[6][4] = {
         { 0, 4, 6, 2 }, // -X
         { 1, 3, 7, 5 }, // +X
@@ -49,6 +46,26 @@ static void box(writer *w, const char *material, double x0, double y0, double z0
     }
     w->vertex_count += 8;
     w->box_count += 1;
+}
+
+// A box from (x0,y0,z0) to (x1,y1,z1) whose +Z (front) edges are lowered by
+// `drop`: 0 gives an axis-aligned box, more a top sloping down towards +Z.
+static void sloped_box(writer *w, const char *material, double x0, double y0, double z0,
+                       double x1, double y1, double z1, double drop)
+{
+    double corner[8][3];
+    for (int k = 0; k < 8; ++k) {
+        corner[k][0] = (k & 1) ? x1 : x0;
+        corner[k][1] = ((k >> 1) & 1 ? y1 : y0) - ((k >> 2) & 1 ? drop : 0.0);
+        corner[k][2] = (k >> 2) & 1 ? z1 : z0;
+    }
+    hexahedron(w, material, corner);
+}
+
+static void box(writer *w, const char *material, double x0, double y0, double z0, double x1,
+                double y1, double z1)
+{
+    sloped_box(w, material, x0, y0, z0, x1, y1, z1, 0.0);
 }
 
 int main(int argc, char **argv)
@@ -85,6 +102,7 @@ int main(int argc, char **argv)
     const int floors = 4, columns = 3;
     const double floor_h = height / floors;
     const double win_w = 1.4, win_h = 1.6, sill_y = 0.9; // window above floor level
+    const double sill_out = 0.12, sill_drop = 0.16;        // sill overhang, slope
 
     box(&w, "ground", -7, -0.2, -7, 7, 0.0, 7);
     // Core of the building, its front face is the glass behind the openings.
@@ -104,10 +122,14 @@ int main(int argc, char **argv)
         for (int f = 0; f < floors; ++f) {
             double y0 = f * floor_h;
             double wy0 = y0 + sill_y, wy1 = wy0 + win_h;
-            box(&w, "wall", wx0, y0, front - recess, wx1, wy0, front);
+            // The wall under the window stops below the sill, whose top slopes
+            // down towards the street: it must not poke through it.
+            box(&w, "wall", wx0, y0, front - recess, wx1, wy0 - 0.08 - sill_drop, front);
             box(&w, "wall", wx0, wy1, front - recess, wx1, y0 + floor_h, front);
-            // Sill: a slab under the opening, sticking out of the facade.
-            box(&w, "sill", wx0 - 0.1, wy0 - 0.08, front - recess, wx1 + 0.1, wy0, front + 0.25);
+            // Sill: a slab under the opening, sticking out of the facade, its top
+            // sloping outwards so that rain runs off its front edge.
+            sloped_box(&w, "sill", wx0 - 0.1, wy0 - 0.08, front - recess, wx1 + 0.1, wy0,
+                       front + sill_out, sill_drop);
         }
     }
     // Balcony on the second floor, centre bay: slab, railing posts and top rail.
