@@ -523,6 +523,51 @@ static double march_entry(const wx_collider *collider, march *m, double s)
     return 2.0;
 }
 
+// The camera that gives the hit at parameter s: DESIGN section 4's "smallest
+// d - depth", read to each map's precision. Across one texel, the depth of a
+// surface seen at angle theta changes by texel * tan(theta), so a camera that
+// sees the surface at a grazing angle has d - depth near 0 over a wide band and
+// would win hits that belong to a camera seeing the same surface head-on. Such a
+// camera's texel covers a long strip of surface while it wins only part of the
+// strip's hits, so its dirt per area comes out too low and the mask shows the
+// cameras' patches. So: among the cameras whose d - depth is within half a texel
+// plus one texel's worth of that slope, the most head-on one (largest |N.view|,
+// the camera `bake` gives initial dirt to) gives the hit; without any, the
+// smallest d - depth. -1 when no camera sees a surface at s.
+static int pick_camera(const wx_collider *collider, const march *m, double s)
+{
+    int best = -1, closest = -1;
+    double best_cos = -1.0, closest_f = INFINITY;
+    for (int c = 0; c < collider->camera_count; ++c) {
+        if (!march_inside(&m[c], s) || !m[c].surface) {
+            continue;
+        }
+        const wx_collider_camera *cam = &collider->cameras[c];
+        double f = m[c].A + s * (m[c].B + s * m[c].C);
+        if (closest < 0 || f < closest_f) {
+            closest = c;
+            closest_f = f;
+        }
+        size_t texel = (size_t)(m[c].hy >> 1) * (size_t)cam->width + (size_t)(m[c].hx >> 1);
+        const float *n = cam->normal + 3 * texel;
+        double bl = sqrt((double)cam->back[0] * cam->back[0] + (double)cam->back[1] * cam->back[1] +
+                         (double)cam->back[2] * cam->back[2]);
+        double nl = sqrt((double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2]);
+        if (!(bl > 0.0) || !(nl > 1e-6) || !isfinite(nl)) {
+            continue;
+        }
+        double cos_view = fabs(n[0] * cam->back[0] + n[1] * cam->back[1] + n[2] * cam->back[2]) /
+                          (bl * nl);
+        double tan_view = sqrt(fmax(0.0, 1.0 - cos_view * cos_view)) / fmax(cos_view, 0.05);
+        double precision = cam->texel_ws * (0.5 + tan_view);
+        if (f * bl <= precision && cos_view > best_cos) {
+            best = c;
+            best_cos = cos_view;
+        }
+    }
+    return best >= 0 ? best : closest;
+}
+
 // True when camera `cam` sees p inside its frame and in front of its surface (or
 // over no surface): then p does not collide, whatever the other cameras say.
 static bool camera_sees_in_front(const wx_collider *collider, const wx_collider_camera *cam,
@@ -628,19 +673,8 @@ bool wx_collider_sweep(const wx_collider *collider, const float p0[3], const flo
     if (!agreed) {
         return false;
     }
-    // The camera with the smallest d - depth gives the hit.
-    int best = -1;
-    double best_f = INFINITY;
-    for (int c = 0; c < K; ++c) {
-        if (!march_inside(&m[c], s) || !m[c].surface) {
-            continue;
-        }
-        double f = m[c].A + s * (m[c].B + s * m[c].C);
-        if (best < 0 || f < best_f) {
-            best = c;
-            best_f = f;
-        }
-    }
+    int best = pick_camera(collider, m, s);
+    double best_f = best >= 0 ? m[best].A + s * (m[best].B + s * m[best].C) : 0.0;
     if (best < 0) {
         return false; // only when rounding puts s on a frame edge: no surface there
     }

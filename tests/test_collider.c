@@ -147,6 +147,39 @@ TEST(bilinear_depth_follows_an_incline)
     ENSURE(worst[1] < 0.026);
 }
 
+// A steep face (70 degrees from horizontal, facing +X) seen at a grazing angle by
+// a camera above and head-on by a camera at +X. Both record it exactly (bilinear
+// depth of a plane), so d - depth is 0 for both up to rounding: every hit must
+// go to the head-on camera, never to the grazing one, whose texel covers a long
+// strip of the face (docs/physics.md, "Which camera gives the hit").
+TEST(head_on_camera_gives_the_hit_on_a_steep_face)
+{
+    fx_world world = { 0 };
+    fx_solid *wedge = fx_box(&world, -3, -3, -3, 3, 3, 3);
+    fx_plane(wedge, 0.9397f, 0.3420f, 0.0f, 0.0f); // x cos 20 + y sin 20 <= 0
+    wx_camera cams[2] = { top_camera(6.4f, 64), fx_camera(10, 0, 0, 0, 0, 0, 0, 1, 0, 6.4f, 64) };
+    wx_maps maps[2];
+    wx_collider col;
+    ENSURE(build(&col, cams, maps, 2, &world, false));
+    int hits = 0, side = 0;
+    double worst = 0.0;
+    for (int i = 0; i < 400; ++i) {
+        float x = -0.9f + 1.8f * (float)i / 400.0f, z = -2.0f + 4.0f * (float)((i * 37) % 400) / 400.0f;
+        float p0[3] = { x, 2.95f, z }, p1[3] = { x, -2.95f, z };
+        wx_hit hit;
+        if (!wx_collider_sweep(&col, p0, p1, &hit)) {
+            continue;
+        }
+        hits++;
+        side += hit.camera == 1;
+        worst = fmax(worst, fabs(0.9397 * hit.point[0] + 0.3420 * hit.point[1]));
+    }
+    release(&col, maps, 2);
+    ENSURE(hits == 400);
+    ENSURE(side == 400);
+    ENSURE(worst < 1e-3); // on the face
+}
+
 // A segment that starts inside a solid collides at once; the particle is put
 // back on the surface of the camera that sees it nearest.
 TEST(start_inside_is_pushed_out)
@@ -263,6 +296,7 @@ int main(void)
     RUN(box_from_three_sides_point_rule);
     RUN(fast_particle_hits_one_texel_wall);
     RUN(bilinear_depth_follows_an_incline);
+    RUN(head_on_camera_gives_the_hit_on_a_steep_face);
     RUN(start_inside_is_pushed_out);
     RUN(coarse_test_is_conservative_and_put_back_is_outside);
     RUN(projective_cameras_are_refused);
