@@ -29,6 +29,11 @@ TEST_BIN := $(TEST_SRC:tests/%.c=$(BUILD)/tests/%)
 TEST_SUPPORT_OBJ := $(BUILD)/obj/tests/ensure.o
 BENCH_SRC := $(wildcard tests/bench/bench_*.c)
 BENCH_BIN := $(BENCH_SRC:tests/bench/%.c=$(BUILD)/bench/%)
+# Only the benchmarks need these: Embree 3 is the exact-geometry reference
+# (tests/bench/bench_embree.c); the library and the tests never link it.
+BENCH_DEB_PACKAGES := libembree-dev
+BENCH_LIBS := -lembree3
+BENCH_CSV = $(BUILD)/bench/results.csv
 SHADERS := $(wildcard shaders/*.glsl)
 VIEWER_SRC := $(wildcard viewer/*.c)
 VIEWER_OBJ := $(VIEWER_SRC:viewer/%.c=$(BUILD)/obj/viewer/%.o)
@@ -37,7 +42,7 @@ VIEWER_BIN := $(if $(VIEWER_SRC),$(BUILD)/weathering-viewer)
 # `weathering bake` in a child process when a scene's maps are still to bake.
 VIEWER_LIBS := -lglfw -lGL -lOpenEXRCore-3_1 -lxml2 -lpng -lm -lpthread
 
-.PHONY: all deps test run bench clean
+.PHONY: all deps bench-deps test run bench clean
 all: $(BUILD)/weathering $(VIEWER_BIN)
 
 # Installs whatever Debian package is missing (apt-get update first), as root or
@@ -74,13 +79,13 @@ $(BUILD)/obj/viewer/%.o: viewer/%.c $(BUILD)/gen/shaders.h | deps
 $(BUILD)/weathering-viewer: $(VIEWER_OBJ) $(BUILD)/libweathering.a
 	$(CC) $(ALL_CFLAGS) -o $@ $^ $(VIEWER_LIBS)
 
-$(BUILD)/obj/bench/%.o: tests/bench/%.c | deps
+$(BUILD)/obj/bench/%.o: tests/bench/%.c | deps bench-deps
 	@mkdir -p $(dir $@)
 	$(CC) $(ALL_CFLAGS) -Itests -c $< -o $@
 
 $(BUILD)/bench/%: $(BUILD)/obj/bench/%.o $(BUILD)/libweathering.a
 	@mkdir -p $(dir $@)
-	$(CC) $(ALL_CFLAGS) -o $@ $^ $(LIBS)
+	$(CC) $(ALL_CFLAGS) -o $@ $^ $(LIBS) $(BENCH_LIBS)
 
 $(BUILD)/libweathering.a: $(LIB_OBJ)
 	@mkdir -p $(dir $@)
@@ -97,9 +102,28 @@ $(BUILD)/tests/%: $(BUILD)/obj/tests/%.o $(TEST_SUPPORT_OBJ) $(BUILD)/libweather
 test: $(BUILD)/weathering $(VIEWER_BIN) $(TEST_BIN)
 	WX_BUILD=$(BUILD) WX_TESTS=tests tests/run.sh $(BUILD)/tests
 
-# Each benchmark prints its table; targets are checked here, never in make test.
+# Like deps, for the packages only the benchmarks need.
+bench-deps:
+	@missing=""; for p in $(BENCH_DEB_PACKAGES); do \
+	    dpkg -s $$p >/dev/null 2>&1 || missing="$$missing $$p"; done; \
+	if [ -n "$$missing" ]; then \
+	    echo "installing missing Debian packages:$$missing"; \
+	    sudo=""; [ "$$(id -u)" -eq 0 ] || sudo=sudo; \
+	    $$sudo apt-get update -q && \
+	    DEBIAN_FRONTEND=noninteractive $$sudo apt-get install -y -q $$missing; \
+	fi
+
+# Each benchmark prints its own table and appends its figures to $(BENCH_CSV);
+# report.sh prints them as one table. A missed target is a MISSED row, never a
+# stop (targets are checked here, never in make test); a benchmark that cannot
+# run fails `make bench` after the others ran.
 bench: $(BUILD)/weathering $(BENCH_BIN)
-	@for b in $(BENCH_BIN); do echo "== $$b"; GALLIUM_DRIVER=llvmpipe WX_BUILD=$(BUILD) $$b || exit 1; done
+	@echo "bench,configuration,metric,value,unit,target,status" > $(BENCH_CSV); \
+	failed=""; for b in $(BENCH_BIN); do echo "== $$b"; \
+	    GALLIUM_DRIVER=llvmpipe WX_BUILD=$(BUILD) WX_BENCH_CSV=$(BENCH_CSV) $$b || failed="$$failed $$b"; \
+	done; \
+	sh tests/bench/report.sh $(BENCH_CSV); \
+	if [ -n "$$failed" ]; then echo "benchmarks that could not run:$$failed"; exit 1; fi
 
 run: $(BUILD)/weathering
 	$(BUILD)/weathering info $(SCENE)

@@ -648,6 +648,23 @@ static wx_result write_failed(const char *path, const exr_stream *s, exr_result_
                         stream_detail(s, rv));
 }
 
+static exr_compression_t exr_compression(wx_exr_compression c)
+{
+    switch (c) {
+    case WX_EXR_NONE:
+        return EXR_COMPRESSION_NONE;
+    case WX_EXR_RLE:
+        return EXR_COMPRESSION_RLE;
+    case WX_EXR_ZIPS:
+        return EXR_COMPRESSION_ZIPS;
+    case WX_EXR_PIZ:
+        return EXR_COMPRESSION_PIZ;
+    case WX_EXR_ZIP:
+        break;
+    }
+    return EXR_COMPRESSION_ZIP;
+}
+
 // Writes the whole file through the stream (the temporary file).
 static wx_result write_body(exr_stream *s, const char *path, const char *tmp_path,
                             const wx_image *image, wx_error *err)
@@ -665,7 +682,7 @@ static wx_result write_body(exr_stream *s, const char *path, const char *tmp_pat
     }
     if (rv == EXR_ERR_SUCCESS) {
         rv = exr_initialize_required_attr_simple(ctx, part, image->width, image->height,
-                                                 EXR_COMPRESSION_ZIP);
+                                                 exr_compression(image->compression));
     }
     for (int c = 0; rv == EXR_ERR_SUCCESS && c < image->channel_count; c++) {
         rv = (exr_result_t)exr_add_channel(ctx, part, image->channel_names[c], EXR_PIXEL_FLOAT,

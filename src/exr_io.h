@@ -2,8 +2,9 @@
 //
 // Reading: named channels (float or half, any compression) into float planes,
 // row 0 = the top scanline, as the file stores it. Writing: float32 scanline
-// files, ZIP compression, any channel names, m44f and string header attributes,
-// written to a temporary ".name" in the same folder and renamed when complete.
+// files, ZIP compression unless the image asks for another, any channel names,
+// m44f and string header attributes, written to a temporary ".name" in the same
+// folder and renamed when complete.
 #ifndef WX_EXR_IO_H
 #define WX_EXR_IO_H
 
@@ -34,10 +35,22 @@ typedef struct wx_attr {
     char string[WX_ATTR_STRING_MAX];
 } wx_attr;
 
+/// How wx_exr_write compresses the pixels (all lossless). Zero is ZIP, so a
+/// zero-initialised image is written as before; docs/performance.md compares
+/// their speed and size on baked maps.
+typedef enum wx_exr_compression {
+    WX_EXR_ZIP = 0, ///< zlib, 16 scanlines per chunk (the default)
+    WX_EXR_NONE,    ///< raw: the fastest, the largest
+    WX_EXR_RLE,     ///< run lengths: fast; small where values repeat (background, flat maps)
+    WX_EXR_ZIPS,    ///< zlib, one scanline per chunk
+    WX_EXR_PIZ,     ///< wavelet + Huffman
+} wx_exr_compression;
+
 /// A float image: planes of width*height floats, row 0 = top.
 typedef struct wx_image {
     int width;
     int height;
+    wx_exr_compression compression; ///< used by wx_exr_write only (reading accepts any)
     int channel_count;
     char channel_names[WX_IMAGE_MAX_CHANNELS][WX_NAME_MAX];
     float *channels[WX_IMAGE_MAX_CHANNELS];
@@ -66,8 +79,9 @@ wx_result wx_exr_read_interleaved(const char *path, const char *const *wanted, i
                                   float **out_texels, int *out_width, int *out_height,
                                   wx_error *err);
 
-/// Writes every channel of `image` as float32 with ZIP compression, plus its
-/// attributes, atomically (temporary ".<name>.tmp<pid>" beside it, then rename).
+/// Writes every channel of `image` as float32 with image->compression (ZIP
+/// unless set), plus its attributes, atomically (temporary ".<name>.tmp<pid>"
+/// beside it, then rename).
 wx_result wx_exr_write(const char *path, const wx_image *image, wx_error *err);
 
 /// Allocates `channel_count` zeroed planes of width*height floats and names them.

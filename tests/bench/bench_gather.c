@@ -2,13 +2,16 @@
 // side, three input cameras (front, back, top) of the same size, in-memory maps
 // of a synthetic building (boxes on a ground plane) rendered by a ray caster
 // here; second-pass radius 2 output texels; 1 and 2 threads. Prints a table of
-// medians and checks the target of issue 5: under 1 s at 2048 on 2 threads.
+// medians and checks the targets of issues 5 and 7: under 1 s, and under 0.5 s,
+// at 2048 on 2 threads. Figures go to $WX_BENCH_CSV (bench_report.h); exit
+// status 1 only on errors.
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "bench_report.h"
 #include "camera.h"
 #include "gather.h"
 #include "progress.h"
@@ -196,6 +199,9 @@ int main(int argc, char **argv)
             printf("%6d %8d %12.1f %12.1f %12.1f %14.1f\n", n, threads, 1e3 * first[repeats / 2],
                    1e3 * second[repeats / 2], 1e3 * median, (double)n * n / median * 1e-6);
             fflush(stdout);
+            bool target_row = n == 2048 && threads == 2;
+            bench_row("gather", "time (s)", median, "s", target_row ? "< 0.5" : NULL,
+                      median < 0.5, "%d px 3 cams radius 2 texels %d thr", n, threads);
             if (n == 2048 && threads == 2) {
                 target_time = median;
             }
@@ -205,11 +211,12 @@ int main(int argc, char **argv)
             release(&maps[c]);
         }
     }
+    bench_row("gather", "peak RSS", bench_peak_mb(), "MB", NULL, false,
+              "whole benchmark (maps of the largest size)");
     if (target_time < 0.0) {
         return 0; // 2048 not measured
     }
-    bool met = target_time < 1.0;
-    printf("target (issue 5): 2048 on 2 threads under 1 s: %.3f s, %s\n", target_time,
-           met ? "met" : "MISSED");
-    return met ? 0 : 1;
+    printf("targets: 2048 on 2 threads under 1 s (issue 5) and 0.5 s (issue 7): %.3f s, %s\n",
+           target_time, target_time < 0.5 ? "met" : target_time < 1.0 ? "MISSED (0.5 s)" : "MISSED");
+    return 0;
 }

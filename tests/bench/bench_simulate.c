@@ -1,42 +1,33 @@
-// bench_simulate.c: particle-steps per second of the simulation (issue 4 target:
-// >= 20 M/s on 2 threads with 3-octave turbulence, <= 64 bytes per live particle).
+// bench_simulate.c: particle-steps per second of the simulation (issue 4 and 7
+// targets: >= 50 M/s on 2 threads without turbulence and >= 20 M/s with
+// 3-octave turbulence, three 1024-pixel cameras; 2-thread speed-up >= 1.8x;
+// <= 48 bytes per live particle).
 //
-// Scene: a 6 x 8 x 6 m building on a 20 m ground slab, three input cameras
-// (front, side, top) of 1024 x 1024 texels framing it; one million raindrops
-// spread over the volume above and around it, falling at 3 m/s, under gravity
-// and wind, with and without turbulence (strength 2, frequency 0.5, 3
+// Scene: a 6 x 8 x 6 m building on a 20 m ground slab, 1, 3 or 6 input cameras
+// (front, side, top, back, other side, a diagonal) framing it; one million
+// raindrops spread over the volume above and around it, falling at 3 m/s, under
+// gravity and wind, with and without turbulence (strength 2, frequency 0.5, 3
 // octaves). Drops that land bounce, slide or are absorbed as the impact map
 // says. Each configuration starts from the same drops and runs 40 steps after a
-// warm-up of 3; the rate is particle-steps per wall-clock second, the best of
-// three runs (the machine is shared: medians move by tens of percent). A plain
-// two-thread arithmetic loop is timed too, to show how much of a second core the
-// machine gave during the run.
+// warm-up of 3; the rate is particle-steps per wall-clock second, the median of
+// three runs (the machine is shared: single runs move by tens of percent). Then
+// how the rate and the memory grow with the particle count and the map size. A
+// plain two-thread arithmetic loop is timed too, to show how much of a second
+// core the machine gave during the run.
 //
 // Environment: WX_BENCH_PARTICLES (default 1000000), WX_BENCH_STEPS (40),
-// WX_BENCH_ONLY (1: only without turbulence, 2: only with).
-// Exit status 1 when a target is missed.
+// WX_BENCH_QUICK (1: only the four target configurations).
+// Figures go to $WX_BENCH_CSV (bench_report.h); exit status 1 only on errors.
 #include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
+#include <unistd.h>
 
+#include "bench_report.h"
 #include "particles.h"
 #include "sim_fixture.h"
 #include "simulate.h"
-
-static double now_s(int clock)
-{
-    struct timespec ts;
-    clock_gettime(clock, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static long env_long(const char *name, long fallback)
-{
-    const char *v = getenv(name);
-    return v != NULL && atol(v) > 0 ? atol(v) : fallback;
-}
 
 // Independent arithmetic for about 0.2 s: how much faster two threads finish
 // twice the work than one thread finishes it once.
@@ -57,18 +48,33 @@ static void *spin(void *arg)
 static double parallel_capacity(void)
 {
     double sink[2];
-    double t0 = now_s(CLOCK_MONOTONIC);
+    double t0 = bench_now_s();
     spin(&sink[0]);
-    double one = now_s(CLOCK_MONOTONIC) - t0;
+    double one = bench_now_s() - t0;
     pthread_t thread;
-    t0 = now_s(CLOCK_MONOTONIC);
+    t0 = bench_now_s();
     if (pthread_create(&thread, NULL, spin, &sink[1]) != 0) {
         return 1.0;
     }
     spin(&sink[0]);
     pthread_join(thread, NULL);
-    double two = now_s(CLOCK_MONOTONIC) - t0;
+    double two = bench_now_s() - t0;
     return 2.0 * one / two;
+}
+
+// Resident memory now, in MB.
+static double rss_mb(void)
+{
+    FILE *f = fopen("/proc/self/statm", "r");
+    long pages = 0, resident = 0;
+    if (f == NULL) {
+        return 0.0;
+    }
+    if (fscanf(f, "%ld %ld", &pages, &resident) != 2) {
+        resident = 0;
+    }
+    fclose(f);
+    return (double)resident * (double)sysconf(_SC_PAGESIZE) / (1024.0 * 1024.0);
 }
 
 typedef struct result {
@@ -76,12 +82,23 @@ typedef struct result {
     double cpu_rate;     ///< particle-steps per CPU second (all threads)
     double collide_frac; ///< collisions per particle-step
     int64_t alive;
-    double bytes_per_particle; ///< allocated particle arrays / live particles
+    double rss_mb;       ///< resident memory at the end of the run
 } result;
 
-static void scene_setup(fx_scene *f, bool turbulence)
+enum { MAX_CAMS = 6 };
+
+// The fixture holds at most FX_MAX_CAMERAS cameras: the bench keeps its own.
+typedef struct bench_scene {
+    fx_scene f;
+    wx_scene_camera cameras[MAX_CAMS];
+    wx_maps maps[MAX_CAMS];
+} bench_scene;
+
+static void scene_setup(bench_scene *b, int cameras, int px, bool turbulence)
 {
+    fx_scene *f = &b->f;
     fx_scene_init(f);
+    f->scene.cameras = b->cameras;
     f->scene.bbox_size = 40;
     fx_world world = { 0 };
     fx_box(&world, -3, 0, -4, 3, 8, 4);
@@ -91,9 +108,24 @@ static void scene_setup(fx_scene *f, bool turbulence)
     world.deposit = 0.5f;
     world.erosion = 0.1f;
     world.dirt = 0.01f;
-    fx_add_camera(f, "front", fx_camera(0, 6, 30, 0, 6, 0, 0, 1, 0, 24, 1024), &world);
-    fx_add_camera(f, "side", fx_camera(30, 6, 0, 0, 6, 0, 0, 1, 0, 24, 1024), &world);
-    fx_add_camera(f, "top", fx_camera(0, 30, 0, 0, 0, 0, 0, 0, -1, 24, 1024), &world);
+    const wx_camera all[MAX_CAMS] = {
+        fx_camera(0, 6, 30, 0, 6, 0, 0, 1, 0, 24, px),
+        fx_camera(30, 6, 0, 0, 6, 0, 0, 1, 0, 24, px),
+        fx_camera(0, 30, 0, 0, 0, 0, 0, 0, -1, 24, px),
+        fx_camera(0, 6, -30, 0, 6, 0, 0, 1, 0, 24, px),
+        fx_camera(-30, 6, 0, 0, 6, 0, 0, 1, 0, 24, px),
+        fx_camera(20, 26, 20, 0, 4, 0, 0, 1, 0, 30, px),
+    };
+    static const char *const names[MAX_CAMS] = { "front", "side", "top", "back", "side2", "diag" };
+    for (int c = 0; c < cameras; ++c) {
+        wx_scene_camera *sc = &b->cameras[c];
+        memset(sc, 0, sizeof *sc);
+        snprintf(sc->name, sizeof sc->name, "%s", names[c]);
+        sc->camera = all[c];
+        f->scene.camera_count++;
+        f->scene.input_count++;
+        fx_render(&sc->camera, &world, &b->maps[c]);
+    }
     fx_gravity(f, 9.8f);
     fx_wind(f, 1.0f, 1, 0, 0.3f);
     if (turbulence) {
@@ -101,11 +133,19 @@ static void scene_setup(fx_scene *f, bool turbulence)
     }
 }
 
-static bool run_config(fx_scene *f, int threads, long particles, long steps, result *out)
+static void scene_free(bench_scene *b)
 {
+    for (int c = 0; c < b->f.scene.camera_count; ++c) {
+        wx_maps_free(&b->maps[c]);
+    }
+}
+
+static bool run_config(bench_scene *b, int threads, long particles, long steps, result *out)
+{
+    fx_scene *f = &b->f;
     wx_sim_config cfg = wx_sim_default_config(&f->scene);
     cfg.threads = threads;
-    cfg.maps = f->maps;
+    cfg.maps = b->maps;
     wx_sim *sim = NULL;
     wx_error err;
     if (wx_sim_create(&f->scene, &cfg, &sim, &err) != WX_OK) {
@@ -136,74 +176,134 @@ static bool run_config(fx_scene *f, int threads, long particles, long steps, res
     }
     wx_sim_stats before, after;
     wx_sim_get_stats(sim, &before);
-    double t0 = now_s(CLOCK_MONOTONIC), c0 = now_s(CLOCK_PROCESS_CPUTIME_ID);
+    double t0 = bench_now_s(), c0 = bench_cpu_s();
     for (long s = 0; s < steps; ++s) {
         wx_sim_step(sim, &err);
     }
-    double t1 = now_s(CLOCK_MONOTONIC), c1 = now_s(CLOCK_PROCESS_CPUTIME_ID);
+    double t1 = bench_now_s(), c1 = bench_cpu_s();
     wx_sim_get_stats(sim, &after);
     double done = (double)(after.particle_steps - before.particle_steps);
     out->rate = done / (t1 - t0);
     out->cpu_rate = done / (c1 - c0);
     out->collide_frac = (double)(after.collisions - before.collisions) / done;
     out->alive = after.alive;
-    wx_particle_view view;
-    wx_sim_particles(sim, &view);
-    out->bytes_per_particle = WX_PARTICLE_BYTES;
+    out->rss_mb = rss_mb();
     wx_sim_destroy(sim);
+    return true;
+}
+
+typedef struct config {
+    int cameras, px;
+    bool turbulence;
+    int threads;
+    long particles;
+} config;
+
+// Median of three runs of one configuration; prints its line and its CSV rows.
+static bool measure(bench_scene *b, const config *c, long steps, result *out)
+{
+    double rate[3], cpu[3], frac[3], rss[3];
+    result r = { 0 };
+    for (int rep = 0; rep < 3; ++rep) {
+        if (!run_config(b, c->threads, c->particles, steps, &r)) {
+            return false;
+        }
+        rate[rep] = r.rate;
+        cpu[rep] = r.cpu_rate;
+        frac[rep] = r.collide_frac;
+        rss[rep] = r.rss_mb;
+    }
+    out->rate = bench_median(rate, 3);
+    out->cpu_rate = bench_median(cpu, 3);
+    out->collide_frac = bench_median(frac, 3);
+    out->rss_mb = bench_median(rss, 3);
+    out->alive = r.alive;
+    printf("%8ld %5d %5d %-6s %8d %11.1f %14.1f %10.2f%% %9.0f\n", c->particles, c->cameras,
+           c->px, c->turbulence ? "3 oct" : "none", c->threads, out->rate / 1e6,
+           out->cpu_rate / 1e6, 100.0 * out->collide_frac, out->rss_mb);
+    fflush(stdout);
     return true;
 }
 
 int main(void)
 {
-    long particles = env_long("WX_BENCH_PARTICLES", 1000000);
-    long steps = env_long("WX_BENCH_STEPS", 40);
-    printf("simulate: %ld particles, %ld steps, 3 cameras of 1024 x 1024, "
-           "building on a slab, rain (gravity + wind)\n",
-           particles, steps);
-    printf("%-22s %8s %14s %14s %12s\n", "configuration", "threads", "M steps/s",
-           "M steps/cpu-s", "collisions");
-    bool ok = true;
-    double turb2 = 0;
-    long only = env_long("WX_BENCH_ONLY", 0); // 1: without turbulence, 2: with
-    for (int turbulence = 0; turbulence < 2; ++turbulence) {
-        if (only != 0 && only != turbulence + 1) {
-            continue;
-        }
-        fx_scene f;
-        scene_setup(&f, turbulence != 0);
-        for (int threads = 1; threads <= 2; ++threads) {
-            result best = { 0 };
-            for (int rep = 0; rep < 3; ++rep) {
-                result r;
-                if (!run_config(&f, threads, particles, steps, &r)) {
-                    fx_scene_free(&f);
-                    return 1;
-                }
-                if (r.rate > best.rate) {
-                    best = r;
-                }
+    long particles = bench_env_long("WX_BENCH_PARTICLES", 1000000);
+    long steps = bench_env_long("WX_BENCH_STEPS", 40);
+    bool quick = bench_env_long("WX_BENCH_QUICK", 0) == 1;
+    printf("simulate: %ld steps after 3 of warm-up, building on a slab, rain (gravity + wind), "
+           "median of 3 runs\n",
+           steps);
+    printf("%8s %5s %5s %-6s %8s %11s %14s %11s %9s\n", "particles", "cams", "px", "turb",
+           "threads", "M steps/s", "M steps/cpu-s", "collisions", "RSS (MB)");
+    const config configs[] = {
+        // The targets: three 1024-pixel cameras, 1 and 2 threads, with and without turbulence.
+        { 3, 1024, false, 1, particles },
+        { 3, 1024, false, 2, particles },
+        { 3, 1024, true, 1, particles },
+        { 3, 1024, true, 2, particles },
+        // How it grows: cameras, particles, map size (2 threads, no turbulence).
+        { 1, 1024, false, 2, particles },
+        { 6, 1024, false, 2, particles },
+        { 3, 1024, false, 2, particles / 4 },
+        { 3, 1024, false, 2, particles * 4 },
+        { 3, 512, false, 2, particles },
+        { 3, 2048, false, 2, particles },
+    };
+    const int count = quick ? 4 : (int)(sizeof configs / sizeof configs[0]);
+    result results[sizeof configs / sizeof configs[0]];
+    bench_scene b;
+    memset(&b, 0, sizeof b);
+    for (int i = 0; i < count; ++i) {
+        const config *c = &configs[i];
+        if (i == 0 || c->cameras != configs[i - 1].cameras || c->px != configs[i - 1].px ||
+            c->turbulence != configs[i - 1].turbulence) {
+            if (i > 0) {
+                scene_free(&b);
             }
-            printf("%-22s %8d %14.1f %14.1f %11.2f%%\n",
-                   turbulence ? "turbulence 3 octaves" : "no turbulence", threads,
-                   best.rate / 1e6, best.cpu_rate / 1e6, 100.0 * best.collide_frac);
-            if (turbulence && threads == 2) {
-                turb2 = best.rate;
-            }
+            scene_setup(&b, c->cameras, c->px, c->turbulence);
         }
-        fx_scene_free(&f);
+        if (!measure(&b, c, steps, &results[i])) {
+            scene_free(&b);
+            return 1;
+        }
+        bool target_row = i == 1 || i == 3;
+        double target = i == 1 ? 50e6 : 20e6;
+        bench_row("simulate", "M steps/s", results[i].rate / 1e6, "M/s",
+                  target_row ? (i == 1 ? ">= 50" : ">= 20") : NULL,
+                  results[i].rate >= target, "%ldk particles %d cams %d px %s %d thr",
+                  c->particles / 1000, c->cameras, c->px,
+                  c->turbulence ? "turb 3 oct" : "no turb", c->threads);
+        if (i >= 4) {
+            bench_row("simulate", "RSS (MB)", results[i].rss_mb, "MB", NULL, false,
+                      "%ldk particles %d cams %d px no turb", c->particles / 1000, c->cameras,
+                      c->px);
+        }
     }
+    scene_free(&b);
+    double up_plain = results[1].rate / results[0].rate;
+    double up_turb = results[3].rate / results[2].rate;
+    double machine = parallel_capacity();
+    printf("2-thread speed-up: %.2fx without turbulence, %.2fx with\n", up_plain, up_turb);
     printf("bytes per live particle: %d (structure of arrays; capacity grows by half, "
            "so allocated slots stay within 1.5x of the peak count)\n",
            WX_PARTICLE_BYTES);
     printf("machine: two threads did %.2fx the work of one in the same time "
            "(2.00 = a full second core)\n",
-           parallel_capacity());
-    bool speed_ok = turb2 >= 20e6, bytes_ok = WX_PARTICLE_BYTES <= 64;
-    printf("target >= 20 M steps/s, 2 threads, turbulence: %.1f M/s  %s\n", turb2 / 1e6,
-           speed_ok ? "ok" : "MISSED");
-    printf("target <= 64 bytes per live particle: %d  %s\n", WX_PARTICLE_BYTES,
-           bytes_ok ? "ok" : "MISSED");
-    ok = speed_ok && bytes_ok;
-    return ok ? 0 : 1;
+           machine);
+    bench_row("simulate", "2-thread speed-up", up_plain, "x", ">= 1.8", up_plain >= 1.8,
+              "3 cams 1024 px no turb");
+    bench_row("simulate", "2-thread speed-up", up_turb, "x", ">= 1.8", up_turb >= 1.8,
+              "3 cams 1024 px turb 3 oct");
+    bench_row("simulate", "machine 2-thread capacity", machine, "x", NULL, false,
+              "plain arithmetic loop");
+    bench_row("simulate", "bytes per live particle", WX_PARTICLE_BYTES, "B", "<= 48",
+              WX_PARTICLE_BYTES <= 48, "particle arrays per slot");
+    bench_row("simulate", "peak RSS", bench_peak_mb(), "MB", NULL, false, "whole benchmark");
+    printf("targets: >= 50 M/s (2 threads, no turbulence): %.1f %s; >= 20 M/s (2 threads, "
+           "turbulence): %.1f %s; speed-up >= 1.8: %.2f/%.2f %s; <= 48 bytes: %d %s\n",
+           results[1].rate / 1e6, results[1].rate >= 50e6 ? "met" : "MISSED",
+           results[3].rate / 1e6, results[3].rate >= 20e6 ? "met" : "MISSED", up_plain, up_turb,
+           up_plain >= 1.8 && up_turb >= 1.8 ? "met" : "MISSED", WX_PARTICLE_BYTES,
+           WX_PARTICLE_BYTES <= 48 ? "met" : "MISSED");
+    return 0;
 }

@@ -1,0 +1,821 @@
+// bench_embree.c: the exact-geometry reference for the projected-maps collider
+// (issue 7). The same step segments are asked of the depth-map collider and of
+// Embree 3 (a ray query along the segment against the mesh triangles).
+//
+// (a) Accuracy, on the shipped scenes (xml_scenes/building.xml, baked here from
+//     its mesh; xml_scenes/thesis_box.xml, whose pre-rendered maps show a 2 m
+//     cube on a slab, given to Embree as the same two boxes). Particles start on
+//     a hemisphere around the geometry, aimed at a random point of its bounds,
+//     at speeds from about 0.5 to 80 texels per step, and fly under the scene's
+//     gravity and wind (turbulence left out: it does not change what a segment
+//     is asked). Each flies until the first step where the collider or the mesh
+//     reports a hit. When only one of them does, the flight goes on (ignoring
+//     that hit) for up to 3 more steps to see whether the other one reports it
+//     late. Reported: distance between the two hit points in texels of the hit
+//     camera (median, 95th, 99th percentile); missed collisions (the mesh is hit,
+//     the collider never sees it) and phantom collisions (the collider hits, the
+//     mesh is never hit) in percent of the particles that hit anything, with the
+//     missed ones split by speed at 50 texels per step.
+// (b) Speed: UV spheres of about 10k, 100k and 1M triangles, baked by three
+//     1024-pixel cameras; one million segments of 1% of the scene's size (rain
+//     steps falling around and onto the sphere), on 2 threads. Ours: the
+//     simulator's path (vectorised coarse test of 16 segments, the swept test on
+//     what it does not clear). Embree: rtcIntersect1 with tfar = segment length.
+//     Medians of 3 runs; BVH build time and memory; the maps' memory does not
+//     depend on the mesh.
+//
+// Figures go to $WX_BENCH_CSV (bench_report.h); exit status 1 only on errors.
+#include <embree3/rtcore.h>
+#include <math.h>
+#include <pthread.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "bake.h"
+#include "bench_report.h"
+#include "collider.h"
+#include "force_field.h"
+#include "maps.h"
+#include "mesh.h"
+#include "particles.h"
+#include "pipeline.h"
+#include "scene.h"
+
+static const double PI = 3.14159265358979323846;
+enum { THREADS = 2 };
+
+// --- the exact side: Embree --------------------------------------------------
+
+typedef struct exact {
+    RTCDevice device;
+    RTCScene scene;
+    int64_t triangles;
+} exact;
+
+static void exact_free(exact *e)
+{
+    if (e->scene != NULL) {
+        rtcReleaseScene(e->scene);
+    }
+    if (e->device != NULL) {
+        rtcReleaseDevice(e->device);
+    }
+    memset(e, 0, sizeof *e);
+}
+
+static bool exact_init(exact *e)
+{
+    memset(e, 0, sizeof *e);
+    e->device = rtcNewDevice("threads=2");
+    if (e->device == NULL) {
+        return false;
+    }
+    e->scene = rtcNewScene(e->device);
+    return e->scene != NULL;
+}
+
+// Adds a triangle mesh: `positions` (3 floats per vertex) plus `origin`.
+static bool exact_add(exact *e, const float *positions, const double origin[3], int64_t nv,
+                      const uint32_t *indices, int64_t nt)
+{
+    RTCGeometry g = rtcNewGeometry(e->device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    float *v = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                       3 * sizeof(float), (size_t)nv);
+    unsigned *t = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                          3 * sizeof(unsigned), (size_t)nt);
+    if (v == NULL || t == NULL) {
+        rtcReleaseGeometry(g);
+        return false;
+    }
+    for (int64_t i = 0; i < nv; ++i) {
+        for (int k = 0; k < 3; ++k) {
+            v[3 * i + k] = (float)((double)positions[3 * i + k] + origin[k]);
+        }
+    }
+    memcpy(t, indices, (size_t)nt * 3 * sizeof(unsigned));
+    rtcCommitGeometry(g);
+    rtcAttachGeometry(e->scene, g);
+    rtcReleaseGeometry(g);
+    e->triangles += nt;
+    return true;
+}
+
+// Two triangles per face of an axis-aligned box, wound outwards.
+static bool exact_add_box(exact *e, const float lo[3], const float hi[3])
+{
+    float p[24];
+    for (int c = 0; c < 8; ++c) {
+        p[3 * c] = (c & 1) ? hi[0] : lo[0];
+        p[3 * c + 1] = (c & 2) ? hi[1] : lo[1];
+        p[3 * c + 2] = (c & 4) ? hi[2] : lo[2];
+    }
+    static const uint32_t idx[36] = { 0, 2, 1, 1, 2, 3, 4, 5, 6, 5, 7, 6, 0, 1, 4, 1, 5, 4,
+                                      2, 6, 3, 3, 6, 7, 0, 4, 2, 2, 4, 6, 1, 3, 5, 3, 7, 5 };
+    const double zero[3] = { 0, 0, 0 };
+    return exact_add(e, p, zero, 8, idx, 12);
+}
+
+static void exact_commit(exact *e)
+{
+    rtcCommitScene(e->scene);
+}
+
+// The first hit of the segment p0 -> p1: its parameter s in [0, 1].
+static bool exact_hit(const exact *e, const float p0[3], const float p1[3], float *s)
+{
+    float d[3] = { p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2] };
+    float len = sqrtf(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    if (len <= 0.0f) {
+        return false;
+    }
+    struct RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    struct RTCRayHit rh;
+    memset(&rh, 0, sizeof rh);
+    rh.ray.org_x = p0[0];
+    rh.ray.org_y = p0[1];
+    rh.ray.org_z = p0[2];
+    rh.ray.dir_x = d[0] / len;
+    rh.ray.dir_y = d[1] / len;
+    rh.ray.dir_z = d[2] / len;
+    rh.ray.tnear = 0.0f;
+    rh.ray.tfar = len;
+    rh.ray.mask = 0xFFFFFFFFu;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(e->scene, &ctx, &rh);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) {
+        return false;
+    }
+    *s = rh.ray.tfar / len;
+    return true;
+}
+
+// --- the depth-map side ------------------------------------------------------
+
+typedef struct maps_world {
+    wx_scene scene;
+    bool scene_loaded;
+    int count;
+    wx_camera cams[WX_COLLIDER_MAX_CAMERAS];
+    wx_maps maps[WX_COLLIDER_MAX_CAMERAS];
+    wx_collider collider;
+    bool collider_ready;
+    wx_forces forces;
+    bool forces_ready;
+    float texel_ws; ///< texel size of the first camera
+    int cam_list[WX_COLLIDER_MAX_CAMERAS];
+} maps_world;
+
+static void maps_world_free(maps_world *w)
+{
+    if (w->collider_ready) {
+        wx_collider_free(&w->collider);
+    }
+    for (int c = 0; c < w->count; ++c) {
+        wx_maps_free(&w->maps[c]);
+    }
+    if (w->forces_ready) {
+        wx_forces_free(&w->forces);
+    }
+    if (w->scene_loaded) {
+        wx_scene_free(&w->scene);
+    }
+    memset(w, 0, sizeof *w);
+}
+
+// Loads the input cameras' depth, normal and impact maps of a loaded scene (whose
+// map paths point at files) and builds the collider and the forces.
+static bool maps_world_finish(maps_world *w)
+{
+    wx_error err;
+    for (int c = 0; c < w->scene.camera_count; ++c) {
+        const wx_scene_camera *sc = &w->scene.cameras[c];
+        if (sc->is_output) {
+            continue;
+        }
+        if (wx_maps_load(&w->maps[w->count], WX_MAPS_DEPTH | WX_MAPS_NORMAL | WX_MAPS_IMPACT,
+                         sc->depth_path, sc->normal_path, sc->impact_path, NULL,
+                         &err) != WX_OK) {
+            fprintf(stderr, "bench_embree: %s\n", err.message);
+            return false;
+        }
+        w->cams[w->count] = sc->camera;
+        w->cam_list[w->count] = w->count;
+        w->count++;
+    }
+    if (wx_collider_init(&w->collider, w->cams, w->maps, w->count, false, &err) != WX_OK) {
+        fprintf(stderr, "bench_embree: %s\n", err.message);
+        return false;
+    }
+    w->collider_ready = true;
+    w->texel_ws = w->collider.cameras[0].texel_ws;
+    if (wx_forces_init(&w->forces, w->scene.fields, w->scene.field_count, w->scene.seed,
+                       &err) != WX_OK) {
+        fprintf(stderr, "bench_embree: %s\n", err.message);
+        return false;
+    }
+    w->forces_ready = true;
+    return true;
+}
+
+// Loads a scene and bakes what it needs baking into `out_dir`.
+static bool maps_world_load(maps_world *w, const char *scene_path, const char *out_dir)
+{
+    memset(w, 0, sizeof *w);
+    wx_error err;
+    if (wx_scene_load(scene_path, &w->scene, &err) != WX_OK) {
+        fprintf(stderr, "bench_embree: %s\n", err.message);
+        return false;
+    }
+    w->scene_loaded = true;
+    wx_run_options opts;
+    wx_run_options_default(&w->scene, &opts);
+    snprintf(opts.out_dir, sizeof opts.out_dir, "%s", out_dir);
+    opts.threads = THREADS;
+    opts.quiet = true;
+    if (w->scene.mesh_count > 0 &&
+        (wx_output_prepare(&opts, &err) != WX_OK || wx_bake_scene(&w->scene, &opts, &err) != WX_OK ||
+         wx_use_baked_maps(&w->scene, &opts, &err) != WX_OK)) {
+        fprintf(stderr, "bench_embree: %s\n", err.message);
+        return false;
+    }
+    return maps_world_finish(w);
+}
+
+// The collider's answer for one segment, as the simulator asks it.
+static bool maps_hit(const maps_world *w, const float p0[3], const float p1[3], wx_hit *hit)
+{
+    return !wx_collider_coarse_clear(&w->collider, p0, p1) &&
+           wx_collider_sweep(&w->collider, p0, p1, hit);
+}
+
+// --- (a) accuracy -------------------------------------------------------------
+
+typedef struct accuracy {
+    double *error_texels; ///< per particle hit by both
+    int64_t both, missed, missed_slow, phantom, neither, segments;
+    double max_speed_texels;
+} accuracy;
+
+static float uniform(uint64_t *state)
+{
+    *state = wx_mix64(*state + UINT64_C(0x9e3779b97f4a7c15));
+    return (float)(*state >> 40) * (1.0f / 16777216.0f);
+}
+
+// Flies `n` particles at the geometry within bounds lo..hi (see the header).
+static bool measure_accuracy(const maps_world *w, const exact *e, const float lo[3],
+                             const float hi[3], int n, accuracy *a)
+{
+    memset(a, 0, sizeof *a);
+    a->error_texels = malloc((size_t)n * sizeof(double));
+    if (a->error_texels == NULL) {
+        return false;
+    }
+    float centre[3], radius = 0.0f;
+    for (int k = 0; k < 3; ++k) {
+        centre[k] = 0.5f * (lo[k] + hi[k]);
+        radius += 0.25f * (hi[k] - lo[k]) * (hi[k] - lo[k]);
+    }
+    radius = 1.2f * sqrtf(radius);
+    float dt = (float)w->scene.time_step;
+    float texel = w->texel_ws;
+    float acc[3];
+    for (int k = 0; k < 3; ++k) {
+        acc[k] = w->forces.gravity[k] + w->forces.wind[k]; // mass 1
+    }
+    uint64_t state = 7;
+    for (int i = 0; i < n; ++i) {
+        // Start on the upper hemisphere, aim at a point of the bounds.
+        float p[3], d[3], aim[3];
+        float z = uniform(&state), phi = 2.0f * (float)PI * uniform(&state);
+        float rxy = sqrtf(fmaxf(0.0f, 1.0f - z * z));
+        d[0] = rxy * cosf(phi);
+        d[1] = z;
+        d[2] = rxy * sinf(phi);
+        for (int k = 0; k < 3; ++k) {
+            p[k] = centre[k] + radius * d[k];
+            aim[k] = lo[k] + (hi[k] - lo[k]) * uniform(&state);
+        }
+        if (wx_collider_point_collides(&w->collider, p)) {
+            --i; // a start behind a surface says nothing
+            continue;
+        }
+        float dir[3] = { aim[0] - p[0], aim[1] - p[1], aim[2] - p[2] };
+        float len = sqrtf(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
+        // Speed: log-uniform from 0.5 to 80 texels per step.
+        float texels_per_step = 0.5f * powf(160.0f, uniform(&state));
+        float speed = texels_per_step * texel / dt;
+        float v[3] = { speed * dir[0] / len, speed * dir[1] / len, speed * dir[2] / len };
+        float maps_s = -1.0f, exact_s = -1.0f, maps_point[3] = { 0 }, exact_point[3] = { 0 };
+        float step_texels = 0.0f;
+        int after_first = -1; // steps since the first report
+        int max_steps = (int)(4.0f * radius / (speed * dt)) + 10;
+        for (int step = 0; step < max_steps; ++step) {
+            float q[3];
+            for (int k = 0; k < 3; ++k) {
+                v[k] += dt * acc[k];
+                q[k] = p[k] + dt * v[k];
+            }
+            a->segments++;
+            float seg = sqrtf((q[0] - p[0]) * (q[0] - p[0]) + (q[1] - p[1]) * (q[1] - p[1]) +
+                              (q[2] - p[2]) * (q[2] - p[2])) /
+                        texel;
+            wx_hit hit;
+            float s;
+            if (maps_s < 0.0f && maps_hit(w, p, q, &hit)) {
+                maps_s = (float)step + hit.s;
+                memcpy(maps_point, hit.point, sizeof maps_point);
+            }
+            if (exact_s < 0.0f && exact_hit(e, p, q, &s)) {
+                exact_s = (float)step + s;
+                for (int k = 0; k < 3; ++k) {
+                    exact_point[k] = p[k] + s * (q[k] - p[k]);
+                }
+                step_texels = seg;
+            }
+            if (maps_s >= 0.0f && exact_s >= 0.0f) {
+                break;
+            }
+            if (maps_s >= 0.0f || exact_s >= 0.0f) {
+                if (++after_first > 3) {
+                    break;
+                }
+            }
+            memcpy(p, q, sizeof p);
+        }
+        if (maps_s >= 0.0f && exact_s >= 0.0f) {
+            float dx = maps_point[0] - exact_point[0], dy = maps_point[1] - exact_point[1],
+                  dz = maps_point[2] - exact_point[2];
+            a->error_texels[a->both++] = sqrt((double)(dx * dx + dy * dy + dz * dz)) / texel;
+        } else if (exact_s >= 0.0f) {
+            a->missed++;
+            a->missed_slow += step_texels < 50.0f;
+        } else if (maps_s >= 0.0f) {
+            a->phantom++;
+        } else {
+            a->neither++;
+        }
+        if (step_texels > a->max_speed_texels) {
+            a->max_speed_texels = step_texels;
+        }
+    }
+    return true;
+}
+
+static double percentile(double *sorted, int64_t n, double q)
+{
+    if (n == 0) {
+        return NAN;
+    }
+    int64_t k = (int64_t)ceil(q * (double)n) - 1;
+    return sorted[k < 0 ? 0 : k >= n ? n - 1 : k];
+}
+
+static bool report_accuracy(const char *name, const maps_world *w, const exact *e,
+                            const float lo[3], const float hi[3], int n)
+{
+    accuracy a;
+    if (!measure_accuracy(w, e, lo, hi, n, &a)) {
+        return false;
+    }
+    qsort(a.error_texels, (size_t)a.both, sizeof(double), bench_compare_double);
+    double med = percentile(a.error_texels, a.both, 0.5);
+    double p95 = percentile(a.error_texels, a.both, 0.95);
+    double p99 = percentile(a.error_texels, a.both, 0.99);
+    int64_t hits = a.both + a.missed + a.phantom;
+    double missed = hits > 0 ? 100.0 * (double)a.missed / (double)hits : 0.0;
+    double phantom = hits > 0 ? 100.0 * (double)a.phantom / (double)hits : 0.0;
+    printf("%-11s %9lld %6d %6lld %9.3f %9.3f %9.3f %9.3f%% %9.3f%% %9lld\n", name,
+           (long long)e->triangles, w->count, (long long)hits, med, p95, p99, missed, phantom,
+           (long long)a.missed_slow);
+    fflush(stdout);
+    bench_row("embree", "hit error median (texels)", med, "texels", "<= 0.5", med <= 0.5,
+              "%s %d particles", name, n);
+    bench_row("embree", "hit error 95th (texels)", p95, "texels", NULL, false, "%s %d particles",
+              name, n);
+    bench_row("embree", "hit error 99th (texels)", p99, "texels", NULL, false, "%s %d particles",
+              name, n);
+    bench_row("embree", "missed collisions (%)", missed, "%", NULL, false, "%s %d particles",
+              name, n);
+    bench_row("embree", "missed under 50 texels/step", (double)a.missed_slow, "particles", "0",
+              a.missed_slow == 0, "%s %d particles", name, n);
+    bench_row("embree", "phantom collisions (%)", phantom, "%", NULL, false, "%s %d particles",
+              name, n);
+    free(a.error_texels);
+    return true;
+}
+
+// --- (b) speed ----------------------------------------------------------------
+
+typedef struct segments {
+    int64_t n;
+    float *x0, *y0, *z0, *x1, *y1, *z1;
+} segments;
+
+typedef struct speed_job {
+    const maps_world *w;
+    const exact *e;
+    const segments *segs;
+    int64_t begin, end;
+    bool use_exact;
+    int64_t hits;
+    int64_t swept; ///< segments the coarse test left to the swept test
+} speed_job;
+
+static void *speed_worker(void *arg)
+{
+    speed_job *j = arg;
+    const segments *g = j->segs;
+    int64_t hits = 0, swept = 0;
+    if (j->use_exact) {
+        for (int64_t i = j->begin; i < j->end; ++i) {
+            float p0[3] = { g->x0[i], g->y0[i], g->z0[i] }, p1[3] = { g->x1[i], g->y1[i], g->z1[i] };
+            float s;
+            hits += exact_hit(j->e, p0, p1, &s);
+        }
+    } else {
+        // As the simulator does: the coarse test on blocks of 16, then the swept
+        // test on what it left, with the maps' lines prefetched a few ahead.
+        enum { B = WX_PARTICLE_BLOCK, CHUNK = 1024, AHEAD = 8 };
+        const wx_collider *c = &j->w->collider;
+        int64_t cand[CHUNK];
+        for (int64_t base = j->begin; base < j->end; base += CHUNK) {
+            int64_t stop = base + CHUNK < j->end ? base + CHUNK : j->end;
+            int m = 0;
+            for (int64_t b = base; b + B <= stop; b += B) {
+                uint32_t outside;
+                uint32_t clear = wx_collider_coarse_block(c, j->w->cam_list, j->w->count, NULL,
+                                                          g->x0 + b, g->y0 + b, g->z0 + b,
+                                                          g->x1 + b, g->y1 + b, g->z1 + b,
+                                                          &outside);
+                uint32_t todo = ~(clear | outside) & 0xFFFFu;
+                while (todo != 0) {
+                    int k = __builtin_ctz(todo);
+                    todo &= todo - 1;
+                    cand[m++] = b + k;
+                }
+            }
+            for (int q = 0; q < m; ++q) {
+                if (q + AHEAD < m) {
+                    int64_t a = cand[q + AHEAD];
+                    const float pa[3] = { g->x1[a], g->y1[a], g->z1[a] };
+                    wx_collider_prefetch(c, pa);
+                }
+                int64_t i = cand[q];
+                float p0[3] = { g->x0[i], g->y0[i], g->z0[i] };
+                float p1[3] = { g->x1[i], g->y1[i], g->z1[i] };
+                wx_hit hit;
+                hits += wx_collider_sweep(c, p0, p1, &hit);
+            }
+            swept += m;
+        }
+    }
+    j->hits = hits;
+    j->swept = swept;
+    return NULL;
+}
+
+// Segments per second on THREADS threads.
+static double time_segments(const maps_world *w, const exact *e, const segments *g, bool use_exact,
+                            int64_t *hits, int64_t *swept)
+{
+    pthread_t threads[THREADS];
+    speed_job jobs[THREADS];
+    int64_t chunk = (g->n / THREADS + WX_PARTICLE_BLOCK - 1) / WX_PARTICLE_BLOCK * WX_PARTICLE_BLOCK;
+    double t0 = bench_now_s();
+    for (int t = 0; t < THREADS; ++t) {
+        jobs[t] = (speed_job){ w, e, g, t * chunk, t + 1 == THREADS ? g->n : (t + 1) * chunk,
+                               use_exact, 0, 0 };
+        if (pthread_create(&threads[t], NULL, speed_worker, &jobs[t]) != 0) {
+            speed_worker(&jobs[t]);
+            threads[t] = 0;
+        }
+    }
+    *hits = 0;
+    *swept = 0;
+    for (int t = 0; t < THREADS; ++t) {
+        if (threads[t] != 0) {
+            pthread_join(threads[t], NULL);
+        }
+        *hits += jobs[t].hits;
+        *swept += jobs[t].swept;
+    }
+    return (double)g->n / (bench_now_s() - t0);
+}
+
+// A UV sphere of radius 1 (as bench_bake writes it), binary PLY with normals.
+static bool write_sphere_ply(const char *path, int stacks, int slices)
+{
+    FILE *f = fopen(path, "wb");
+    if (f == NULL) {
+        return false;
+    }
+    fprintf(f,
+            "ply\nformat binary_little_endian 1.0\nelement vertex %d\n"
+            "property float x\nproperty float y\nproperty float z\n"
+            "property float nx\nproperty float ny\nproperty float nz\n"
+            "element face %d\nproperty list uchar int vertex_indices\nend_header\n",
+            (stacks + 1) * (slices + 1), stacks * slices * 2);
+    for (int i = 0; i <= stacks; ++i) {
+        double theta = PI * i / stacks;
+        for (int j = 0; j <= slices; ++j) {
+            double phi = 2.0 * PI * j / slices;
+            float p[6] = { (float)(sin(theta) * cos(phi)), (float)cos(theta),
+                           (float)(sin(theta) * sin(phi)) };
+            p[3] = p[0];
+            p[4] = p[1];
+            p[5] = p[2];
+            fwrite(p, sizeof p, 1, f);
+        }
+    }
+    for (int i = 0; i < stacks; ++i) {
+        for (int j = 0; j < slices; ++j) {
+            int32_t a = i * (slices + 1) + j, b = a + 1, c = a + slices + 1, d = c + 1;
+            unsigned char three = 3;
+            int32_t t1[3] = { a, c, b }, t2[3] = { b, c, d };
+            fwrite(&three, 1, 1, f);
+            fwrite(t1, sizeof t1, 1, f);
+            fwrite(&three, 1, 1, f);
+            fwrite(t2, sizeof t2, 1, f);
+        }
+    }
+    return fclose(f) == 0;
+}
+
+static bool write_sphere_scene(const char *path, const char *mesh)
+{
+    FILE *f = fopen(path, "w");
+    if (f == NULL) {
+        return false;
+    }
+    fprintf(f,
+            "<Weathering>\n"
+            "  <Solver><BoundingBox size=\"4\"/><Simulation timeStep=\"0.01\"/></Solver>\n"
+            "  <ForceFields><Gravity acceleration=\"9.8\"/></ForceFields>\n"
+            "  <Collider><ProjectedMaps>\n"
+            "    <Ortho cameraName=\"front\"><View eye=\"0 0 5\" target=\"0 0 0\" up=\"0 1 0\""
+            " width=\"2.2\" height=\"2.2\" resolution=\"1024\"/></Ortho>\n"
+            "    <Ortho cameraName=\"side\"><View eye=\"5 0.5 0\" target=\"0 0 0\" up=\"0 1 0\""
+            " width=\"2.2\" height=\"2.2\" resolution=\"1024\"/></Ortho>\n"
+            "    <Ortho cameraName=\"top\"><View eye=\"0 5 0\" target=\"0 0 0\" up=\"0 0 -1\""
+            " width=\"2.2\" height=\"2.2\" resolution=\"1024\"/></Ortho>\n"
+            "  </ProjectedMaps></Collider>\n"
+            "  <Geometry><Mesh file=\"%s\"><Surface material=\"*\" absorption=\"0.2\""
+            " bounce=\"0.3\"/></Mesh></Geometry>\n"
+            "</Weathering>\n",
+            mesh);
+    return fclose(f) == 0;
+}
+
+// Rain steps of 1% of the scene's size (2.2 m): starts uniform in the cube
+// around the sphere but outside it, falling steeply.
+static bool make_segments(segments *g, int64_t n)
+{
+    g->n = n;
+    float **arrays[6] = { &g->x0, &g->y0, &g->z0, &g->x1, &g->y1, &g->z1 };
+    for (int a = 0; a < 6; ++a) {
+        *arrays[a] = malloc((size_t)n * sizeof(float));
+        if (*arrays[a] == NULL) {
+            return false;
+        }
+    }
+    uint64_t state = 11;
+    for (int64_t i = 0; i < n;) {
+        float p[3] = { 2.2f * uniform(&state) - 1.1f, 2.2f * uniform(&state) - 1.1f,
+                       2.2f * uniform(&state) - 1.1f };
+        if (p[0] * p[0] + p[1] * p[1] + p[2] * p[2] <= 1.0f) {
+            continue;
+        }
+        float d[3] = { uniform(&state) - 0.5f, -2.0f, uniform(&state) - 0.5f };
+        float len = sqrtf(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        float step = 0.022f / len;
+        g->x0[i] = p[0];
+        g->y0[i] = p[1];
+        g->z0[i] = p[2];
+        g->x1[i] = p[0] + step * d[0];
+        g->y1[i] = p[1] + step * d[1];
+        g->z1[i] = p[2] + step * d[2];
+        ++i;
+    }
+    return true;
+}
+
+static void free_segments(segments *g)
+{
+    free(g->x0);
+    free(g->y0);
+    free(g->z0);
+    free(g->x1);
+    free(g->y1);
+    free(g->z1);
+}
+
+static double rss_mb(void)
+{
+    FILE *f = fopen("/proc/self/statm", "r");
+    long pages = 0, resident = 0;
+    if (f == NULL) {
+        return 0.0;
+    }
+    if (fscanf(f, "%ld %ld", &pages, &resident) != 2) {
+        resident = 0;
+    }
+    fclose(f);
+    return (double)resident * (double)sysconf(_SC_PAGESIZE) / (1024.0 * 1024.0);
+}
+
+static bool speed_for_sphere(const char *dir, int stacks, int slices, const segments *g)
+{
+    char mesh[1200], scene[1200], out[1200];
+    snprintf(mesh, sizeof mesh, "%s/sphere_%d.ply", dir, stacks);
+    snprintf(scene, sizeof scene, "%s/sphere_%d.xml", dir, stacks);
+    snprintf(out, sizeof out, "%s/sphere_%d_out", dir, stacks);
+    char mesh_name[64];
+    snprintf(mesh_name, sizeof mesh_name, "sphere_%d.ply", stacks);
+    if (!write_sphere_ply(mesh, stacks, slices) || !write_sphere_scene(scene, mesh_name)) {
+        fprintf(stderr, "bench_embree: cannot write %s\n", mesh);
+        return false;
+    }
+    maps_world w;
+    if (!maps_world_load(&w, scene, out)) {
+        maps_world_free(&w);
+        return false;
+    }
+    // Embree: the same mesh file through the same importer.
+    wx_mesh_data m;
+    wx_error err;
+    if (wx_mesh_import(mesh, &m, &err) != WX_OK) {
+        fprintf(stderr, "bench_embree: %s\n", err.message);
+        maps_world_free(&w);
+        return false;
+    }
+    double rss0 = rss_mb();
+    exact e;
+    double t0 = bench_now_s();
+    bool ok = exact_init(&e) &&
+              exact_add(&e, m.positions, m.origin, m.vertex_count, m.indices, m.triangle_count);
+    if (ok) {
+        exact_commit(&e);
+    }
+    double build_s = bench_now_s() - t0;
+    double bvh_mb = rss_mb() - rss0;
+    wx_mesh_data_free(&m);
+    if (!ok) {
+        fprintf(stderr, "bench_embree: Embree could not take the mesh\n");
+        exact_free(&e);
+        maps_world_free(&w);
+        return false;
+    }
+    double maps_mb = 0.0;
+    for (int c = 0; c < w.count; ++c) {
+        // What the collider reads: its depth copy and pyramid, normal and impact.
+        maps_mb += (double)w.maps[c].width * w.maps[c].height * (4 + 12 + 8) * 1.07 / 1048576.0;
+    }
+    double ours[3], theirs[3];
+    int64_t hits_ours = 0, hits_exact = 0, swept = 0, unused;
+    for (int r = 0; r < 3; ++r) {
+        ours[r] = time_segments(&w, &e, g, false, &hits_ours, &swept);
+        theirs[r] = time_segments(&w, &e, g, true, &hits_exact, &unused);
+    }
+    double o = bench_median(ours, 3), t = bench_median(theirs, 3);
+    long long tri = (long long)e.triangles;
+    printf("%9lld %12.1f %12.1f %8.1fx %11.3f %9.0f %9.0f %7.2f%% %7.2f%% %7.2f%%\n", tri,
+           o / 1e6, t / 1e6, o / t, build_s, bvh_mb, maps_mb,
+           100.0 * (double)swept / (double)g->n, 100.0 * (double)hits_ours / (double)g->n,
+           100.0 * (double)hits_exact / (double)g->n);
+    fflush(stdout);
+    bench_row("embree", "ours M segments/s", o / 1e6, "M/s", NULL, false,
+              "%lldk triangles 3 cams 1024 px 2 thr", tri / 1000);
+    bench_row("embree", "Embree M segments/s", t / 1e6, "M/s", NULL, false,
+              "%lldk triangles 2 thr", tri / 1000);
+    bench_row("embree", "speed ratio ours/Embree", o / t, "x", NULL, false,
+              "%lldk triangles", tri / 1000);
+    bench_row("embree", "Embree BVH build (s)", build_s, "s", NULL, false, "%lldk triangles",
+              tri / 1000);
+    bench_row("embree", "Embree BVH memory (MB)", bvh_mb, "MB", NULL, false, "%lldk triangles",
+              tri / 1000);
+    bench_row("embree", "collider maps memory (MB)", maps_mb, "MB", NULL, false,
+              "%lldk triangles 3 cams 1024 px", tri / 1000);
+    exact_free(&e);
+    maps_world_free(&w);
+    remove(mesh);
+    remove(scene);
+    return true;
+}
+
+// The thesis scene's two boxes (tests/tools/gen_thesis_maps.c).
+static bool thesis_exact(exact *e)
+{
+    const float cube_lo[3] = { -1, 0, -1 }, cube_hi[3] = { 1, 2, 1 };
+    const float slab_lo[3] = { -3, -0.2f, -3 }, slab_hi[3] = { 3, 0, 3 };
+    if (!exact_init(e) || !exact_add_box(e, cube_lo, cube_hi) ||
+        !exact_add_box(e, slab_lo, slab_hi)) {
+        return false;
+    }
+    exact_commit(e);
+    return true;
+}
+
+static bool accuracy_scene(const char *name, const char *scene_path, const char *out, int n)
+{
+    maps_world w;
+    exact e;
+    memset(&e, 0, sizeof e);
+    bool ok = maps_world_load(&w, scene_path, out);
+    float lo[3], hi[3];
+    if (ok && w.scene.mesh_count > 0) {
+        ok = exact_init(&e);
+        for (int k = 0; k < 3; ++k) {
+            lo[k] = INFINITY;
+            hi[k] = -INFINITY;
+        }
+        for (int i = 0; ok && i < w.scene.mesh_count; ++i) {
+            wx_mesh_data m;
+            wx_error err;
+            if (wx_mesh_import(w.scene.meshes[i].path, &m, &err) != WX_OK) {
+                fprintf(stderr, "bench_embree: %s\n", err.message);
+                ok = false;
+                break;
+            }
+            ok = exact_add(&e, m.positions, m.origin, m.vertex_count, m.indices,
+                           m.triangle_count);
+            for (int k = 0; k < 3; ++k) {
+                lo[k] = fminf(lo[k], (float)m.bounds_min[k]);
+                hi[k] = fmaxf(hi[k], (float)m.bounds_max[k]);
+            }
+            wx_mesh_data_free(&m);
+        }
+        if (ok) {
+            exact_commit(&e);
+        }
+    } else if (ok) {
+        ok = thesis_exact(&e);
+        const float tlo[3] = { -3, -0.2f, -3 }, thi[3] = { 3, 2, 3 };
+        memcpy(lo, tlo, sizeof lo);
+        memcpy(hi, thi, sizeof hi);
+    }
+    if (ok) {
+        ok = report_accuracy(name, &w, &e, lo, hi, n);
+    }
+    exact_free(&e);
+    maps_world_free(&w);
+    return ok;
+}
+
+int main(void)
+{
+    const char *build = getenv("WX_BUILD") != NULL ? getenv("WX_BUILD") : "build";
+    long n = bench_env_long("WX_BENCH_EMBREE_PARTICLES", 20000);
+    long segs = bench_env_long("WX_BENCH_SEGMENTS", 1000000);
+    char dir[1024], out[1100];
+    snprintf(dir, sizeof dir, "%s/tmp", build);
+    mkdir(dir, 0777);
+    snprintf(dir, sizeof dir, "%s/tmp/bench_embree", build);
+    mkdir(dir, 0777);
+
+    printf("embree (a): depth-map collider against the exact mesh (Embree 3 rtcIntersect1), "
+           "%ld particles per scene, 0.5-80 texels per step\n",
+           n);
+    printf("%-11s %9s %6s %6s %9s %9s %9s %10s %10s %9s\n", "scene", "triangles", "cams", "hits",
+           "median", "95th", "99th", "missed", "phantom", "missed<50");
+    snprintf(out, sizeof out, "%s/building", dir);
+    if (!accuracy_scene("building", "xml_scenes/building.xml", out, (int)n)) {
+        return 1;
+    }
+    snprintf(out, sizeof out, "%s/thesis_box", dir);
+    if (!accuracy_scene("thesis_box", "xml_scenes/thesis_box.xml", out, (int)n)) {
+        return 1;
+    }
+
+    printf("embree (b): %ld segments of 1%% of the scene's size around a UV sphere, "
+           "%d threads, median of 3\n",
+           segs, THREADS);
+    printf("%9s %12s %12s %9s %11s %9s %9s %8s %8s %8s\n", "triangles", "ours M/s", "Embree M/s",
+           "ratio", "BVH build s", "BVH MB", "maps MB", "swept", "ours hit", "mesh hit");
+    segments g;
+    memset(&g, 0, sizeof g);
+    if (!make_segments(&g, segs)) {
+        fprintf(stderr, "bench_embree: out of memory\n");
+        return 1;
+    }
+    static const int sizes[3][2] = { { 50, 100 }, { 158, 316 }, { 500, 1000 } };
+    for (int s = 0; s < 3; ++s) {
+        if (!speed_for_sphere(dir, sizes[s][0], sizes[s][1], &g)) {
+            free_segments(&g);
+            return 1;
+        }
+    }
+    free_segments(&g);
+    bench_row("embree", "peak RSS", bench_peak_mb(), "MB", NULL, false, "whole benchmark");
+    char cmd[1200];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
+    if (system(cmd) != 0) {
+        fprintf(stderr, "bench_embree: could not remove %s\n", dir);
+    }
+    return 0;
+}
