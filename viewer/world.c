@@ -128,7 +128,7 @@ bool vw_world_needs_bake(const vw_world *world, const vw_world *running)
     if (!any) {
         return false;
     }
-    if (previous != NULL && (running->wrote_dirt_maps || !same_bake_input(scene, previous))) {
+    if (previous != NULL && !same_bake_input(scene, previous)) {
         return true;
     }
     struct timespec t;
@@ -441,7 +441,8 @@ static wx_result load_maps(vw_world *world, wx_error *err)
         if (!cam->is_output) {
             which |= WX_MAPS_IMPACT;
             if (cam->dirt_path[0] != '\0') {
-                which |= WX_MAPS_DIRT;
+                // After G the file holds simulated dirt; start from its initialDirt.
+                which |= WX_MAPS_DIRT | WX_MAPS_INITIAL_DIRT;
             }
         }
         wx_result r = wx_maps_load(&world->maps[world->camera_maps[c]], which, cam->depth_path,
@@ -511,7 +512,6 @@ wx_result vw_world_gather(vw_world *world, char saved[WX_PATH_MAX], wx_error *er
     wx_result r = wx_output_prepare(&world->opts, err);
     if (r == WX_OK) {
         r = wx_sim_write_dirt_maps(world->sim, &world->opts, err);
-        world->wrote_dirt_maps = true; // even a failed write may have replaced some
     }
     if (r != WX_OK || world->scene.output_index < 0) {
         return r;

@@ -52,7 +52,6 @@ typedef struct vw_world {
     int *input_camera;       ///< input index -> scene camera index
     wx_sim *sim;
     float load_scale;        ///< particle load drawn fully dirty (largest emitter dirt)
-    bool wrote_dirt_maps;    ///< a gather wrote <camera>_dirt.exr into the output folder
 
     vw_vertex *lines;        ///< GL_LINES pairs
     int line_count;
