@@ -30,9 +30,9 @@
 
 /// Most input cameras a collider takes.
 #define WX_COLLIDER_MAX_CAMERAS 64
-/// Levels of the coarse pyramid: blocks of 8, 32, 128, ... texels.
+/// Levels of the coarse pyramid: blocks of 4, 16, 64, ... texels.
 #define WX_COARSE_LEVELS 5 ///< collider.c writes the five levels out one by one
-#define WX_COARSE_BLOCK_SHIFT 3
+#define WX_COARSE_BLOCK_SHIFT 2
 #define WX_COARSE_LEVEL_SHIFT 2
 
 /// One input camera as the collider sees it.
@@ -48,7 +48,7 @@ typedef struct wx_collider_camera {
     float *depth;   ///< W*H, +inf where there is no surface (owned copy)
     const float *normal; ///< 3*W*H world normals (borrowed)
     const float *impact; ///< 2*W*H absorption, bounce (borrowed)
-    /// Coarse pyramid: level l has blocks of 8 << 2l texels; its value at block
+    /// Coarse pyramid: level l has blocks of 4 << 2l texels; its value at block
     /// (bx, by) is the least depth over the 3x3 blocks around it, lowered by a
     /// rounding margin. Levels are stored one after the other in `coarse`.
     int levels;
