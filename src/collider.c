@@ -531,7 +531,8 @@ static double march_entry(const wx_collider *collider, march *m, double s)
 // camera's texel covers a long strip of surface while it wins only part of the
 // strip's hits, so its dirt per area comes out too low and the mask shows the
 // cameras' patches. So: among the cameras whose d - depth is within half a texel
-// plus one texel's worth of that slope, the most head-on one (largest |N.view|,
+// plus one texel's worth of that slope (against the bilinear depth and against
+// the hit texel's own depth), the most head-on one (largest |N.view|,
 // the camera `bake` gives initial dirt to) gives the hit; without any, the
 // smallest d - depth. -1 when no camera sees a surface at s.
 static int pick_camera(const wx_collider *collider, const march *m, double s)
@@ -560,7 +561,12 @@ static int pick_camera(const wx_collider *collider, const march *m, double s)
                           (bl * nl);
         double tan_view = sqrt(fmax(0.0, 1.0 - cos_view * cos_view)) / fmax(cos_view, 0.05);
         double precision = cam->texel_ws * (0.5 + tan_view);
-        if (f * bl <= precision && cos_view > best_cos) {
+        // The texel itself must record this surface too: between a wall and a
+        // slab's edge in front of it the bilinear depth is no surface at all,
+        // and a point behind it (on the ground between them) is not seen there.
+        double d = m[c].D0 + s * m[c].dD;
+        double off = fabs(d - (double)cam->depth[texel]) * bl;
+        if (f * bl <= precision && off <= precision && cos_view > best_cos) {
             best = c;
             best_cos = cos_view;
         }

@@ -180,6 +180,40 @@ TEST(head_on_camera_gives_the_hit_on_a_steep_face)
     ENSURE(worst < 1e-3); // on the face
 }
 
+// Ground in front of a wall, seen by a camera in front and one above. In the
+// front camera the rows at ground level show the slab's front edge (head-on,
+// like the top camera sees the ground), and its bilinear depth between the wall
+// and that edge passes through the ground between them: the hit there must
+// still go to the top camera, which really sees the ground, not to the slab's
+// edge 3 m away.
+TEST(ground_between_wall_and_slab_edge_goes_to_the_camera_that_sees_it)
+{
+    fx_world world = { 0 };
+    fx_box(&world, -2, 0, -1, 2, 3, 0);      // wall, front face at z = 0
+    fx_box(&world, -3, -0.2f, -3, 3, 0, 3);  // ground slab, front edge at z = 3
+    wx_camera cams[2] = { fx_camera(0, 1, 10, 0, 1, 0, 0, 1, 0, 6.4f, 64), top_camera(6.4f, 64) };
+    wx_maps maps[2];
+    wx_collider col;
+    ENSURE(build(&col, cams, maps, 2, &world, false));
+    int hits = 0, top = 0;
+    double worst = 0.0;
+    for (int i = 0; i < 200; ++i) {
+        float x = -1.9f + 3.8f * (float)i / 200.0f, z = 0.3f + 2.4f * (float)((i * 53) % 200) / 200.0f;
+        float p0[3] = { x, 0.5f, z }, p1[3] = { x, -0.1f, z };
+        wx_hit hit;
+        if (!wx_collider_sweep(&col, p0, p1, &hit)) {
+            continue;
+        }
+        hits++;
+        top += hit.camera == 1;
+        worst = fmax(worst, fabs(hit.point[1]));
+    }
+    release(&col, maps, 2);
+    ENSURE(hits == 200);
+    ENSURE(top == 200);
+    ENSURE(worst < 0.05); // on the ground (within half a front-camera texel)
+}
+
 // A segment that starts inside a solid collides at once; the particle is put
 // back on the surface of the camera that sees it nearest.
 TEST(start_inside_is_pushed_out)
@@ -297,6 +331,7 @@ int main(void)
     RUN(fast_particle_hits_one_texel_wall);
     RUN(bilinear_depth_follows_an_incline);
     RUN(head_on_camera_gives_the_hit_on_a_steep_face);
+    RUN(ground_between_wall_and_slab_edge_goes_to_the_camera_that_sees_it);
     RUN(start_inside_is_pushed_out);
     RUN(coarse_test_is_conservative_and_put_back_is_outside);
     RUN(projective_cameras_are_refused);
