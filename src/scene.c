@@ -29,6 +29,7 @@
 #include <libxml/tree.h>
 #include <libxml/xmlerror.h>
 
+#include "collider.h"
 #include "exr_io.h"
 
 /// Limits that bound memory before anything else is checked.
@@ -1447,6 +1448,10 @@ static wx_result parse_ortho(parser *p, const xmlNode *node, void *user)
     }
     if (s->camera_count >= SCENE_MAX_CAMERAS) {
         return fail(p, node, "too many cameras (at most %d)", SCENE_MAX_CAMERAS);
+    }
+    if (!attrs.out && s->input_count >= WX_COLLIDER_MAX_CAMERAS) {
+        return fail(p, node, "too many input cameras (the collider takes at most %d)",
+                    WX_COLLIDER_MAX_CAMERAS);
     }
     wx_scene_camera *grown = reserve(s->cameras, s->camera_count, &p->camera_cap, sizeof *grown);
     if (grown == NULL) {
