@@ -42,7 +42,7 @@ VIEWER_BIN := $(if $(VIEWER_SRC),$(BUILD)/weathering-viewer)
 # `weathering bake` in a child process when a scene's maps are still to bake.
 VIEWER_LIBS := -lglfw -lGL -lOpenEXRCore-3_1 -lxml2 -lpng -lm -lpthread
 
-.PHONY: all deps bench-deps test run bench clean
+.PHONY: all deps bench-deps test run bench clean sanitize fuzz valgrind
 all: $(BUILD)/weathering $(VIEWER_BIN)
 
 # Installs whatever Debian package is missing (apt-get update first), as root or
@@ -130,5 +130,68 @@ run: $(BUILD)/weathering
 
 clean:
 	rm -rf $(BUILD)
+
+# --- Reliability (docs/reliability.md) ---------------------------------------
+# make sanitize: the whole suite built with AddressSanitizer and UBSan in its own
+# folder ($(SAN_BUILD)); only the known Mesa leak is suppressed (tests/sanitize/).
+SAN_BUILD ?= $(BUILD)-san
+SAN_CFLAGS := -O1 -g -fno-omit-frame-pointer -fsanitize=address,undefined \
+    -fno-sanitize-recover=all
+# tests/sanitize/bin/xvfb-run keeps Mesa's GLX driver loaded in the viewer to the
+# end, so that LeakSanitizer still sees the driver's globals at exit.
+SAN_ENV := ASAN_OPTIONS=detect_leaks=1:strict_string_checks=1:check_initialization_order=1 \
+    LSAN_OPTIONS=suppressions=$(CURDIR)/tests/sanitize/lsan.supp:print_suppressions=0 \
+    UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 PATH="$(CURDIR)/tests/sanitize/bin:$$PATH"
+# The reliability targets need a few more Debian packages than the build.
+sanitize fuzz valgrind: DEB_PACKAGES += clang libclang-rt-dev valgrind
+sanitize: | deps
+	$(MAKE) --no-print-directory BUILD=$(SAN_BUILD) CFLAGS="$(SAN_CFLAGS)" \
+	    $(SAN_BUILD)/weathering $(SAN_BUILD)/weathering-viewer \
+	    $(TEST_SRC:tests/%.c=$(SAN_BUILD)/tests/%)
+	$(SAN_ENV) WX_BUILD=$(SAN_BUILD) WX_TESTS=tests tests/run.sh $(SAN_BUILD)/tests
+
+# make fuzz: libFuzzer targets (clang) in $(BUILD)/fuzz, seeded with the shipped
+# scenes and maps, each run for FUZZ_SECONDS. The library is rebuilt with clang
+# and the fuzzer's instrumentation in $(BUILD)/fuzz/lib.
+FUZZ_CC ?= clang
+FUZZ_SECONDS ?= 30
+FUZZ_CFLAGS := -O1 -g -fno-omit-frame-pointer -fsanitize=fuzzer-no-link,address,undefined \
+    -fno-sanitize-recover=all -Wno-missing-field-initializers
+FUZZ_TARGETS := $(patsubst tests/fuzz/%.c,$(BUILD)/fuzz/%,$(wildcard tests/fuzz/fuzz_*.c))
+FUZZ_ENV := ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+    LSAN_OPTIONS=suppressions=$(CURDIR)/tests/sanitize/lsan.supp
+$(BUILD)/fuzz/lib/libweathering.a: FORCE | deps
+	$(MAKE) BUILD=$(BUILD)/fuzz/lib CC=$(FUZZ_CC) CFLAGS="$(FUZZ_CFLAGS)" $@
+
+$(BUILD)/fuzz/%: tests/fuzz/%.c $(BUILD)/fuzz/lib/libweathering.a
+	$(FUZZ_CC) $(WARN) $(DEFS) $(INCLUDES) $(FUZZ_CFLAGS) -fsanitize=fuzzer -o $@ $^ $(LIBS)
+
+fuzz: $(FUZZ_TARGETS)
+	@for t in $(FUZZ_TARGETS); do \
+	    name=$$(basename $$t); corpus=$(BUILD)/fuzz/corpus/$$name; mkdir -p $$corpus; \
+	    sh tests/fuzz/seed.sh $$name $$corpus || exit 1; \
+	    echo "== $$name for $(FUZZ_SECONDS) s"; \
+	    $(FUZZ_ENV) $$t -max_total_time=$(FUZZ_SECONDS) -timeout=10 -rss_limit_mb=4096 \
+	        -malloc_limit_mb=4096 -print_final_stats=1 -artifact_prefix=$(BUILD)/fuzz/ \
+	        $$corpus >$(BUILD)/fuzz/$$name.log 2>&1; status=$$?; \
+	    grep -E '^(INFO: seed corpus|#[0-9]+ +DONE|stat::number_of_executed_units|Done )' \
+	        $(BUILD)/fuzz/$$name.log; \
+	    [ $$status -eq 0 ] || { tail -n 60 $(BUILD)/fuzz/$$name.log; exit 1; }; \
+	done
+
+# make valgrind: memcheck on two small scenes (maps given; maps baked), every phase;
+# any error or definite leak fails.
+VALGRIND := valgrind --error-exitcode=3 --leak-check=full --errors-for-leak-kinds=definite \
+    --suppressions=tests/sanitize/valgrind.supp -q
+valgrind: $(BUILD)/weathering | deps
+	rm -rf $(BUILD)/valgrind
+	GALLIUM_DRIVER=llvmpipe $(VALGRIND) $(BUILD)/weathering run tests/sanitize/valgrind.xml \
+	    --out $(BUILD)/valgrind/maps -q --threads 2
+	GALLIUM_DRIVER=llvmpipe $(VALGRIND) $(BUILD)/weathering run tests/sanitize/valgrind_bake.xml \
+	    --out $(BUILD)/valgrind/bake -q --threads 2
+	@echo "valgrind: no errors"
+
+.PHONY: FORCE
+FORCE:
 
 -include $(wildcard $(BUILD)/obj/*.d $(BUILD)/obj/tests/*.d $(BUILD)/obj/bench/*.d $(BUILD)/obj/viewer/*.d)
