@@ -7,10 +7,13 @@
 #include <errno.h>
 #include <inttypes.h>
 #include <math.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
+#include "atomic_file.h"
 #include "bake.h"
 #include "gather.h"
 #include "pipeline.h"
@@ -250,26 +253,6 @@ static void print_camera(const wx_scene_camera *sc)
     }
 }
 
-// Bytes a run needs, roughly: every map in memory plus every particle alive at once.
-static double memory_estimate(const wx_scene *scene, double *particles)
-{
-    double bytes = 0.0;
-    for (int c = 0; c < scene->camera_count; ++c) {
-        const wx_scene_camera *sc = &scene->cameras[c];
-        double texels = (double)sc->camera.width * (double)sc->camera.height;
-        // input: depth 1 + normal 3 + impact 2 + dirt 3 floats; output: depth, normal,
-        // mask and the second pass' buffer.
-        bytes += texels * (sc->is_output ? 6.0 : 9.0) * sizeof(float);
-    }
-    double duration = wx_scene_duration(scene);
-    *particles = 0.0;
-    for (int e = 0; e < scene->emitter_count; ++e) {
-        *particles += emitter_particle_count(&scene->emitters[e], duration);
-    }
-    enum { BYTES_PER_PARTICLE = 64 };
-    return bytes + *particles * BYTES_PER_PARTICLE;
-}
-
 static int command_info(const cli_args *args)
 {
     wx_scene scene;
@@ -333,10 +316,16 @@ static int command_info(const cli_args *args)
         }
         printf("\n");
     }
-    double particles = 0.0;
-    double bytes = memory_estimate(&scene, &particles);
-    printf("memory: about %.0f MiB (maps, and %.0f particles if all were alive at once)\n",
-           bytes / (1024.0 * 1024.0), particles);
+    wx_memory_need need;
+    wx_memory_estimate(&scene, true, &need);
+    double available = wx_memory_available();
+    printf("memory: about %.0f MiB (maps, and %.0f particles if all were alive at once)",
+           need.total_bytes / (1024.0 * 1024.0), need.particles);
+    if (available >= 0.0) {
+        printf(" of %.0f MiB available%s", available / (1024.0 * 1024.0),
+               need.total_bytes > available ? ": too much, a run would be refused" : "");
+    }
+    printf("\n");
     printf("output folder: %s\n", opts.out_dir);
     wx_scene_free(&scene);
     return 0;
@@ -392,6 +381,10 @@ static int run_phases(const cli_args *args, unsigned phases)
         r = wx_error_set(&err, WX_BAD_INPUT,
                          "%s: has no output camera (<Ortho out=\"true\">); `%s` needs one",
                          scene.path, args->command);
+    }
+    if (r == WX_OK) {
+        // Refused before any work (or any folder) is made: docs/reliability.md.
+        r = wx_memory_check(&scene, (phases & PHASE_SIMULATE) != 0, &err);
     }
     if (r == WX_OK) {
         r = wx_output_prepare(&opts, &err);
@@ -451,8 +444,43 @@ static int command_run(const cli_args *args)
     return run_phases(args, PHASE_BAKE | PHASE_SIMULATE | PHASE_GATHER);
 }
 
+// --- interrupts -------------------------------------------------------------------
+
+// SIGINT, SIGTERM, SIGHUP: remove the temporaries still being written and exit
+// with 128 + the signal (130 for Ctrl-C). Finished outputs are already under
+// their final names (atomic rename); no output is ever half there.
+static void on_interrupt(int sig)
+{
+    wx_temp_remove_all();
+    static const char message[] = "\nweathering: interrupted; temporary files removed\n";
+    ssize_t ignored = write(STDERR_FILENO, message, sizeof message - 1);
+    (void)ignored;
+    _exit(128 + sig);
+}
+
+static void install_interrupt_handlers(void)
+{
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_interrupt;
+    sigfillset(&sa.sa_mask); // no second signal inside the handler
+    const int signals[] = { SIGINT, SIGTERM, SIGHUP };
+    for (size_t i = 0; i < sizeof signals / sizeof signals[0]; ++i) {
+        struct sigaction old;
+        // nohup: an ignored SIGHUP stays ignored. SIGINT is caught even when the
+        // shell started us in the background with it ignored: `kill -INT` on a
+        // background run means "stop it".
+        if (signals[i] == SIGHUP && sigaction(SIGHUP, NULL, &old) == 0 &&
+            old.sa_handler == SIG_IGN) {
+            continue;
+        }
+        sigaction(signals[i], &sa, NULL);
+    }
+}
+
 int main(int argc, char **argv)
 {
+    install_interrupt_handlers();
     cli_args args;
     int status = parse_args(argc, argv, &args);
     if (status >= 0) {

@@ -3,9 +3,11 @@
 #include "pipeline.h"
 
 #include <errno.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -55,7 +57,155 @@ static wx_result make_folders(const char *path, wx_error *err)
 
 wx_result wx_output_prepare(const wx_run_options *opts, wx_error *err)
 {
-    return make_folders(opts->out_dir, err);
+    wx_result r = make_folders(opts->out_dir, err);
+    if (r == WX_OK) {
+        // Temporaries of an earlier run that was killed (SIGKILL, power loss).
+        wx_temp_remove_stale(opts->out_dir);
+    }
+    return r;
+}
+
+// --- memory limits (docs/reliability.md) ---------------------------------------
+
+static double emitter_particles(const wx_emitter *e, double duration)
+{
+    double end = e->end < duration ? e->end : duration;
+    return end > e->start ? floor(e->rate * (end - e->start)) : 0.0;
+}
+
+void wx_memory_estimate(const wx_scene *scene, bool with_particles, wx_memory_need *need)
+{
+    memset(need, 0, sizeof *need);
+    need->camera_line = scene->path[0] != '\0' ? 1 : 0;
+    double largest = -1.0;
+    for (int c = 0; c < scene->camera_count; ++c) {
+        const wx_scene_camera *sc = &scene->cameras[c];
+        double texels = (double)sc->camera.width * (double)sc->camera.height;
+        double floats = sc->is_output ? WX_OUTPUT_FLOATS_PER_TEXEL : WX_INPUT_FLOATS_PER_TEXEL;
+        need->map_bytes += texels * floats * (double)sizeof(float);
+        if (texels > largest) {
+            largest = texels;
+            need->camera_line = sc->line;
+        }
+    }
+    largest = -1.0;
+    double duration = wx_scene_duration(scene);
+    for (int e = 0; e < scene->emitter_count && with_particles; ++e) {
+        double n = emitter_particles(&scene->emitters[e], duration);
+        need->particles += n;
+        if (n > largest) {
+            largest = n;
+            need->emitter_line = scene->emitters[e].line;
+        }
+    }
+    need->particle_bytes = need->particles * WX_BYTES_PER_PARTICLE;
+    need->total_bytes = need->map_bytes + need->particle_bytes;
+}
+
+// A "Key:   1234 kB" line of /proc/meminfo, in bytes; < 0 when absent.
+static double meminfo_bytes(const char *key)
+{
+    FILE *f = fopen("/proc/meminfo", "r");
+    if (f == NULL) {
+        return -1.0;
+    }
+    char line[256];
+    double bytes = -1.0;
+    size_t key_len = strlen(key);
+    while (fgets(line, sizeof line, f) != NULL) {
+        if (strncmp(line, key, key_len) == 0 && line[key_len] == ':') {
+            bytes = 1024.0 * strtod(line + key_len + 1, NULL);
+            break;
+        }
+    }
+    fclose(f);
+    return bytes;
+}
+
+// A cgroup v2 number file ("max" or bytes); < 0 when absent or "max".
+static double cgroup_number(const char *path)
+{
+    FILE *f = fopen(path, "r");
+    if (f == NULL) {
+        return -1.0;
+    }
+    char text[64] = "";
+    double value = -1.0;
+    if (fgets(text, sizeof text, f) != NULL && text[0] >= '0' && text[0] <= '9') {
+        value = strtod(text, NULL);
+    }
+    fclose(f);
+    return value;
+}
+
+static void take_min(double *least, double value)
+{
+    if (value >= 0.0 && (*least < 0.0 || value < *least)) {
+        *least = value;
+    }
+}
+
+double wx_memory_available(void)
+{
+    const char *override = getenv("WX_MEMORY_AVAILABLE_MB");
+    if (override != NULL && override[0] != '\0') {
+        char *end = NULL;
+        double mb = strtod(override, &end);
+        if (end != override && *end == '\0' && mb >= 0.0) {
+            return mb * 1024.0 * 1024.0;
+        }
+    }
+    double least = meminfo_bytes("MemAvailable");
+    if (least < 0.0) {
+        long pages = sysconf(_SC_AVPHYS_PAGES);
+        long page = sysconf(_SC_PAGESIZE);
+        if (pages > 0 && page > 0) {
+            least = (double)pages * (double)page;
+        }
+    }
+    double cg_max = cgroup_number("/sys/fs/cgroup/memory.max");
+    double cg_now = cgroup_number("/sys/fs/cgroup/memory.current");
+    if (cg_max >= 0.0) {
+        take_min(&least, cg_now >= 0.0 && cg_now < cg_max ? cg_max - cg_now : 0.0);
+    }
+    struct rlimit rl;
+    if (getrlimit(RLIMIT_AS, &rl) == 0 && rl.rlim_cur != RLIM_INFINITY) {
+        take_min(&least, (double)rl.rlim_cur);
+    }
+    if (getrlimit(RLIMIT_DATA, &rl) == 0 && rl.rlim_cur != RLIM_INFINITY) {
+        take_min(&least, (double)rl.rlim_cur);
+    }
+    return least;
+}
+
+static double gib(double bytes)
+{
+    return bytes / (1024.0 * 1024.0 * 1024.0);
+}
+
+wx_result wx_memory_check(const wx_scene *scene, bool with_particles, wx_error *err)
+{
+    wx_memory_need need;
+    wx_memory_estimate(scene, with_particles, &need);
+    double available = wx_memory_available();
+    if (available < 0.0 || need.total_bytes <= available) {
+        return WX_OK;
+    }
+    if (need.particle_bytes > need.map_bytes) {
+        return wx_error_set(err, WX_BAD_INPUT,
+                            "%s:%d: the emitters would emit %.4g particles: with the maps that "
+                            "needs about %.3g GiB (%.0f bytes per particle, %.3g GiB of maps), "
+                            "but only %.3g GiB of memory is available; lower the rate or the "
+                            "duration (see docs/reliability.md)",
+                            scene->path, need.emitter_line, need.particles, gib(need.total_bytes),
+                            WX_BYTES_PER_PARTICLE, gib(need.map_bytes), gib(available));
+    }
+    return wx_error_set(err, WX_BAD_INPUT,
+                        "%s:%d: the maps need about %.3g GiB (%.3g GiB with the particles), but "
+                        "only %.3g GiB of memory is available; use smaller maps (see "
+                        "docs/reliability.md)",
+                        scene->path, need.camera_line, gib(need.map_bytes),
+                        gib(need.total_bytes), gib(available));
 }
 
 static bool same_file(const struct stat *a, const char *path)

@@ -53,6 +53,38 @@ int wx_cpu_count(void);
 /// Creates the output folder (and its parents) and checks it is a folder.
 wx_result wx_output_prepare(const wx_run_options *opts, wx_error *err);
 
+/// Memory a run needs, estimated before work starts (docs/reliability.md).
+typedef struct wx_memory_need {
+    double map_bytes;      ///< every camera's maps in memory
+    double particles;      ///< particles the emitters emit over the simulation
+    double particle_bytes; ///< as if every particle emitted were alive at once
+    double total_bytes;
+    int camera_line;       ///< scene line of the camera with the largest maps
+    int emitter_line;      ///< scene line of the emitter with the most particles
+} wx_memory_need;
+
+/// Floats held per texel of an input camera: depth 1, normal 3, impact 2, dirt 3,
+/// and the 4 planes of the dirt map written after the simulation.
+#define WX_INPUT_FLOATS_PER_TEXEL 13.0
+/// Floats held per texel of the output camera: depth, normal 3, the first and
+/// second pass of the mask, and the bake's and the gather's working planes.
+#define WX_OUTPUT_FLOATS_PER_TEXEL 10.0
+/// Bytes per particle: WX_PARTICLE_BYTES with room for the arrays to double as
+/// they grow, plus the per-step events and candidates of the workers.
+#define WX_BYTES_PER_PARTICLE 192.0
+
+/// Estimates the memory of a run; particles count only when `with_particles`.
+void wx_memory_estimate(const wx_scene *scene, bool with_particles, wx_memory_need *need);
+
+/// Bytes this process can still use: the least of MemAvailable, the cgroup's
+/// memory.max minus memory.current and RLIMIT_AS / RLIMIT_DATA; < 0 when
+/// unknown. $WX_MEMORY_AVAILABLE_MB overrides it (tests, or to insist).
+double wx_memory_available(void);
+
+/// Refuses (WX_BAD_INPUT, "scene:LINE: ...") a run whose estimate exceeds the
+/// memory available, naming the numbers, before any work starts.
+wx_result wx_memory_check(const wx_scene *scene, bool with_particles, wx_error *err);
+
 /// Joins the output folder and a plain file name into `path`. Fails (WX_BAD_INPUT)
 /// when the result would be one of the scene's input files (a map or a mesh the
 /// scene names, the scene itself): inputs are never overwritten. Maps this
