@@ -53,6 +53,13 @@ static void stream_on_error(exr_const_context_t ctxt, exr_result_t code, const c
     if (s->message[0] == '\0') {
         snprintf(s->message, sizeof s->message, "%s",
                  msg != NULL ? msg : exr_get_default_error_message(code));
+        // The library quotes bytes of a corrupt header: keep the message one
+        // printable line.
+        for (char *c = s->message; *c != '\0'; ++c) {
+            if ((unsigned char)*c < 0x20 || (unsigned char)*c >= 0x7f) {
+                *c = '?';
+            }
+        }
     }
 }
 

@@ -46,6 +46,25 @@ static wx_result need_path(const char *path, const char *what, wx_error *err)
     return WX_OK;
 }
 
+// Refuses NaN and infinities in a map whose values are all meant to be finite
+// (normal, impact, dirt: only the depth map marks "no surface" with them).
+static wx_result check_finite(const char *path, const char *what, const float *values,
+                              size_t count, int width, int stride, const char *const *channels,
+                              wx_error *err)
+{
+    for (size_t k = 0; k < count; k++) {
+        if (!isfinite(values[k])) {
+            size_t texel = k / (size_t)stride;
+            return wx_error_set(err, WX_BAD_INPUT,
+                                "%s: %s map texel (%d, %d) channel %s is %s (must be finite)",
+                                path, what, (int)(texel % (size_t)width),
+                                (int)(texel / (size_t)width), channels[k % (size_t)stride],
+                                isnan(values[k]) ? "NaN" : "infinite");
+        }
+    }
+    return WX_OK;
+}
+
 // Reads an interleaved map and checks its size.
 static wx_result load_interleaved(const char *path, const char *const *channels, int count,
                                   float **out, size_check *check, wx_error *err)
@@ -89,12 +108,22 @@ wx_result wx_maps_load(wx_maps *maps, unsigned which, const char *depth_path,
         if (result == WX_OK) {
             result = load_interleaved(normal_path, channels, 3, &maps->normal, &check, err);
         }
+        if (result == WX_OK) {
+            result = check_finite(normal_path, "normal", maps->normal,
+                                  3 * (size_t)check.width * (size_t)check.height, check.width, 3,
+                                  channels, err);
+        }
     }
     if (result == WX_OK && wanted(which, WX_MAPS_IMPACT)) {
         static const char *const channels[] = {"R", "G"};
         result = need_path(impact_path, "impact", err);
         if (result == WX_OK) {
             result = load_interleaved(impact_path, channels, 2, &maps->impact, &check, err);
+        }
+        if (result == WX_OK) {
+            result = check_finite(impact_path, "impact", maps->impact,
+                                  2 * (size_t)check.width * (size_t)check.height, check.width, 2,
+                                  channels, err);
         }
     }
     if (result == WX_OK && wanted(which, WX_MAPS_DIRT)) {
@@ -120,6 +149,13 @@ wx_result wx_maps_load(wx_maps *maps, unsigned which, const char *depth_path,
                 maps->erosion = image->channels[2];
                 image->channels[0] = image->channels[1] = image->channels[2] = NULL;
                 result = check_size(&check, dirt_path, image->width, image->height, err);
+            }
+            for (int c = 0; c < 3 && result == WX_OK; c++) {
+                const char *name[1] = { image->channel_names[c] };
+                result = check_finite(dirt_path, "dirt",
+                                      c == 0 ? maps->dirt : c == 1 ? maps->deposit : maps->erosion,
+                                      (size_t)check.width * (size_t)check.height, check.width, 1,
+                                      name, err);
             }
             wx_image_free(image);
         }

@@ -146,6 +146,13 @@ static void record_xml_error(xml_errors *st, int line, const char *message)
     while (n > 0 && (st->message[n - 1] == '\n' || st->message[n - 1] == ' ')) {
         st->message[--n] = '\0';
     }
+    // One line: libxml2 puts the offending bytes on a line of their own
+    // ("...encoding !\nBytes: 0xC8 ...").
+    for (char *c = st->message; *c != '\0'; ++c) {
+        if ((unsigned char)*c < 0x20) {
+            *c = ' ';
+        }
+    }
 }
 
 #if LIBXML_VERSION >= 21200

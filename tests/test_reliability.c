@@ -1,0 +1,498 @@
+// test_reliability.c: bad inputs through the command line, interrupted and killed
+// runs, the memory limit, and the temporaries of atomic writes (docs/reliability.md).
+#define _XOPEN_SOURCE 700 // realpath
+#include <dirent.h>
+#include <errno.h>
+#include <fcntl.h>
+#include <limits.h>
+#include <signal.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "atomic_file.h"
+#include "ensure.h"
+#include "exr_io.h"
+
+static char out[65536];
+
+static int compare_names(const void *a, const void *b)
+{
+    return strcmp(*(const char *const *)a, *(const char *const *)b);
+}
+
+// The names in `folder` ending in `suffix`, sorted; returns the count (<= cap).
+static int list_names(const char *folder, const char *suffix, char **names, int cap)
+{
+    DIR *dir = opendir(folder);
+    if (dir == NULL) {
+        return 0;
+    }
+    int count = 0;
+    struct dirent *entry;
+    size_t suffix_len = strlen(suffix);
+    while ((entry = readdir(dir)) != NULL && count < cap) {
+        size_t len = strlen(entry->d_name);
+        if (strcmp(entry->d_name, ".") == 0 || strcmp(entry->d_name, "..") == 0) {
+            continue;
+        }
+        if (len >= suffix_len && strcmp(entry->d_name + len - suffix_len, suffix) == 0) {
+            names[count++] = strdup(entry->d_name);
+        }
+    }
+    closedir(dir);
+    qsort(names, (size_t)count, sizeof names[0], compare_names);
+    return count;
+}
+
+static void free_names(char **names, int count)
+{
+    for (int i = 0; i < count; ++i) {
+        free(names[i]);
+    }
+}
+
+// The same "<!-- expect: LINE: substring -->" first line as test_scene's bad_scenes.
+// LINE 0: the message names no XML line (a map whose pixels are bad is found
+// when the simulation loads it; the message names the map file).
+static bool read_expectation(const char *path, int *line, char *substring, size_t cap)
+{
+    char *text = ensure_read_file(path);
+    if (text == NULL) {
+        return false;
+    }
+    const char *prefix = "<!-- expect: ";
+    bool ok = false;
+    if (strncmp(text, prefix, strlen(prefix)) == 0) {
+        char *rest = text + strlen(prefix);
+        char *colon;
+        long n = strtol(rest, &colon, 10);
+        char *end = strstr(rest, " -->");
+        char *newline = strchr(rest, '\n');
+        if (colon != rest && colon[0] == ':' && colon[1] == ' ' && end != NULL &&
+            (newline == NULL || end < newline)) {
+            *line = (int)n;
+            snprintf(substring, cap, "%.*s", (int)(end - (colon + 2)), colon + 2);
+            ok = true;
+        }
+    }
+    free(text);
+    return ok;
+}
+
+// Runs `weathering simulate` on every bad input of `folder`: exit status 2, one
+// message naming the file (and the line), and no output file written.
+static int check_bad_folder(const char *folder, int *checked)
+{
+    char *names[256];
+    int count = list_names(folder, ".xml", names, 256);
+    int failures = 0;
+    for (int i = 0; i < count; ++i) {
+        char path[4400];
+        snprintf(path, sizeof path, "%s/%s", folder, names[i]);
+        int line;
+        char substring[512];
+        if (!read_expectation(path, &line, substring, sizeof substring)) {
+            fprintf(stderr, "%s: no '<!-- expect: LINE: substring -->' first line\n", path);
+            failures++;
+            continue;
+        }
+        char out_dir[4400];
+        snprintf(out_dir, sizeof out_dir, "%s/bad_%d", ensure_tmpdir(), *checked + i);
+        int status = ensure_shell(out, sizeof out, "%s/weathering simulate %s --out %s -q",
+                                  ensure_build_dir(), path, out_dir);
+        char prefix[4500];
+        if (line > 0) {
+            snprintf(prefix, sizeof prefix, "weathering: %s:%d: ", path, line);
+        } else {
+            snprintf(prefix, sizeof prefix, "weathering: ");
+        }
+        char *written[8];
+        int written_count = list_names(out_dir, "", written, 8);
+        bool ok = status == 2 && strncmp(out, prefix, strlen(prefix)) == 0 &&
+                  ensure_contains(out, substring) && written_count == 0 &&
+                  strchr(out, '\n') == out + strlen(out) - 1; // one line
+        free_names(written, written_count);
+        if (!ok) {
+            fprintf(stderr, "%s: expected exit 2 with \"%s...%s\" and no output, got %d: %s\n",
+                    path, prefix, substring, status, out);
+            failures++;
+        }
+    }
+    *checked += count;
+    free_names(names, count);
+    return failures;
+}
+
+// Every bad scene and map of tests/bad/ and tests/bad/run/ through the command line.
+TEST(bad_inputs_exit_2_with_their_message)
+{
+    char folder[4096];
+    int checked = 0;
+    snprintf(folder, sizeof folder, "%s/bad", ensure_tests_dir());
+    int failures = check_bad_folder(folder, &checked);
+    snprintf(folder, sizeof folder, "%s/bad/run", ensure_tests_dir());
+    failures += check_bad_folder(folder, &checked);
+    ENSURE(checked >= 60);
+    ENSURE(failures == 0);
+}
+
+TEST(memory_estimate_over_the_limit_is_refused_with_the_numbers)
+{
+    const char *dir = ensure_tmpdir();
+    int status = ensure_shell(out, sizeof out,
+                              "WX_MEMORY_AVAILABLE_MB=4 %s/weathering simulate "
+                              "xml_scenes/thesis_box.xml --out %s/mem -q",
+                              ensure_build_dir(), dir);
+    ENSURE(status == 2);
+    ENSURE(ensure_contains(out, "xml_scenes/thesis_box.xml:"));
+    ENSURE(ensure_contains(out, "GiB of memory is available"));
+    ENSURE(ensure_contains(out, "0.00391 GiB")); // 4 MiB
+    char mem_dir[4200];
+    snprintf(mem_dir, sizeof mem_dir, "%s/mem", dir);
+    struct stat st;
+    ENSURE(stat(mem_dir, &st) != 0); // refused before the output folder was made
+    // info says so, and is not refused.
+    status = ensure_shell(out, sizeof out,
+                          "WX_MEMORY_AVAILABLE_MB=4 %s/weathering info xml_scenes/thesis_box.xml",
+                          ensure_build_dir());
+    ENSURE(status == 0);
+    ENSURE(ensure_contains(out, "a run would be refused"));
+    // With enough memory the same scene is accepted.
+    status = ensure_shell(out, sizeof out,
+                          "WX_MEMORY_AVAILABLE_MB=1000 %s/weathering info xml_scenes/thesis_box.xml",
+                          ensure_build_dir());
+    ENSURE(status == 0);
+    ENSURE(!ensure_contains(out, "refused"));
+}
+
+// --- interrupted and killed runs ----------------------------------------------------
+
+static bool copy_file(const char *from, const char *to)
+{
+    return ensure_shell(NULL, 0, "cp '%s' '%s'", from, to) == 0;
+}
+
+// A copy of the building scene, made slower (more steps), in `dir`/scene/.
+static bool make_long_scene(const char *dir, char scene[PATH_MAX])
+{
+    char folder[PATH_MAX];
+    snprintf(folder, sizeof folder, "%s/scene/meshes", dir);
+    if (ensure_shell(NULL, 0, "mkdir -p '%s'", folder) != 0) {
+        return false;
+    }
+    char path[PATH_MAX + 64];
+    snprintf(path, sizeof path, "%s/building.obj", folder);
+    if (!copy_file("xml_scenes/meshes/building.obj", path)) {
+        return false;
+    }
+    snprintf(path, sizeof path, "%s/building.mtl", folder);
+    if (!copy_file("xml_scenes/meshes/building.mtl", path)) {
+        return false;
+    }
+    snprintf(scene, PATH_MAX, "%s/scene/building.xml", dir);
+    return ensure_shell(NULL, 0,
+                        "sed -e 's/steps=\"600\"/steps=\"6000\"/' -e 's/end=\"4\"/end=\"40\"/' "
+                        "xml_scenes/building.xml > '%s'",
+                        scene) == 0;
+}
+
+// A checksum of every file under `folder` except `skip` (names and contents).
+static uint64_t tree_hash(const char *folder, const char *skip)
+{
+    char command[3 * PATH_MAX];
+    snprintf(command, sizeof command,
+             "cd '%s' && find . -path './%s' -prune -o -type f -print | sort | "
+             "xargs -r cksum; find . -path './%s' -prune -o -print | sort",
+             folder, skip, skip);
+    FILE *pipe = popen(command, "r");
+    if (pipe == NULL) {
+        return 0;
+    }
+    uint64_t hash = 1469598103934665603ull;
+    int c;
+    while ((c = fgetc(pipe)) != EOF) {
+        hash = (hash ^ (uint64_t)(unsigned char)c) * 1099511628211ull;
+    }
+    pclose(pipe);
+    return hash;
+}
+
+static void sleep_s(double seconds)
+{
+    struct timespec ts = { (time_t)seconds, (long)((seconds - (double)(time_t)seconds) * 1e9) };
+    while (nanosleep(&ts, &ts) != 0 && errno == EINTR) {
+    }
+}
+
+// Starts `weathering run SCENE --out OUT` in the folder `cwd`, sends `sig` after
+// `seconds` and returns the wait status (or -1).
+static int run_and_signal(const char *cwd, const char *scene, const char *out_dir, int sig,
+                          double seconds)
+{
+    char program[PATH_MAX];
+    if (realpath(ensure_build_dir(), program) == NULL) {
+        return -1;
+    }
+    strncat(program, "/weathering", sizeof program - strlen(program) - 1);
+    pid_t pid = fork();
+    if (pid < 0) {
+        return -1;
+    }
+    if (pid == 0) {
+        int null = open("/dev/null", O_WRONLY);
+        if (null >= 0) {
+            dup2(null, STDOUT_FILENO);
+            dup2(null, STDERR_FILENO);
+        }
+        signal(SIGINT, SIG_DFL);
+        if (chdir(cwd) != 0) {
+            _exit(99);
+        }
+        execl(program, program, "run", scene, "--out", out_dir, "--threads", "2", "-q",
+              (char *)NULL);
+        _exit(98);
+    }
+    sleep_s(seconds);
+    kill(pid, sig);
+    int status = 0;
+    if (waitpid(pid, &status, 0) != pid) {
+        return -1;
+    }
+    return status;
+}
+
+static bool ends_with(const char *name, const char *suffix)
+{
+    size_t n = strlen(name), k = strlen(suffix);
+    return n >= k && strcmp(name + n - k, suffix) == 0;
+}
+
+// Every file under a final name reads back: EXRs in full, PNGs up to IEND, JSON.
+// Counts the temporaries (".name.tmpPID") left in `temps`.
+static bool outputs_read_back(const char *folder, int *files, int *temps)
+{
+    char *names[256];
+    int count = list_names(folder, "", names, 256);
+    bool ok = true;
+    *files = 0;
+    *temps = 0;
+    for (int i = 0; i < count; ++i) {
+        char path[PATH_MAX + 300];
+        snprintf(path, sizeof path, "%s/%s", folder, names[i]);
+        if (names[i][0] == '.') {
+            *temps += 1;
+            continue;
+        }
+        *files += 1;
+        if (ends_with(names[i], ".exr")) {
+            wx_image header;
+            wx_error err;
+            if (wx_exr_read_header(path, &header, &err) != WX_OK) {
+                fprintf(stderr, "%s\n", err.message);
+                ok = false;
+                continue;
+            }
+            char wanted_names[WX_IMAGE_MAX_CHANNELS][WX_NAME_MAX];
+            const char *wanted[WX_IMAGE_MAX_CHANNELS];
+            int channels = header.channel_count;
+            for (int c = 0; c < channels; ++c) {
+                memcpy(wanted_names[c], header.channel_names[c], WX_NAME_MAX);
+                wanted[c] = wanted_names[c];
+            }
+            wx_image_free(&header);
+            wx_image image;
+            if (wx_exr_read(path, wanted, channels, &image, &err) != WX_OK) {
+                fprintf(stderr, "%s\n", err.message);
+                ok = false;
+            }
+            wx_image_free(&image);
+        } else if (ends_with(names[i], ".png")) {
+            char *data = NULL;
+            FILE *f = fopen(path, "rb");
+            long size = 0;
+            if (f != NULL && fseek(f, 0, SEEK_END) == 0) {
+                size = ftell(f);
+                data = size >= 20 ? malloc((size_t)size) : NULL;
+                if (data != NULL && (fseek(f, 0, SEEK_SET) != 0 ||
+                                     fread(data, 1, (size_t)size, f) != (size_t)size)) {
+                    free(data);
+                    data = NULL;
+                }
+            }
+            if (f != NULL) {
+                fclose(f);
+            }
+            if (data == NULL || memcmp(data, "\x89PNG", 4) != 0 ||
+                memcmp(data + size - 8, "IEND", 4) != 0) {
+                fprintf(stderr, "%s: not a complete PNG\n", path);
+                ok = false;
+            }
+            free(data);
+        } else {
+            fprintf(stderr, "%s: unexpected file\n", path);
+            ok = false;
+        }
+    }
+    free_names(names, count);
+    return ok;
+}
+
+// SIGINT at several moments of a run (bake, simulate): exit status 130, no
+// temporary left, every output there reads back, the scene's folder unchanged
+// and nothing written in the current folder.
+TEST(sigint_stops_a_run_cleanly)
+{
+    char dir[PATH_MAX];
+    ENSURE(realpath(ensure_tmpdir(), dir) != NULL);
+    char scene[PATH_MAX];
+    ENSURE(make_long_scene(dir, scene));
+    char cwd[PATH_MAX + 16];
+    snprintf(cwd, sizeof cwd, "%s/cwd", dir);
+    ENSURE(mkdir(cwd, 0777) == 0);
+    char scene_dir[PATH_MAX + 16];
+    snprintf(scene_dir, sizeof scene_dir, "%s/scene", dir);
+    uint64_t before = tree_hash(scene_dir, "out");
+    const double moments[] = { 0.3, 2.0, 4.5 };
+    for (int k = 0; k < 3; ++k) {
+        char out_dir[PATH_MAX + 32];
+        snprintf(out_dir, sizeof out_dir, "%s/out/int%d", scene_dir, k);
+        int status = run_and_signal(cwd, scene, out_dir, SIGINT, moments[k]);
+        ENSURE(WIFEXITED(status));
+        ENSURE(WEXITSTATUS(status) == 130);
+        int files = 0, temps = 0;
+        ENSURE(outputs_read_back(out_dir, &files, &temps));
+        ENSURE(temps == 0);
+        if (k == 2) {
+            ENSURE(files > 0); // interrupted after the bake wrote its maps
+        }
+    }
+    ENSURE(tree_hash(scene_dir, "out") == before);
+    char *names[4];
+    int in_cwd = list_names(cwd, "", names, 4);
+    free_names(names, in_cwd);
+    ENSURE(in_cwd == 0);
+    // SIGTERM too: 128 + 15.
+    char out_dir[PATH_MAX + 32];
+    snprintf(out_dir, sizeof out_dir, "%s/out/term", scene_dir);
+    int status = run_and_signal(cwd, scene, out_dir, SIGTERM, 1.0);
+    ENSURE(WIFEXITED(status) && WEXITSTATUS(status) == 143);
+}
+
+// SIGKILL at several moments: whatever has a final name reads back; the next
+// run in that folder removes the temporaries the killed one left.
+TEST(sigkill_never_leaves_a_torn_file)
+{
+    char dir[PATH_MAX];
+    ENSURE(realpath(ensure_tmpdir(), dir) != NULL);
+    char scene[PATH_MAX];
+    ENSURE(make_long_scene(dir, scene));
+    char scene_dir[PATH_MAX + 16];
+    snprintf(scene_dir, sizeof scene_dir, "%s/scene", dir);
+    uint64_t before = tree_hash(scene_dir, "out");
+    char out_dir[PATH_MAX + 32];
+    snprintf(out_dir, sizeof out_dir, "%s/out/kill", scene_dir);
+    const double moments[] = { 0.5, 1.0, 1.7, 2.5, 3.5 };
+    for (int k = 0; k < 5; ++k) {
+        // The same folder each time: later runs replace what earlier ones wrote.
+        int status = run_and_signal(scene_dir, scene, out_dir, SIGKILL, moments[k]);
+        ENSURE(WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL);
+        int files = 0, temps = 0;
+        ENSURE(outputs_read_back(out_dir, &files, &temps));
+    }
+    ENSURE(tree_hash(scene_dir, "out") == before);
+    // Whatever temporaries the killed runs left, their processes are gone.
+    wx_temp_remove_stale(out_dir);
+    char *names[256];
+    int count = list_names(out_dir, "", names, 256);
+    int temps = 0;
+    for (int i = 0; i < count; ++i) {
+        temps += names[i][0] == '.';
+    }
+    free_names(names, count);
+    ENSURE(temps == 0);
+}
+
+TEST(stale_temporaries_of_dead_processes_are_removed)
+{
+    char dir[PATH_MAX];
+    snprintf(dir, sizeof dir, "%s/stale", ensure_tmpdir());
+    ENSURE(mkdir(dir, 0777) == 0);
+    char mine[64];
+    snprintf(mine, sizeof mine, ".mask.exr.tmp%ld", (long)getpid());
+    ensure_write_file(dir, ".mask.exr.tmp999999999", "dead"); // above any pid_max
+    ensure_write_file(dir, mine, "alive");
+    ensure_write_file(dir, "mask.exr", "final");
+    ensure_write_file(dir, ".hidden", "not a temporary");
+    ensure_write_file(dir, ".x.tmpabc", "not a temporary");
+    ENSURE(wx_temp_remove_stale(dir) == 1);
+    char *names[8];
+    int count = list_names(dir, "", names, 8);
+    ENSURE(count == 4);
+    bool dead_gone = true;
+    for (int i = 0; i < count; ++i) {
+        dead_gone = dead_gone && strcmp(names[i], ".mask.exr.tmp999999999") != 0;
+    }
+    free_names(names, count);
+    ENSURE(dead_gone);
+}
+
+// The registry behind the interrupt handler: a temporary being written is
+// removed by wx_temp_remove_all, a committed one is forgotten.
+TEST(interrupt_removes_only_unfinished_temporaries)
+{
+    const char *dir = ensure_tmpdir();
+    char final_a[PATH_MAX], final_b[PATH_MAX];
+    snprintf(final_a, sizeof final_a, "%s/a.exr", dir);
+    snprintf(final_b, sizeof final_b, "%s/b.exr", dir);
+    char tmp_a[WX_PATH_MAX], tmp_b[WX_PATH_MAX];
+    wx_temp_path(final_a, tmp_a);
+    wx_temp_path(final_b, tmp_b);
+    ENSURE(tmp_a[strlen(dir) + 1] == '.');
+    FILE *f = fopen(tmp_a, "wb");
+    ENSURE(f != NULL);
+    fputs("a", f);
+    fclose(f);
+    f = fopen(tmp_b, "wb");
+    ENSURE(f != NULL);
+    fputs("b", f);
+    fclose(f);
+    wx_error err;
+    ENSURE(wx_atomic_commit(tmp_b, final_b, &err) == WX_OK);
+    wx_temp_remove_all();
+    ENSURE(access(tmp_a, F_OK) != 0);  // unfinished: removed
+    ENSURE(access(final_b, F_OK) == 0); // committed: kept
+    ENSURE(access(final_a, F_OK) != 0);
+    // Many temporaries, more than the registry's slots, some abandoned.
+    for (int i = 0; i < 200; ++i) {
+        char name[PATH_MAX + 32], tmp[WX_PATH_MAX];
+        snprintf(name, sizeof name, "%s/many%d.exr", dir, i);
+        wx_temp_path(name, tmp);
+        if (i % 2 == 0) {
+            wx_temp_forget(tmp);
+        }
+    }
+    char last[PATH_MAX + 32], tmp_last[WX_PATH_MAX];
+    snprintf(last, sizeof last, "%s/last.exr", dir);
+    wx_temp_path(last, tmp_last);
+    f = fopen(tmp_last, "wb");
+    ENSURE(f != NULL);
+    fclose(f);
+    wx_temp_remove_all();
+    ENSURE(access(tmp_last, F_OK) != 0);
+}
+
+int main(void)
+{
+    RUN(bad_inputs_exit_2_with_their_message);
+    RUN(memory_estimate_over_the_limit_is_refused_with_the_numbers);
+    RUN(stale_temporaries_of_dead_processes_are_removed);
+    RUN(interrupt_removes_only_unfinished_temporaries);
+    RUN(sigint_stops_a_run_cleanly);
+    RUN(sigkill_never_leaves_a_torn_file);
+    return ensure_summary();
+}
