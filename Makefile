@@ -1,7 +1,7 @@
 # Weathering: particle-driven weathering masks.
 #   make          build build/weathering (installs missing Debian packages first)
 #   make test     build and run the test suite
-#   make run      run the shipped default scene
+#   make run      run the shipped default scene into out/building/
 #   make bench    benchmarks (speed and memory targets)
 # BUILD=dir puts every build product in another folder.
 
@@ -125,8 +125,10 @@ bench: $(BUILD)/weathering $(BENCH_BIN)
 	sh tests/bench/report.sh $(BENCH_CSV); \
 	if [ -n "$$failed" ]; then echo "benchmarks that could not run:$$failed"; exit 1; fi
 
+# Bakes, simulates and gathers the default scene into out/<scene name>/ (mask.exr
+# and its preview mask.png); SCENE=file.xml runs another scene.
 run: $(BUILD)/weathering
-	$(BUILD)/weathering info $(SCENE)
+	$(BUILD)/weathering run $(SCENE)
 
 clean:
 	rm -rf $(BUILD)
