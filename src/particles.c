@@ -16,9 +16,7 @@ void wx_particles_free(wx_particles *p)
     free(p->load);
     free(p->id);
     free(p->collisions_left);
-    free(p->last_texel);
-    free(p->last_step);
-    free(p->last_cam);
+    free(p->last_slide);
     memset(p, 0, sizeof *p);
 }
 
@@ -56,13 +54,12 @@ bool wx_particles_reserve(wx_particles *p, int64_t needed)
               grow((void **)&p->vx, old, capacity, sizeof *p->vx) &&
               grow((void **)&p->vy, old, capacity, sizeof *p->vy) &&
               grow((void **)&p->vz, old, capacity, sizeof *p->vz) &&
-              grow((void **)&p->inv_mass, old, capacity, sizeof *p->inv_mass) &&
+              (p->inv_mass == NULL ||
+               grow((void **)&p->inv_mass, old, capacity, sizeof *p->inv_mass)) &&
               grow((void **)&p->load, old, capacity, sizeof *p->load) &&
               grow((void **)&p->id, old, capacity, sizeof *p->id) &&
               grow((void **)&p->collisions_left, old, capacity, sizeof *p->collisions_left) &&
-              grow((void **)&p->last_texel, old, capacity, sizeof *p->last_texel) &&
-              grow((void **)&p->last_step, old, capacity, sizeof *p->last_step) &&
-              grow((void **)&p->last_cam, old, capacity, sizeof *p->last_cam);
+              grow((void **)&p->last_slide, old, capacity, sizeof *p->last_slide);
     if (!ok) {
         return false;
     }
@@ -70,9 +67,37 @@ bool wx_particles_reserve(wx_particles *p, int64_t needed)
     return true;
 }
 
+// Makes 1/mass `inv` storable: a new shared value when no particle is alive, else
+// the per-particle array (filled with the shared value) if `inv` differs from it.
+static bool accept_inv_mass(wx_particles *p, float inv)
+{
+    if (p->inv_mass != NULL || inv == p->inv_mass_block[0]) {
+        return true;
+    }
+    if (p->count == 0) {
+        for (int k = 0; k < WX_PARTICLE_BLOCK; ++k) {
+            p->inv_mass_block[k] = inv;
+        }
+        return true;
+    }
+    float *all = malloc((size_t)p->capacity * sizeof *all);
+    if (all == NULL) {
+        return false;
+    }
+    for (int64_t k = 0; k < p->capacity; ++k) {
+        all[k] = p->inv_mass_block[0];
+    }
+    p->inv_mass = all;
+    return true;
+}
+
 int64_t wx_particles_push(wx_particles *p, const float pos[3], const float vel[3], float mass,
                           double load, uint64_t id, uint32_t max_collisions)
 {
+    float inv = 1.0f / mass;
+    if (!accept_inv_mass(p, inv)) {
+        return -1;
+    }
     int64_t i = p->count++;
     p->x[i] = pos[0];
     p->y[i] = pos[1];
@@ -80,13 +105,13 @@ int64_t wx_particles_push(wx_particles *p, const float pos[3], const float vel[3
     p->vx[i] = vel[0];
     p->vy[i] = vel[1];
     p->vz[i] = vel[2];
-    p->inv_mass[i] = 1.0f / mass;
+    if (p->inv_mass != NULL) {
+        p->inv_mass[i] = inv;
+    }
     p->load[i] = load;
     p->id[i] = id;
     p->collisions_left[i] = max_collisions;
-    p->last_texel[i] = 0;
-    p->last_step[i] = 0;
-    p->last_cam[i] = WX_NO_SLIDE;
+    p->last_slide[i] = WX_NO_SLIDE;
     return i;
 }
 
@@ -102,11 +127,11 @@ void wx_particles_remove(wx_particles *p, int64_t i)
     p->vx[i] = p->vx[last];
     p->vy[i] = p->vy[last];
     p->vz[i] = p->vz[last];
-    p->inv_mass[i] = p->inv_mass[last];
+    if (p->inv_mass != NULL) {
+        p->inv_mass[i] = p->inv_mass[last];
+    }
     p->load[i] = p->load[last];
     p->id[i] = p->id[last];
     p->collisions_left[i] = p->collisions_left[last];
-    p->last_texel[i] = p->last_texel[last];
-    p->last_step[i] = p->last_step[last];
-    p->last_cam[i] = p->last_cam[last];
+    p->last_slide[i] = p->last_slide[last];
 }

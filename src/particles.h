@@ -6,6 +6,11 @@
 // last slide). Dead particles are removed in O(1) by moving the last one into
 // their slot. Every array holds `capacity` entries, a multiple of
 // WX_PARTICLE_BLOCK, so the step loop can run whole blocks past `count`.
+//
+// While every particle has the same mass (one emitter, or emitters of one mass:
+// the common case) there is no 1/mass array: `inv_mass` is NULL and the block
+// loop reads `inv_mass_block`, 16 copies of the shared value. The first particle
+// of another mass creates the array.
 #ifndef WX_PARTICLES_H
 #define WX_PARTICLES_H
 
@@ -17,8 +22,8 @@
 /// Particles are stepped in blocks of this many (arrays are padded to it).
 #define WX_PARTICLE_BLOCK 16
 
-/// last_cam value of a particle whose last impact was not a slide.
-#define WX_NO_SLIDE 0xFF
+/// last_slide value of a particle whose previous step was not a slide hit.
+#define WX_NO_SLIDE UINT32_MAX
 
 typedef struct wx_particles {
     int64_t count;
@@ -26,18 +31,33 @@ typedef struct wx_particles {
     // Hot: read and written by every step.
     float *x, *y, *z;
     float *vx, *vy, *vz;
-    float *inv_mass;
+    float *inv_mass; ///< 1/mass per particle, or NULL while all share inv_mass_block[0]
+    float inv_mass_block[WX_PARTICLE_BLOCK]; ///< the shared 1/mass, once per lane
     // Cold: touched on emission, collision and removal.
     double *load;             ///< dirt carried
     uint64_t *id;             ///< emitter index << 48 | serial number within it
     uint32_t *collisions_left; ///< hits before the particle settles (>= 1 while alive)
-    uint32_t *last_texel;     ///< texel of the last slide hit (when last_cam != WX_NO_SLIDE)
-    uint32_t *last_step;      ///< step of the last slide hit
-    uint8_t *last_cam;        ///< camera of the last slide hit, or WX_NO_SLIDE
+    /// Where a slide hit of the previous step was, numbered over the texels of
+    /// all input maps (the simulation numbers them), or WX_NO_SLIDE: the step
+    /// loop resets it for every particle that does not collide.
+    uint32_t *last_slide;
 } wx_particles;
 
-/// Bytes stored per particle slot (all arrays).
-#define WX_PARTICLE_BYTES (7 * 4 + 8 + 8 + 4 + 4 + 4 + 1)
+/// Bytes stored per particle slot (all arrays), with a 1/mass array.
+#define WX_PARTICLE_BYTES (7 * 4 + 8 + 8 + 4 + 4)
+
+/// Bytes stored per particle slot now: WX_PARTICLE_BYTES less the 1/mass array
+/// while all particles share one mass.
+static inline int wx_particles_slot_bytes(const wx_particles *p)
+{
+    return WX_PARTICLE_BYTES - (p->inv_mass == NULL ? (int)sizeof(float) : 0);
+}
+
+/// 1/mass of particle i.
+static inline float wx_particle_inv_mass(const wx_particles *p, int64_t i)
+{
+    return p->inv_mass != NULL ? p->inv_mass[i] : p->inv_mass_block[0];
+}
 
 /// Frees every array; the struct is zeroed.
 void wx_particles_free(wx_particles *p);
@@ -46,7 +66,8 @@ void wx_particles_free(wx_particles *p);
 /// false when out of memory (the particles are unchanged).
 bool wx_particles_reserve(wx_particles *p, int64_t needed);
 
-/// Appends one particle (capacity must be reserved). Returns its index.
+/// Appends one particle (capacity must be reserved). Returns its index, or -1
+/// when out of memory (a first particle of a new mass needs the 1/mass array).
 int64_t wx_particles_push(wx_particles *p, const float pos[3], const float vel[3], float mass,
                           double load, uint64_t id, uint32_t max_collisions);
 

@@ -106,6 +106,9 @@ struct wx_sim {
     const wx_maps *maps;
     wx_dirt_map *dirt;
     int camera_order[WX_COLLIDER_MAX_CAMERAS]; ///< coarse test order (speed only)
+    /// Texel numbering for the particles' last slide: input camera c's texel t
+    /// is slide_base[c] + t; slide_base[input_count] is the total.
+    uint32_t slide_base[WX_COLLIDER_MAX_CAMERAS + 1];
     // State.
     int64_t step;
     wx_particles particles;
@@ -215,7 +218,8 @@ static void collide_one(wx_sim *sim, sim_worker *w, int64_t i, const float p0[3]
     wx_particles *P = &sim->particles;
     wx_hit hit;
     if (!wx_collider_sweep(&sim->collider, p0, p1, &hit)) {
-        // The Euler step stands (already stored).
+        // The Euler step stands (already stored); a step without a hit ends a streak.
+        P->last_slide[i] = WX_NO_SLIDE;
         if (!inside_box(sim, p1)) {
             push_dead(w, i, true);
         }
@@ -239,19 +243,16 @@ static void collide_one(wx_sim *sim, sim_worker *w, int64_t i, const float p0[3]
     e.camera = (uint8_t)hit.camera;
     e.flags = (uint8_t)kind;
     memcpy(e.point, hit.point, sizeof e.point);
-    // Streaks: a slide that follows a slide of the previous step on the same map.
-    if (kind == WX_IMPACT_SLIDE && P->last_cam[i] == hit.camera &&
-        P->last_step[i] == (uint32_t)(sim->step - 1)) {
+    // Streaks: a slide that follows a slide of the previous step on the same map
+    // (last_slide is reset in every step without a hit; unsigned arithmetic puts
+    // another map's texels and WX_NO_SLIDE out of range).
+    uint32_t base = sim->slide_base[hit.camera];
+    uint32_t from = P->last_slide[i] - base;
+    if (kind == WX_IMPACT_SLIDE && from < sim->slide_base[hit.camera + 1] - base) {
         e.flags |= EVENT_LINE;
-        e.from = P->last_texel[i];
+        e.from = from;
     }
-    if (kind == WX_IMPACT_SLIDE) {
-        P->last_cam[i] = (uint8_t)hit.camera;
-        P->last_texel[i] = hit.texel;
-        P->last_step[i] = (uint32_t)sim->step;
-    } else {
-        P->last_cam[i] = WX_NO_SLIDE;
-    }
+    P->last_slide[i] = kind == WX_IMPACT_SLIDE ? base + hit.texel : WX_NO_SLIDE;
     if (dies) {
         e.flags |= EVENT_DIES;
     }
@@ -294,7 +295,7 @@ static void collide_one(wx_sim *sim, sim_worker *w, int64_t i, const float p0[3]
     }
     if (kind == WX_IMPACT_SLIDE) {
         // Adherence pulls a sliding particle onto the surface: v -= A N dt / m.
-        float pull = sim->params.adherence * (float)sim->dt * P->inv_mass[i];
+        float pull = sim->params.adherence * (float)sim->dt * wx_particle_inv_mass(P, i);
         for (int k = 0; k < 3; ++k) {
             after[k] -= pull * N[k];
         }
@@ -365,9 +366,9 @@ static void step_range(wx_sim *sim, sim_worker *w)
         memcpy(ox, P->x + b, sizeof ox);
         memcpy(oy, P->y + b, sizeof oy);
         memcpy(oz, P->z + b, sizeof oz);
+        const float *inv_mass = P->inv_mass != NULL ? P->inv_mass + b : P->inv_mass_block;
         integrate_block(&sim->forces, t, dt, ox, oy, oz, P->vx + b, P->vy + b, P->vz + b,
-                        P->inv_mass + b, nx, ny, nz, nvx, nvy, nvz, sim->bbox_lo, sim->bbox_hi,
-                        inside);
+                        inv_mass, nx, ny, nz, nvx, nvy, nvz, sim->bbox_lo, sim->bbox_hi, inside);
         // The camera that cleared most last step, on every lane.
         uint32_t out_a;
         uint32_t clear = wx_collider_coarse_block(&sim->collider, sim->camera_order, first,
@@ -387,6 +388,19 @@ static void step_range(wx_sim *sim, sim_worker *w)
         int lanes = w->end - b < B ? (int)(w->end - b) : B;
         uint32_t valid = (1u << lanes) - 1u;
         uint32_t special = (~clear | outbox) & valid;
+        // A step without a hit ends a streak: reset every lane that cannot hit
+        // (padding lanes too); the candidates below reset their own. Written only
+        // where set, so the array's lines stay clean.
+        uint32_t *last_slide = P->last_slide + b;
+        uint32_t sliding = 0;
+        for (int k = 0; k < B; ++k) {
+            sliding |= (uint32_t)(last_slide[k] != WX_NO_SLIDE) << k;
+        }
+        sliding &= ~special;
+        while (sliding != 0) {
+            last_slide[__builtin_ctz(sliding)] = WX_NO_SLIDE;
+            sliding &= sliding - 1;
+        }
         while (special != 0) {
             int k = __builtin_ctz(special);
             special &= special - 1;
@@ -408,8 +422,11 @@ static void step_range(wx_sim *sim, sim_worker *w)
         const sim_candidate *c = &w->cands[j];
         if (!(c->flags & CAND_CLEAR)) {
             collide_one(sim, w, c->index, c->p0, c->p1, c->v);
-        } else if (c->flags & CAND_OUTBOX) {
-            push_dead(w, c->index, true); // a free flight out of the box
+        } else {
+            P->last_slide[c->index] = WX_NO_SLIDE;
+            if (c->flags & CAND_OUTBOX) {
+                push_dead(w, c->index, true); // a free flight out of the box
+            }
         }
     }
 }
@@ -582,8 +599,12 @@ static wx_result emit(wx_sim *sim, double t, wx_error *err)
             uint64_t id = wx_particle_id((uint32_t)e, (uint64_t)(sim->emitted[e] + k));
             float pos[3], vel[3];
             wx_emitter_sample(em, sim->seed, id, pos, vel);
-            wx_particles_push(&sim->particles, pos, vel, em->mass, em->dirt, id,
-                              max_collisions_of(em->max_collisions));
+            if (wx_particles_push(&sim->particles, pos, vel, em->mass, em->dirt, id,
+                                  max_collisions_of(em->max_collisions)) < 0) {
+                sim->emitted[e] += k;
+                sim->stats.particles_emitted += k;
+                return wx_error_set(err, WX_FAIL, "out of memory (particle masses)");
+            }
             sim->stats.dirt_emitted += em->dirt;
         }
         sim->emitted[e] = target;
@@ -746,6 +767,21 @@ wx_result wx_sim_create(const wx_scene *scene, const wx_sim_config *config, wx_s
                              config->nearest_depth, err);
     }
     free(cameras);
+    if (r == WX_OK) {
+        uint64_t total = 0;
+        for (int c = 0; c < sim->input_count; ++c) {
+            sim->slide_base[c] = (uint32_t)total;
+            total += (uint64_t)sim->maps[c].width * (uint64_t)sim->maps[c].height;
+            if (total >= WX_NO_SLIDE) {
+                r = wx_error_set(err, WX_BAD_INPUT,
+                                 "the input maps hold %llu texels or more in all (the "
+                                 "simulation numbers at most %llu)",
+                                 (unsigned long long)total, (unsigned long long)WX_NO_SLIDE - 1);
+                break;
+            }
+        }
+        sim->slide_base[sim->input_count] = (uint32_t)total;
+    }
     for (int c = 0; r == WX_OK && c < sim->input_count; ++c) {
         const wx_maps *m = &sim->maps[c];
         r = wx_dirt_map_init(&sim->dirt[c], m->width, m->height, m->dirt, m->deposit,
@@ -875,6 +911,11 @@ const wx_dirt_map *wx_sim_dirt_map(const wx_sim *sim, int input)
     return &sim->dirt[input];
 }
 
+int wx_sim_particle_bytes(const wx_sim *sim)
+{
+    return wx_particles_slot_bytes(&sim->particles);
+}
+
 wx_result wx_sim_spawn(wx_sim *sim, const float position[3], const float velocity[3],
                        float mass, double load, int max_collisions, wx_error *err)
 {
@@ -884,9 +925,12 @@ wx_result wx_sim_spawn(wx_sim *sim, const float position[3], const float velocit
     if (!wx_particles_reserve(&sim->particles, sim->particles.count + 1)) {
         return wx_error_set(err, WX_FAIL, "out of memory (particles)");
     }
-    uint64_t id = wx_particle_id(PSEUDO_EMITTER, sim->spawned++);
-    wx_particles_push(&sim->particles, position, velocity, mass, load, id,
-                      max_collisions_of(max_collisions));
+    uint64_t id = wx_particle_id(PSEUDO_EMITTER, sim->spawned);
+    if (wx_particles_push(&sim->particles, position, velocity, mass, load, id,
+                          max_collisions_of(max_collisions)) < 0) {
+        return wx_error_set(err, WX_FAIL, "out of memory (particle masses)");
+    }
+    sim->spawned++;
     sim->stats.particles_emitted++;
     sim->stats.dirt_emitted += load;
     return WX_OK;

@@ -65,6 +65,10 @@ typedef struct wx_particle_view {
 
 void wx_sim_particles(const wx_sim *sim, wx_particle_view *view);
 
+/// Bytes each particle slot takes now (WX_PARTICLE_BYTES, less the 1/mass array
+/// while all particles share one mass).
+int wx_sim_particle_bytes(const wx_sim *sim);
+
 typedef enum wx_impact {
     WX_IMPACT_ABSORB = 0,
     WX_IMPACT_BOUNCE = 1,
