@@ -77,6 +77,9 @@ static inline void bench_row(const char *bench, const char *metric, double value
     va_start(ap, config_fmt);
     vsnprintf(config, sizeof config, config_fmt, ap);
     va_end(ap);
+    for (char *c = config; *c != '\0'; ++c) {
+        *c = *c == ',' ? ';' : *c; // a comma would shift the CSV's columns
+    }
     fprintf(f, "%s,%s,%s,%.6g,%s,%s,%s\n", bench, config, metric, value, unit,
             target != NULL ? target : "", target == NULL ? "" : met ? "met" : "MISSED");
     fclose(f);

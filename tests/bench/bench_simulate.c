@@ -332,9 +332,9 @@ int main(void)
     bench_row("simulate", "machine 2-thread capacity", machine_vector, "x", NULL, false,
               "independent vector arithmetic");
     bench_row("simulate", "bytes per live particle", bytes, "B", "<= 48", bytes <= 48,
-              "particle arrays per slot, one mass");
+              "particle arrays per slot; one mass");
     bench_row("simulate", "bytes per live particle", WX_PARTICLE_BYTES, "B", NULL, false,
-              "particle arrays per slot, several masses");
+              "particle arrays per slot; several masses");
     bench_row("simulate", "peak RSS", bench_peak_mb(), "MB", NULL, false, "whole benchmark");
     printf("targets: >= 50 M/s (2 threads, no turbulence): %.1f %s; >= 20 M/s (2 threads, "
            "turbulence): %.1f %s; speed-up >= 1.8: %.2f/%.2f %s; <= 48 bytes: %d %s\n",
