@@ -385,6 +385,7 @@ static wx_result reader_decode(exr_reader *r, const char *path, const read_targe
     for (int64_t row = 0; row < r->height; row += lines) {
         int64_t last = row + lines - 1 < r->height - 1 ? row + lines - 1 : r->height - 1;
         exr_chunk_info_t ci;
+        memset(&ci, 0, sizeof ci);
         stream_reset(&r->stream);
         exr_result_t rv = exr_read_scanline_chunk_info(r->ctx, 0, (int)(r->min_y + row), &ci);
         if (rv == EXR_ERR_SUCCESS) {
@@ -425,6 +426,18 @@ static wx_result reader_decode(exr_reader *r, const char *path, const read_targe
         }
         if (rv == EXR_ERR_SUCCESS) {
             rv = exr_decoding_run(r->ctx, 0, &dec);
+        }
+        if (rv == EXR_ERR_OUT_OF_MEMORY) {
+            // The decoders also say "out of memory" for corrupt compressed data
+            // (found by fuzzing: a B44A chunk): it is one only if a buffer twice
+            // the chunk's size cannot be had either.
+            void *probe = ci.unpacked_size < ((uint64_t)1 << 40)
+                              ? malloc(2 * (size_t)ci.unpacked_size + 1)
+                              : NULL;
+            if (probe != NULL) {
+                rv = EXR_ERR_CORRUPT_CHUNK;
+            }
+            free(probe);
         }
         if (rv != EXR_ERR_SUCCESS) {
             if (rv == EXR_ERR_OUT_OF_MEMORY) {

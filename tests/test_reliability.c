@@ -365,13 +365,15 @@ TEST(sigint_stops_a_run_cleanly)
     char scene_dir[PATH_MAX + 16];
     snprintf(scene_dir, sizeof scene_dir, "%s/scene", dir);
     uint64_t before = tree_hash(scene_dir, "out");
-    // Early in the bake; in the bake; once the bake wrote its last map (simulating).
-    const double moments[] = { 0.3, 1.5, 1.0 };
+    // Counted from when the output folder exists (the handlers are in place by
+    // then, however loaded the machine): early in the bake; in the bake; and once
+    // the bake wrote its last map (simulating).
+    const double moments[] = { 0.1, 1.0, 1.0 };
     for (int k = 0; k < 3; ++k) {
         char out_dir[PATH_MAX + 32];
         snprintf(out_dir, sizeof out_dir, "%s/out/int%d", scene_dir, k);
         int status = run_and_signal(cwd, scene, out_dir, SIGINT, moments[k],
-                                    k == 2 ? "out_normal.exr" : NULL);
+                                    k == 2 ? "out_normal.exr" : ".");
         ENSURE(WIFEXITED(status));
         ENSURE(WEXITSTATUS(status) == 130);
         int files = 0, temps = 0;
@@ -389,7 +391,7 @@ TEST(sigint_stops_a_run_cleanly)
     // SIGTERM too: 128 + 15.
     char out_dir[PATH_MAX + 32];
     snprintf(out_dir, sizeof out_dir, "%s/out/term", scene_dir);
-    int status = run_and_signal(cwd, scene, out_dir, SIGTERM, 1.0, NULL);
+    int status = run_and_signal(cwd, scene, out_dir, SIGTERM, 0.5, ".");
     ENSURE(WIFEXITED(status) && WEXITSTATUS(status) == 143);
 }
 
@@ -496,12 +498,42 @@ TEST(interrupt_removes_only_unfinished_temporaries)
     ENSURE(access(tmp_last, F_OK) != 0);
 }
 
+// A run whose output folder holds the scene's own maps under the names it would
+// write: refused with status 2, every input byte for byte unchanged.
+TEST(an_input_is_never_overwritten)
+{
+    const char *dir = ensure_tmpdir();
+    int status = ensure_shell(
+        out, sizeof out,
+        "set -e; mkdir -p %s/inputs; cd %s/inputs; m=$OLDPWD/maps/thesis_box_; "
+        "for c in front top; do for k in depth normal impact dirt; do "
+        "cp $m${c}_$k.exr ${c}_$k.exr; done; done; "
+        "cp ${m}out_depth.exr out_depth.exr; cp ${m}out_normal.exr out_normal.exr; "
+        "sed -e 's|../maps/thesis_box_||g' $OLDPWD/xml_scenes/thesis_box.xml > scene.xml; "
+        "cksum * > ../inputs.sum",
+        dir, dir);
+    ENSURE(status == 0);
+    status = ensure_shell(out, sizeof out, "%s/weathering run %s/inputs/scene.xml --out %s/inputs -q",
+                          ensure_build_dir(), dir, dir);
+    ENSURE(status == 2);
+    ENSURE(ensure_contains(out, "front_dirt.exr: is an input of scene"));
+    ENSURE(ensure_shell(out, sizeof out, "cd %s/inputs && cksum * | cmp - ../inputs.sum", dir) ==
+           0);
+    char inputs[PATH_MAX];
+    snprintf(inputs, sizeof inputs, "%s/inputs", dir);
+    char *names[32];
+    int count = list_names(inputs, "", names, 32);
+    free_names(names, count);
+    ENSURE(count == 11); // nothing added: no temporary, no mask
+}
+
 int main(void)
 {
     RUN(bad_inputs_exit_2_with_their_message);
     RUN(memory_estimate_over_the_limit_is_refused_with_the_numbers);
     RUN(stale_temporaries_of_dead_processes_are_removed);
     RUN(interrupt_removes_only_unfinished_temporaries);
+    RUN(an_input_is_never_overwritten);
     RUN(sigint_stops_a_run_cleanly);
     RUN(sigkill_never_leaves_a_torn_file);
     return ensure_summary();
