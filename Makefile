@@ -42,7 +42,7 @@ VIEWER_BIN := $(if $(VIEWER_SRC),$(BUILD)/weathering-viewer)
 # `weathering bake` in a child process when a scene's maps are still to bake.
 VIEWER_LIBS := -lglfw -lGL -lOpenEXRCore-3_1 -lxml2 -lpng -lm -lpthread
 
-.PHONY: all deps bench-deps test run bench clean sanitize fuzz valgrind
+.PHONY: all deps bench-deps test run bench clean sanitize tsan fuzz valgrind
 all: $(BUILD)/weathering $(VIEWER_BIN)
 
 # Installs whatever Debian package is missing (apt-get update first), as root or
@@ -151,6 +151,21 @@ sanitize: | deps
 	    $(SAN_BUILD)/weathering $(SAN_BUILD)/weathering-viewer \
 	    $(TEST_SRC:tests/%.c=$(SAN_BUILD)/tests/%)
 	$(SAN_ENV) WX_BUILD=$(SAN_BUILD) WX_TESTS=tests tests/run.sh $(SAN_BUILD)/tests
+
+# make tsan: the tests of the threaded phases (simulate's chunk hand-off and
+# ordered dirt exchange, gather's rows) built with ThreadSanitizer in
+# $(TSAN_BUILD). Without function multiversioning: its load-time resolvers run
+# before ThreadSanitizer is set up. The bake is left out: its threads are Mesa's.
+TSAN_BUILD ?= $(BUILD)-tsan
+TSAN_CFLAGS := -O1 -g -fno-omit-frame-pointer -fsanitize=thread -DWX_NO_CLONES
+TSAN_TESTS := test_simulate test_gather
+tsan: | deps
+	$(MAKE) --no-print-directory BUILD=$(TSAN_BUILD) CFLAGS="$(TSAN_CFLAGS)" \
+	    $(TSAN_BUILD)/weathering $(TSAN_TESTS:%=$(TSAN_BUILD)/tests/%)
+	@rm -rf $(TSAN_BUILD)/tsan-tests && mkdir -p $(TSAN_BUILD)/tsan-tests
+	@for t in $(TSAN_TESTS); do ln -s ../tests/$$t $(TSAN_BUILD)/tsan-tests/$$t; done
+	TSAN_OPTIONS=halt_on_error=1:second_deadlock_stack=1 WX_BUILD=$(TSAN_BUILD) \
+	    WX_TESTS=tests tests/run.sh $(TSAN_BUILD)/tsan-tests
 
 # make fuzz: libFuzzer targets (clang) in $(BUILD)/fuzz, seeded with the shipped
 # scenes and maps, each run for FUZZ_SECONDS. The library is rebuilt with clang

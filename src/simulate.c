@@ -4,18 +4,26 @@
 // choices.
 //
 // One step:
-//  1. in parallel, each thread steps a contiguous range of particles, a block
+//  1. in parallel, the threads take chunks of 8192 (by default) consecutive
+//     particles in turn (whoever is free takes the next) and step them, a block
 //     of WX_PARTICLE_BLOCK at a time: forces and the Euler step (vectorised),
 //     the coarse collision test (vectorised), then for the few segments it does
-//     not clear, the swept test and the reaction. Dirt is not touched: each
-//     collision is recorded as an event, each death in a list;
-//  2. serially, in particle order, the events exchange dirt with the maps;
+//     not clear, the swept test and the reaction. Dirt is not touched there:
+//     each collision is recorded as an event of its chunk, each death in the
+//     chunk's list;
+//  2. in chunk order, hence particle order, the events exchange dirt with the
+//     maps. One thread does this (the calling one), while the others step: it
+//     applies each chunk as soon as that chunk and every one before it are
+//     done, so this serial work overlaps the parallel phase and only the last
+//     chunks' events are left when the stepping ends;
 //  3. dead particles are removed, highest index first (swap with the last);
 //  4. emitters emit up to the new time.
 #include "simulate.h"
 
 #include <math.h>
 #include <pthread.h>
+#include <sched.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -30,7 +38,7 @@
 enum {
     DEFAULT_HIT_CAPACITY = 4096,
     PSEUDO_EMITTER = 0xFFFF, ///< emitter index of particles added by wx_sim_spawn
-    CHUNK_ALIGN = 64,        ///< thread ranges start on multiples of this
+    DEFAULT_CHUNK = 8192,    ///< particles a thread takes at a time (a multiple of the block)
 };
 
 // Event flags: the impact kind in the low bits.
@@ -71,15 +79,21 @@ static const uint32_t lane_bit[WX_PARTICLE_BLOCK] = {
     1u << 8, 1u << 9, 1u << 10, 1u << 11, 1u << 12, 1u << 13, 1u << 14, 1u << 15,
 };
 
+// The record of one chunk of particles in one step: written by the thread that
+// stepped it, read by the one that applies it once `done` says it may.
+typedef struct sim_chunk {
+    sim_event *events; ///< in increasing particle order
+    int64_t event_count, event_capacity;
+    int64_t *dead; ///< index << 1 | escaped, in increasing index order
+    int64_t dead_count, dead_capacity;
+    atomic_int done; ///< set (release) when the chunk's records are complete
+} sim_chunk;
+
 typedef struct sim_worker {
     struct wx_sim *sim;
     int index;
     pthread_t thread;
-    int64_t begin, end; ///< particle range of the current step
-    sim_event *events;
-    int64_t event_count, event_capacity;
-    int64_t *dead; ///< index << 1 | escaped, in increasing index order
-    int64_t dead_count, dead_capacity;
+    sim_chunk *chunk; ///< the chunk being stepped
     sim_candidate *cands;
     int64_t cand_count, cand_capacity;
     bool failed; ///< out of memory in this step
@@ -118,6 +132,11 @@ struct wx_sim {
     // Threads.
     int thread_count;
     sim_worker *workers;
+    sim_chunk *chunks;
+    int64_t chunk_particles;             ///< particles per chunk
+    int64_t chunk_count, chunk_capacity; ///< chunks of this step, allocated
+    atomic_int_fast64_t next_chunk;      ///< the next chunk a thread takes
+    int64_t applied;                     ///< chunks whose events are applied
     pthread_mutex_t lock;
     pthread_cond_t start, done;
     uint64_t generation;
@@ -130,17 +149,18 @@ struct wx_sim {
 
 static bool push_event(sim_worker *w, const sim_event *e)
 {
-    if (w->event_count == w->event_capacity) {
-        int64_t capacity = w->event_capacity > 0 ? 2 * w->event_capacity : 1024;
-        sim_event *bigger = realloc(w->events, (size_t)capacity * sizeof *bigger);
+    sim_chunk *ch = w->chunk;
+    if (ch->event_count == ch->event_capacity) {
+        int64_t capacity = ch->event_capacity > 0 ? 2 * ch->event_capacity : 256;
+        sim_event *bigger = realloc(ch->events, (size_t)capacity * sizeof *bigger);
         if (bigger == NULL) {
             w->failed = true;
             return false;
         }
-        w->events = bigger;
-        w->event_capacity = capacity;
+        ch->events = bigger;
+        ch->event_capacity = capacity;
     }
-    w->events[w->event_count++] = *e;
+    ch->events[ch->event_count++] = *e;
     return true;
 }
 
@@ -161,17 +181,18 @@ static void push_candidate(sim_worker *w, const sim_candidate *c)
 
 static void push_dead(sim_worker *w, int64_t index, bool escaped)
 {
-    if (w->dead_count == w->dead_capacity) {
-        int64_t capacity = w->dead_capacity > 0 ? 2 * w->dead_capacity : 1024;
-        int64_t *bigger = realloc(w->dead, (size_t)capacity * sizeof *bigger);
+    sim_chunk *ch = w->chunk;
+    if (ch->dead_count == ch->dead_capacity) {
+        int64_t capacity = ch->dead_capacity > 0 ? 2 * ch->dead_capacity : 256;
+        int64_t *bigger = realloc(ch->dead, (size_t)capacity * sizeof *bigger);
         if (bigger == NULL) {
             w->failed = true;
             return;
         }
-        w->dead = bigger;
-        w->dead_capacity = capacity;
+        ch->dead = bigger;
+        ch->dead_capacity = capacity;
     }
-    w->dead[w->dead_count++] = index << 1 | (escaped ? 1 : 0);
+    ch->dead[ch->dead_count++] = index << 1 | (escaped ? 1 : 0);
 }
 
 // --- the step of one particle range ------------------------------------------
@@ -349,18 +370,18 @@ static void coarse_rest(wx_sim *sim, sim_worker *w)
     }
 }
 
-static void step_range(wx_sim *sim, sim_worker *w)
+// Steps particles [begin, end) into the records of the worker's chunk.
+static void step_range(wx_sim *sim, sim_worker *w, int64_t begin, int64_t end)
 {
     enum { B = WX_PARTICLE_BLOCK };
     wx_particles *P = &sim->particles;
     float t = (float)((double)sim->step * sim->dt);
     float dt = (float)sim->dt;
     int first = sim->input_count > 0 ? 1 : 0;
-    w->event_count = 0;
-    w->dead_count = 0;
+    w->chunk->event_count = 0;
+    w->chunk->dead_count = 0;
     w->cand_count = 0;
-    w->failed = false;
-    for (int64_t b = w->begin; b < w->end; b += B) {
+    for (int64_t b = begin; b < end; b += B) {
         float ox[B], oy[B], oz[B], nx[B], ny[B], nz[B], nvx[B], nvy[B], nvz[B];
         int inside[B];
         memcpy(ox, P->x + b, sizeof ox);
@@ -385,7 +406,7 @@ static void step_range(wx_sim *sim, sim_worker *w)
         for (int k = 0; k < B; ++k) {
             outbox |= -(uint32_t)!inside[k] & lane_bit[k];
         }
-        int lanes = w->end - b < B ? (int)(w->end - b) : B;
+        int lanes = end - b < B ? (int)(end - b) : B;
         uint32_t valid = (1u << lanes) - 1u;
         uint32_t special = (~clear | outbox) & valid;
         // A step without a hit ends a streak: reset every lane that cannot hit
@@ -431,62 +452,7 @@ static void step_range(wx_sim *sim, sim_worker *w)
     }
 }
 
-// --- the thread pool -----------------------------------------------------------
-
-static void *worker_main(void *arg)
-{
-    sim_worker *w = arg;
-    wx_sim *sim = w->sim;
-    uint64_t seen = 0;
-    pthread_mutex_lock(&sim->lock);
-    for (;;) {
-        while (sim->generation == seen && !sim->quit) {
-            pthread_cond_wait(&sim->start, &sim->lock);
-        }
-        if (sim->quit) {
-            break;
-        }
-        seen = sim->generation;
-        pthread_mutex_unlock(&sim->lock);
-        step_range(sim, w);
-        pthread_mutex_lock(&sim->lock);
-        if (--sim->pending == 0) {
-            pthread_cond_signal(&sim->done);
-        }
-    }
-    pthread_mutex_unlock(&sim->lock);
-    return NULL;
-}
-
-static void run_workers(wx_sim *sim)
-{
-    int64_t n = sim->particles.count;
-    int T = sim->thread_count;
-    int64_t chunk = (n + T - 1) / T;
-    chunk = (chunk + CHUNK_ALIGN - 1) / CHUNK_ALIGN * CHUNK_ALIGN;
-    for (int t = 0; t < T; ++t) {
-        int64_t begin = (int64_t)t * chunk;
-        sim->workers[t].begin = begin < n ? begin : n;
-        sim->workers[t].end = begin + chunk < n ? begin + chunk : n;
-    }
-    if (T == 1) {
-        step_range(sim, &sim->workers[0]);
-        return;
-    }
-    pthread_mutex_lock(&sim->lock);
-    sim->pending = T - 1;
-    sim->generation++;
-    pthread_cond_broadcast(&sim->start);
-    pthread_mutex_unlock(&sim->lock);
-    step_range(sim, &sim->workers[0]);
-    pthread_mutex_lock(&sim->lock);
-    while (sim->pending > 0) {
-        pthread_cond_wait(&sim->done, &sim->lock);
-    }
-    pthread_mutex_unlock(&sim->lock);
-}
-
-// --- the serial phases -----------------------------------------------------------
+// --- the dirt exchange -------------------------------------------------------------
 
 static void record_hit(wx_sim *sim, const sim_event *e)
 {
@@ -503,39 +469,163 @@ static void record_hit(wx_sim *sim, const sim_event *e)
     }
 }
 
-// Dirt exchange (thesis 4.8.4.3 as pinned in DESIGN section 4), in particle order.
-static void apply_events(wx_sim *sim)
+// Dirt exchange (thesis 4.8.4.3 as pinned in DESIGN section 4) of one chunk's
+// events, in particle order.
+static void apply_chunk(wx_sim *sim, const sim_chunk *ch)
 {
     double *load = sim->particles.load;
-    for (int t = 0; t < sim->thread_count; ++t) {
-        const sim_worker *w = &sim->workers[t];
-        for (int64_t k = 0; k < w->event_count; ++k) {
-            if (k + 8 < w->event_count) {
-                const sim_event *ahead = &w->events[k + 8];
-                __builtin_prefetch(&sim->dirt[ahead->camera].texels[ahead->texel]);
-                __builtin_prefetch(&load[ahead->index]);
-            }
-            const sim_event *e = &w->events[k];
-            wx_dirt_map *map = &sim->dirt[e->camera];
-            double *p = &load[e->index];
-            if (e->flags & EVENT_LINE) {
-                wx_dirt_map_exchange_line(map, e->from, e->texel, p);
+    for (int64_t k = 0; k < ch->event_count; ++k) {
+        if (k + 8 < ch->event_count) {
+            const sim_event *ahead = &ch->events[k + 8];
+            __builtin_prefetch(&sim->dirt[ahead->camera].texels[ahead->texel]);
+            __builtin_prefetch(&load[ahead->index]);
+        }
+        const sim_event *e = &ch->events[k];
+        wx_dirt_map *map = &sim->dirt[e->camera];
+        double *p = &load[e->index];
+        if (e->flags & EVENT_LINE) {
+            wx_dirt_map_exchange_line(map, e->from, e->texel, p);
+        } else {
+            wx_dirt_map_exchange(map, e->texel, p);
+        }
+        if (e->flags & EVENT_DIES) {
+            wx_dirt_map_deposit_all(map, e->texel, p);
+            if ((e->flags & EVENT_KIND_MASK) == WX_IMPACT_ABSORB) {
+                sim->stats.absorbed++;
             } else {
-                wx_dirt_map_exchange(map, e->texel, p);
+                sim->stats.settled++;
             }
-            if (e->flags & EVENT_DIES) {
-                wx_dirt_map_deposit_all(map, e->texel, p);
-                if ((e->flags & EVENT_KIND_MASK) == WX_IMPACT_ABSORB) {
-                    sim->stats.absorbed++;
-                } else {
-                    sim->stats.settled++;
-                }
+        }
+        sim->stats.collisions++;
+        record_hit(sim, e);
+    }
+}
+
+// Applies the chunks that are done, in order, up to the first that is not (or,
+// with `wait`, up to the last, waiting for each). Only the calling thread of
+// wx_sim_step runs this, so the maps, the loads and the statistics have one
+// writer, and the order is the particles' whatever thread stepped them.
+static void apply_ready(wx_sim *sim, bool wait)
+{
+    while (sim->applied < sim->chunk_count) {
+        const sim_chunk *ch = &sim->chunks[sim->applied];
+        if (!atomic_load_explicit(&ch->done, memory_order_acquire)) {
+            if (!wait) {
+                return;
             }
-            sim->stats.collisions++;
-            record_hit(sim, e);
+            sched_yield(); // another thread is finishing this chunk
+            continue;
+        }
+        apply_chunk(sim, ch);
+        sim->applied++;
+    }
+}
+
+// --- the thread pool -----------------------------------------------------------
+
+// Steps chunks until none is left; the calling thread (`apply`) also applies
+// what is ready after each of its chunks.
+static void take_chunks(wx_sim *sim, sim_worker *w, bool apply)
+{
+    int64_t n = sim->particles.count;
+    for (;;) {
+        int64_t c = atomic_fetch_add_explicit(&sim->next_chunk, 1, memory_order_relaxed);
+        if (c >= sim->chunk_count) {
+            return;
+        }
+        int64_t begin = c * sim->chunk_particles;
+        int64_t end = n - begin < sim->chunk_particles ? n : begin + sim->chunk_particles;
+        w->chunk = &sim->chunks[c];
+        step_range(sim, w, begin, end);
+        atomic_store_explicit(&sim->chunks[c].done, 1, memory_order_release);
+        if (apply) {
+            apply_ready(sim, false);
         }
     }
 }
+
+static void *worker_main(void *arg)
+{
+    sim_worker *w = arg;
+    wx_sim *sim = w->sim;
+    uint64_t seen = 0;
+    pthread_mutex_lock(&sim->lock);
+    for (;;) {
+        while (sim->generation == seen && !sim->quit) {
+            pthread_cond_wait(&sim->start, &sim->lock);
+        }
+        if (sim->quit) {
+            break;
+        }
+        seen = sim->generation;
+        pthread_mutex_unlock(&sim->lock);
+        take_chunks(sim, w, false);
+        pthread_mutex_lock(&sim->lock);
+        if (--sim->pending == 0) {
+            pthread_cond_signal(&sim->done);
+        }
+    }
+    pthread_mutex_unlock(&sim->lock);
+    return NULL;
+}
+
+// One chunk record per chunk_particles particles, reset for a new step. Records
+// keep their buffers from step to step: after the first steps nothing is
+// allocated.
+static wx_result prepare_chunks(wx_sim *sim, wx_error *err)
+{
+    int64_t count = (sim->particles.count + sim->chunk_particles - 1) / sim->chunk_particles;
+    if (count > sim->chunk_capacity) {
+        int64_t capacity = count + count / 2;
+        sim_chunk *bigger = realloc(sim->chunks, (size_t)capacity * sizeof *bigger);
+        if (bigger == NULL) {
+            return wx_error_set(err, WX_FAIL, "out of memory (collision events)");
+        }
+        memset(bigger + sim->chunk_capacity, 0,
+               (size_t)(capacity - sim->chunk_capacity) * sizeof *bigger);
+        for (int64_t c = sim->chunk_capacity; c < capacity; ++c) {
+            atomic_init(&bigger[c].done, 0);
+        }
+        sim->chunks = bigger;
+        sim->chunk_capacity = capacity;
+    }
+    for (int64_t c = 0; c < count; ++c) {
+        sim->chunks[c].event_count = 0;
+        sim->chunks[c].dead_count = 0;
+        atomic_store_explicit(&sim->chunks[c].done, 0, memory_order_relaxed);
+    }
+    sim->chunk_count = count;
+    sim->applied = 0;
+    atomic_store_explicit(&sim->next_chunk, 0, memory_order_relaxed);
+    for (int t = 0; t < sim->thread_count; ++t) {
+        sim->workers[t].failed = false;
+    }
+    return WX_OK;
+}
+
+// Steps every particle and applies every event (phases 1 and 2).
+static void run_workers(wx_sim *sim)
+{
+    int T = sim->thread_count;
+    if (T > 1) {
+        pthread_mutex_lock(&sim->lock);
+        sim->pending = T - 1;
+        sim->generation++;
+        pthread_cond_broadcast(&sim->start);
+        pthread_mutex_unlock(&sim->lock);
+    }
+    take_chunks(sim, &sim->workers[0], true);
+    apply_ready(sim, true);
+    if (T > 1) {
+        pthread_mutex_lock(&sim->lock);
+        while (sim->pending > 0) {
+            pthread_cond_wait(&sim->done, &sim->lock);
+        }
+        pthread_mutex_unlock(&sim->lock);
+    }
+}
+
+// --- the serial phases -----------------------------------------------------------
 
 // The coarse test tries first the camera that cleared most segments in the last
 // step (it stops once a block is cleared). Only speed depends on this order.
@@ -559,20 +649,20 @@ static void reorder_cameras(wx_sim *sim)
 
 static void remove_dead(wx_sim *sim)
 {
-    for (int t = 0; t < sim->thread_count; ++t) {
-        const sim_worker *w = &sim->workers[t];
-        for (int64_t k = 0; k < w->dead_count; ++k) {
-            if (w->dead[k] & 1) {
+    for (int64_t c = 0; c < sim->chunk_count; ++c) {
+        const sim_chunk *ch = &sim->chunks[c];
+        for (int64_t k = 0; k < ch->dead_count; ++k) {
+            if (ch->dead[k] & 1) {
                 sim->stats.escaped++;
-                sim->stats.dirt_escaped += sim->particles.load[w->dead[k] >> 1];
+                sim->stats.dirt_escaped += sim->particles.load[ch->dead[k] >> 1];
             }
         }
     }
     // Highest index first, so the particle moved into a hole is always alive.
-    for (int t = sim->thread_count - 1; t >= 0; --t) {
-        const sim_worker *w = &sim->workers[t];
-        for (int64_t k = w->dead_count - 1; k >= 0; --k) {
-            wx_particles_remove(&sim->particles, w->dead[k] >> 1);
+    for (int64_t c = sim->chunk_count - 1; c >= 0; --c) {
+        const sim_chunk *ch = &sim->chunks[c];
+        for (int64_t k = ch->dead_count - 1; k >= 0; --k) {
+            wx_particles_remove(&sim->particles, ch->dead[k] >> 1);
         }
     }
 }
@@ -617,6 +707,10 @@ wx_result wx_sim_step(wx_sim *sim, wx_error *err)
 {
     int64_t n = sim->particles.count;
     if (n > 0) {
+        wx_result r = prepare_chunks(sim, err);
+        if (r != WX_OK) {
+            return r;
+        }
         run_workers(sim);
         for (int t = 0; t < sim->thread_count; ++t) {
             if (sim->workers[t].failed) {
@@ -624,7 +718,6 @@ wx_result wx_sim_step(wx_sim *sim, wx_error *err)
             }
         }
         sim->stats.particle_steps += n;
-        apply_events(sim);
         remove_dead(sim);
         reorder_cameras(sim);
     }
@@ -717,6 +810,8 @@ wx_result wx_sim_create(const wx_scene *scene, const wx_sim_config *config, wx_s
     sim->emitters = scene->emitters;
     sim->thread_count = config->threads > 0 ? config->threads : wx_cpu_count();
     sim->hit_capacity = config->hit_capacity > 0 ? config->hit_capacity : DEFAULT_HIT_CAPACITY;
+    int64_t chunk = config->chunk_particles > 0 ? config->chunk_particles : DEFAULT_CHUNK;
+    sim->chunk_particles = (chunk + WX_PARTICLE_BLOCK - 1) / WX_PARTICLE_BLOCK * WX_PARTICLE_BLOCK;
 
     wx_result r = WX_OK;
     if (!(sim->dt > 0.0) || !isfinite(sim->dt)) {
@@ -821,12 +916,15 @@ void wx_sim_destroy(wx_sim *sim)
     }
     if (sim->workers != NULL) {
         for (int t = 0; t < sim->thread_count; ++t) {
-            free(sim->workers[t].events);
-            free(sim->workers[t].dead);
             free(sim->workers[t].cands);
         }
         free(sim->workers);
     }
+    for (int64_t c = 0; c < sim->chunk_capacity; ++c) {
+        free(sim->chunks[c].events);
+        free(sim->chunks[c].dead);
+    }
+    free(sim->chunks);
     if (sim->dirt != NULL) {
         for (int c = 0; c < sim->input_count; ++c) {
             wx_dirt_map_free(&sim->dirt[c]);

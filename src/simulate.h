@@ -29,6 +29,9 @@ typedef struct wx_sim_config {
     int threads;         ///< worker threads, 0 = one per core (default)
     int hit_capacity;    ///< recent hit points kept for the viewer, 0 = 4096 (default)
     bool nearest_depth;  ///< nearest-texel depth (the thesis) instead of bilinear
+    /// Particles a thread steps at a time, rounded up to a multiple of
+    /// WX_PARTICLE_BLOCK; 0 = 8192 (default). Results do not depend on it.
+    int chunk_particles;
     /// One wx_maps per input camera, in scene order (borrowed: must outlive the
     /// simulation; depth, normal and impact needed, dirt planes optional), or
     /// NULL (default) to load the maps named in the scene.

@@ -20,10 +20,11 @@ static wx_camera top_camera(float size, int px)
     return fx_camera(0, 10, 0, 0, 0, 0, 0, 0, -1, size, px); // u along x, v along -z
 }
 
-static wx_sim *start(fx_scene *f, int threads)
+static wx_sim *start_chunked(fx_scene *f, int threads, int chunk_particles)
 {
     wx_sim_config cfg = wx_sim_default_config(&f->scene);
     cfg.threads = threads;
+    cfg.chunk_particles = chunk_particles;
     cfg.maps = f->maps;
     wx_sim *sim = NULL;
     wx_error err;
@@ -32,6 +33,11 @@ static wx_sim *start(fx_scene *f, int threads)
         return NULL;
     }
     return sim;
+}
+
+static wx_sim *start(fx_scene *f, int threads)
+{
+    return start_chunked(f, threads, 0);
 }
 
 static bool run(wx_sim *sim, int steps)
@@ -396,17 +402,19 @@ static uint64_t fnv1a(const unsigned char *data, size_t size, uint64_t h)
 }
 
 // Hash of the written dirt maps (file bytes) and of the particle state.
-static bool run_and_hash(int threads, uint64_t *files, uint64_t *state, wx_sim_stats *st)
+static bool run_and_hash(int threads, int chunk_particles, uint64_t *files, uint64_t *state,
+                         wx_sim_stats *st)
 {
     fx_scene f;
     busy_scene(&f);
-    wx_sim *sim = start(&f, threads);
+    wx_sim *sim = start_chunked(&f, threads, chunk_particles);
     if (sim == NULL || !run(sim, 100)) {
         return false;
     }
     wx_run_options opts;
     memset(&opts, 0, sizeof opts);
-    snprintf(opts.out_dir, sizeof opts.out_dir, "%s/t%d", ensure_tmpdir(), threads);
+    snprintf(opts.out_dir, sizeof opts.out_dir, "%s/t%d_c%d", ensure_tmpdir(), threads,
+             chunk_particles);
     wx_error err;
     bool ok = wx_output_prepare(&opts, &err) == WX_OK &&
               wx_sim_write_dirt_maps(sim, &opts, &err) == WX_OK;
@@ -439,18 +447,24 @@ static bool run_and_hash(int threads, uint64_t *files, uint64_t *state, wx_sim_s
     return ok;
 }
 
+// Threads take chunks of particles in turn, and one of them applies the chunks'
+// dirt in particle order while the others step: with the default chunks (8192
+// particles: 3 of them here) and with chunks of 64 (300 of them, handed between
+// threads all the time), the bytes are those of one thread.
 TEST(same_output_bytes_for_1_2_and_4_threads)
 {
-    uint64_t files[3], state[3];
-    wx_sim_stats st[3];
-    int threads[3] = { 1, 2, 4 };
-    for (int k = 0; k < 3; ++k) {
-        ENSURE(run_and_hash(threads[k], &files[k], &state[k], &st[k]));
+    enum { RUNS = 6 };
+    uint64_t files[RUNS], state[RUNS];
+    wx_sim_stats st[RUNS];
+    const int threads[RUNS] = { 1, 2, 4, 1, 2, 4 };
+    const int chunks[RUNS] = { 0, 0, 0, 64, 64, 64 };
+    for (int k = 0; k < RUNS; ++k) {
+        ENSURE(run_and_hash(threads[k], chunks[k], &files[k], &state[k], &st[k]));
     }
     printf("        dirt maps hash %016llx, particles hash %016llx, %lld alive\n",
            (unsigned long long)files[0], (unsigned long long)state[0], (long long)st[0].alive);
-    ENSURE(st[0].alive > 1000); // several thread ranges of 64 particles
-    for (int k = 1; k < 3; ++k) {
+    ENSURE(st[0].alive > 2 * 8192); // at least three default chunks
+    for (int k = 1; k < RUNS; ++k) {
         ENSURE(files[k] == files[0]);
         ENSURE(state[k] == state[0]);
         ENSURE(memcmp(&st[k], &st[0], sizeof st[0]) == 0);
