@@ -10,7 +10,9 @@
 // octaves). Drops that land bounce, slide or are absorbed as the impact map
 // says. Each configuration starts from the same drops and runs 40 steps after a
 // warm-up of 3; the rate is particle-steps per wall-clock second, the median of
-// three runs (the machine is shared: single runs move by tens of percent). Then
+// three runs (the machine is shared: single runs move by tens of percent). The
+// target configurations run five times on 1 and 2 threads alternately, and the
+// speed-up is the median of the five back-to-back ratios. Then
 // how the rate and the memory grow with the particle count and the map size. A
 // plain two-thread arithmetic loop is timed too, to show how much of a second
 // core the machine gave during the run.
@@ -227,30 +229,68 @@ typedef struct config {
     long particles;
 } config;
 
-// Median of three runs of one configuration; prints its line and its CSV rows.
+enum { REPS = 3, PAIRED_REPS = 5 };
+
+static void print_result(const config *c, const result *r)
+{
+    printf("%8ld %5d %5d %-6s %8d %11.1f %14.1f %10.2f%% %9.0f\n", c->particles, c->cameras,
+           c->px, c->turbulence ? "3 oct" : "none", c->threads, r->rate / 1e6,
+           r->cpu_rate / 1e6, 100.0 * r->collide_frac, r->rss_mb);
+    fflush(stdout);
+}
+
+// The medians of `reps` runs of one configuration, kept in `runs`.
+static void summarise(const result *runs, int reps, result *out)
+{
+    double rate[PAIRED_REPS], cpu[PAIRED_REPS], frac[PAIRED_REPS], rss[PAIRED_REPS];
+    for (int rep = 0; rep < reps; ++rep) {
+        rate[rep] = runs[rep].rate;
+        cpu[rep] = runs[rep].cpu_rate;
+        frac[rep] = runs[rep].collide_frac;
+        rss[rep] = runs[rep].rss_mb;
+    }
+    *out = runs[reps - 1];
+    out->rate = bench_median(rate, reps);
+    out->cpu_rate = bench_median(cpu, reps);
+    out->collide_frac = bench_median(frac, reps);
+    out->rss_mb = bench_median(rss, reps);
+}
+
+// Median of three runs of one configuration; prints its line.
 static bool measure(bench_scene *b, const config *c, long steps, result *out)
 {
-    double rate[3], cpu[3], frac[3], rss[3];
-    result r = { 0 };
-    for (int rep = 0; rep < 3; ++rep) {
-        if (!run_config(b, c->threads, c->particles, steps, &r)) {
+    result runs[REPS];
+    for (int rep = 0; rep < REPS; ++rep) {
+        if (!run_config(b, c->threads, c->particles, steps, &runs[rep])) {
             return false;
         }
-        rate[rep] = r.rate;
-        cpu[rep] = r.cpu_rate;
-        frac[rep] = r.collide_frac;
-        rss[rep] = r.rss_mb;
     }
-    out->rate = bench_median(rate, 3);
-    out->cpu_rate = bench_median(cpu, 3);
-    out->collide_frac = bench_median(frac, 3);
-    out->rss_mb = bench_median(rss, 3);
-    out->alive = r.alive;
-    out->particle_bytes = r.particle_bytes;
-    printf("%8ld %5d %5d %-6s %8d %11.1f %14.1f %10.2f%% %9.0f\n", c->particles, c->cameras,
-           c->px, c->turbulence ? "3 oct" : "none", c->threads, out->rate / 1e6,
-           out->cpu_rate / 1e6, 100.0 * out->collide_frac, out->rss_mb);
-    fflush(stdout);
+    summarise(runs, REPS, out);
+    print_result(c, out);
+    return true;
+}
+
+// One configuration on 1 and on 2 threads, the two runs back to back, five
+// times: the speed-up is the median of the five pairs' ratios, so a change in
+// the machine's load between the 1-thread and the 2-thread runs (seconds apart
+// on this shared machine) moves one pair, not the figure.
+static bool measure_pair(bench_scene *b, const config *one, const config *two, long steps,
+                         result *out_one, result *out_two, double *speedup)
+{
+    result runs[2][PAIRED_REPS];
+    double ratio[PAIRED_REPS];
+    for (int rep = 0; rep < PAIRED_REPS; ++rep) {
+        if (!run_config(b, one->threads, one->particles, steps, &runs[0][rep]) ||
+            !run_config(b, two->threads, two->particles, steps, &runs[1][rep])) {
+            return false;
+        }
+        ratio[rep] = runs[1][rep].rate / runs[0][rep].rate;
+    }
+    summarise(runs[0], PAIRED_REPS, out_one);
+    summarise(runs[1], PAIRED_REPS, out_two);
+    *speedup = bench_median(ratio, PAIRED_REPS);
+    print_result(one, out_one);
+    print_result(two, out_two);
     return true;
 }
 
@@ -260,7 +300,7 @@ int main(void)
     long steps = bench_env_long("WX_BENCH_STEPS", 40);
     bool quick = bench_env_long("WX_BENCH_QUICK", 0) == 1;
     printf("simulate: %ld steps after 3 of warm-up, building on a slab, rain (gravity + wind), "
-           "median of 3 runs\n",
+           "median of 3 runs (of 5 for the target rows, 1 and 2 threads alternating)\n",
            steps);
     printf("%8s %5s %5s %-6s %8s %11s %14s %11s %9s\n", "particles", "cams", "px", "turb",
            "threads", "M steps/s", "M steps/cpu-s", "collisions", "RSS (MB)");
@@ -282,6 +322,7 @@ int main(void)
     result results[sizeof configs / sizeof configs[0]];
     bench_scene b;
     memset(&b, 0, sizeof b);
+    double speedup[2] = { 0.0, 0.0 }; // without, with turbulence
     for (int i = 0; i < count; ++i) {
         const config *c = &configs[i];
         if (i == 0 || c->cameras != configs[i - 1].cameras || c->px != configs[i - 1].px ||
@@ -291,17 +332,29 @@ int main(void)
             }
             scene_setup(&b, c->cameras, c->px, c->turbulence);
         }
-        if (!measure(&b, c, steps, &results[i])) {
+        // Rows 0-3 are the target pairs (1 then 2 threads), measured together.
+        bool ok = i >= 4 ? measure(&b, c, steps, &results[i])
+                  : i % 2 == 0
+                      ? measure_pair(&b, c, &configs[i + 1], steps, &results[i],
+                                     &results[i + 1], &speedup[i / 2])
+                      : true;
+        if (!ok) {
             scene_free(&b);
             return 1;
         }
-        bool target_row = i == 1 || i == 3;
-        double target = i == 1 ? 50e6 : 20e6;
-        bench_row("simulate", "M steps/s", results[i].rate / 1e6, "M/s",
-                  target_row ? (i == 1 ? ">= 50" : ">= 20") : NULL,
-                  results[i].rate >= target, "%ldk particles %d cams %d px %s %d thr",
-                  c->particles / 1000, c->cameras, c->px,
-                  c->turbulence ? "turb 3 oct" : "no turb", c->threads);
+        if (i < 4 && i % 2 == 0) {
+            continue; // its row is written with its pair's
+        }
+        for (int row = i < 4 ? i - 1 : i; row <= i; ++row) {
+            const config *rc = &configs[row];
+            bool target_row = row == 1 || row == 3;
+            double target = row == 1 ? 50e6 : 20e6;
+            bench_row("simulate", "M steps/s", results[row].rate / 1e6, "M/s",
+                      target_row ? (row == 1 ? ">= 50" : ">= 20") : NULL,
+                      results[row].rate >= target, "%ldk particles %d cams %d px %s %d thr",
+                      rc->particles / 1000, rc->cameras, rc->px,
+                      rc->turbulence ? "turb 3 oct" : "no turb", rc->threads);
+        }
         if (i >= 4) {
             bench_row("simulate", "RSS (MB)", results[i].rss_mb, "MB", NULL, false,
                       "%ldk particles %d cams %d px no turb", c->particles / 1000, c->cameras,
@@ -309,11 +362,11 @@ int main(void)
         }
     }
     scene_free(&b);
-    double up_plain = results[1].rate / results[0].rate;
-    double up_turb = results[3].rate / results[2].rate;
+    double up_plain = speedup[0];
+    double up_turb = speedup[1];
     double machine = parallel_capacity(spin);
     double machine_vector = parallel_capacity(spin_vector);
-    printf("2-thread speed-up: %.2fx without turbulence, %.2fx with\n", up_plain, up_turb);
+    printf("2-thread speed-up (median of 5 paired runs): %.2fx without turbulence, %.2fx with\n", up_plain, up_turb);
     int bytes = results[1].particle_bytes;
     printf("bytes per live particle: %d (structure of arrays, all drops of one mass; %d with "
            "particles of several masses; capacity grows by half, so allocated slots stay "
