@@ -370,7 +370,7 @@ TEST(sigint_stops_a_run_cleanly)
     // the bake wrote its last map (simulating).
     const double moments[] = { 0.1, 1.0, 1.0 };
     for (int k = 0; k < 3; ++k) {
-        char out_dir[PATH_MAX + 32];
+        char out_dir[sizeof scene_dir + 32];
         snprintf(out_dir, sizeof out_dir, "%s/out/int%d", scene_dir, k);
         int status = run_and_signal(cwd, scene, out_dir, SIGINT, moments[k],
                                     k == 2 ? "out_normal.exr" : ".");
