@@ -3,6 +3,8 @@
 #   make test     build and run the test suite
 #   make run      run the shipped default scene into out/building/
 #   make bench    benchmarks (speed and memory targets)
+#   make sanitize, make tsan, make valgrind, make fuzz
+#                 the reliability checks CI runs (docs/reliability.md)
 # BUILD=dir puts every build product in another folder.
 
 BUILD ?= build
