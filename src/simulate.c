@@ -370,7 +370,8 @@ static void coarse_rest(wx_sim *sim, sim_worker *w)
     }
 }
 
-// Steps particles [begin, end) into the records of the worker's chunk.
+// Steps particles [begin, end) into the records of the worker's chunk (emptied
+// by prepare_chunks).
 static void step_range(wx_sim *sim, sim_worker *w, int64_t begin, int64_t end)
 {
     enum { B = WX_PARTICLE_BLOCK };
@@ -378,8 +379,6 @@ static void step_range(wx_sim *sim, sim_worker *w, int64_t begin, int64_t end)
     float t = (float)((double)sim->step * sim->dt);
     float dt = (float)sim->dt;
     int first = sim->input_count > 0 ? 1 : 0;
-    w->chunk->event_count = 0;
-    w->chunk->dead_count = 0;
     w->cand_count = 0;
     for (int64_t b = begin; b < end; b += B) {
         float ox[B], oy[B], oz[B], nx[B], ny[B], nz[B], nvx[B], nvy[B], nvz[B];

@@ -324,6 +324,11 @@ int main(void)
     memset(&b, 0, sizeof b);
     double speedup[2] = { 0.0, 0.0 }; // without, with turbulence
     for (int i = 0; i < count; ++i) {
+        // Rows 0-3 are the target pairs (1 then 2 threads), measured together.
+        bool pair = i < 4;
+        if (pair && i % 2 == 1) {
+            continue; // measured with row i - 1
+        }
         const config *c = &configs[i];
         if (i == 0 || c->cameras != configs[i - 1].cameras || c->px != configs[i - 1].px ||
             c->turbulence != configs[i - 1].turbulence) {
@@ -332,20 +337,14 @@ int main(void)
             }
             scene_setup(&b, c->cameras, c->px, c->turbulence);
         }
-        // Rows 0-3 are the target pairs (1 then 2 threads), measured together.
-        bool ok = i >= 4 ? measure(&b, c, steps, &results[i])
-                  : i % 2 == 0
-                      ? measure_pair(&b, c, &configs[i + 1], steps, &results[i],
-                                     &results[i + 1], &speedup[i / 2])
-                      : true;
+        bool ok = pair ? measure_pair(&b, c, &configs[i + 1], steps, &results[i],
+                                      &results[i + 1], &speedup[i / 2])
+                       : measure(&b, c, steps, &results[i]);
         if (!ok) {
             scene_free(&b);
             return 1;
         }
-        if (i < 4 && i % 2 == 0) {
-            continue; // its row is written with its pair's
-        }
-        for (int row = i < 4 ? i - 1 : i; row <= i; ++row) {
+        for (int row = i; row <= (pair ? i + 1 : i); ++row) {
             const config *rc = &configs[row];
             bool target_row = row == 1 || row == 3;
             double target = row == 1 ? 50e6 : 20e6;
@@ -355,7 +354,7 @@ int main(void)
                       rc->particles / 1000, rc->cameras, rc->px,
                       rc->turbulence ? "turb 3 oct" : "no turb", rc->threads);
         }
-        if (i >= 4) {
+        if (!pair) {
             bench_row("simulate", "RSS (MB)", results[i].rss_mb, "MB", NULL, false,
                       "%ldk particles %d cams %d px no turb", c->particles / 1000, c->cameras,
                       c->px);
@@ -366,7 +365,9 @@ int main(void)
     double up_turb = speedup[1];
     double machine = parallel_capacity(spin);
     double machine_vector = parallel_capacity(spin_vector);
-    printf("2-thread speed-up (median of 5 paired runs): %.2fx without turbulence, %.2fx with\n", up_plain, up_turb);
+    printf("2-thread speed-up (median of 5 paired runs): %.2fx without turbulence, %.2fx "
+           "with\n",
+           up_plain, up_turb);
     int bytes = results[1].particle_bytes;
     printf("bytes per live particle: %d (structure of arrays, all drops of one mass; %d with "
            "particles of several masses; capacity grows by half, so allocated slots stay "
