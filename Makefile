@@ -213,4 +213,9 @@ valgrind: $(BUILD)/weathering | deps
 .PHONY: FORCE
 FORCE:
 
+# Object files of the tests and benchmarks are intermediates of their programs:
+# keep them, so that a second `make test` relinks nothing it need not and the
+# test count stays the last line of its output (make would delete them after).
+.SECONDARY:
+
 -include $(wildcard $(BUILD)/obj/*.d $(BUILD)/obj/tests/*.d $(BUILD)/obj/bench/*.d $(BUILD)/obj/viewer/*.d)
