@@ -118,20 +118,7 @@ static const char *mesh_name(const wx_scene *scene, const wx_mesh *mesh)
     return mesh->path;
 }
 
-static void warn(const baker *b, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
-
-static void warn(const baker *b, const char *fmt, ...)
-{
-    if (b->opts->quiet) {
-        return;
-    }
-    va_list args;
-    va_start(args, fmt);
-    fprintf(stderr, "warning: ");
-    vfprintf(stderr, fmt, args);
-    fputc('\n', stderr);
-    va_end(args);
-}
+#define warn(b, ...) wx_warn((b)->opts->quiet, __VA_ARGS__)
 
 static wx_result gl_check(const char *what, wx_error *err)
 {
@@ -1137,7 +1124,7 @@ wx_result wx_bake_scene_stats(wx_scene *scene, const wx_run_options *opts,
         r = check_sizes(b, err);
     }
     if (r == WX_OK) {
-        r = wx_output_prepare(opts, err);
+        r = wx_output_prepare(scene, opts, NULL, err);
     }
     stats->setup_s += wx_now_s() - t0;
     if (r == WX_OK) {

@@ -57,18 +57,10 @@ static void mat_mul(const double a[16], const double b[16], double out[16])
 // must be (0, 0, 0, w) with w != 0. Returns false for a perspective matrix.
 static bool to_affine(const float m[16], double out[16])
 {
-    double scale = 0.0;
-    for (int k = 0; k < 16; ++k) {
-        if (!isfinite(m[k])) {
-            return false;
-        }
-        scale = fmax(scale, fabs((double)m[k]));
-    }
-    double w = m[15];
-    double skew = fabs((double)m[3]) + fabs((double)m[7]) + fabs((double)m[11]);
-    if (!(fabs(w) > 1e-12 * scale) || skew > 1e-6 * scale) {
+    if (!wx_matrix_is_orthographic(m)) {
         return false;
     }
+    double w = m[15];
     for (int k = 0; k < 16; ++k) {
         out[k] = (double)m[k] / w;
     }
@@ -813,12 +805,9 @@ static wx_result load_input(const wx_scene *scene, const wx_run_options *opts,
                                 scene->path, cam->name, simulated, scene->path, opts->out_dir);
         }
         dirt_path = cam->dirt_path;
-        if (!opts->quiet) {
-            fprintf(stderr,
-                    "weathering: note: gather: no simulated dirt map %s; camera '%s' uses its "
-                    "scene dirt map %s\n",
-                    simulated, cam->name, dirt_path);
-        }
+        wx_note(opts->quiet,
+                "gather: no simulated dirt map %s; camera '%s' uses its scene dirt map %s",
+                simulated, cam->name, dirt_path);
     }
     wx_result result = wx_maps_load(maps, WX_MAPS_DEPTH | WX_MAPS_NORMAL | WX_MAPS_DIRT,
                                     cam->depth_path, cam->normal_path, NULL, dirt_path, err);
