@@ -75,8 +75,9 @@ void wx_temp_remove_all(void)
     }
 }
 
-// True when `name` is ".<something>.tmp<digits>"; stores the digits as a pid.
-static int temp_name_pid(const char *name, long *pid)
+// True when `name` is ".<something>.tmp<digits>"; stores the digits as a pid and
+// <something> in `base`.
+static int temp_name_pid(const char *name, long *pid, char base[WX_PATH_MAX])
 {
     if (name[0] != '.') {
         return 0;
@@ -95,10 +96,12 @@ static int temp_name_pid(const char *name, long *pid)
         return 0;
     }
     *pid = value;
+    snprintf(base, WX_PATH_MAX, "%.*s", (int)(tag - name - 1), name + 1);
     return 1;
 }
 
-int wx_temp_remove_stale(const char *folder)
+int wx_temp_remove_stale(const char *folder, bool (*is_ours)(const char *name, void *context),
+                         void *context)
 {
     DIR *dir = opendir(folder);
     if (dir == NULL) {
@@ -108,7 +111,8 @@ int wx_temp_remove_stale(const char *folder)
     struct dirent *entry;
     while ((entry = readdir(dir)) != NULL) {
         long pid = 0;
-        if (!temp_name_pid(entry->d_name, &pid)) {
+        char base[WX_PATH_MAX];
+        if (!temp_name_pid(entry->d_name, &pid, base) || !is_ours(base, context)) {
             continue;
         }
         // kill(pid, 0) fails with ESRCH when no such process runs; our own pid

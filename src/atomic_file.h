@@ -10,6 +10,7 @@
 #ifndef WX_ATOMIC_FILE_H
 #define WX_ATOMIC_FILE_H
 
+#include <stdbool.h>
 #include <stddef.h>
 
 #include "error.h"
@@ -27,8 +28,11 @@ void wx_temp_forget(const char *tmp);
 void wx_temp_remove_all(void);
 
 /// Removes the temporary files ".<name>.tmp<pid>" in `folder` whose process no
-/// longer runs (left by a run that was killed). Returns how many were removed.
-int wx_temp_remove_stale(const char *folder);
+/// longer runs (left by a run that was killed) and whose <name> `is_ours` accepts
+/// (only the program's own output names: a user's ".draft.txt.tmp42" stays).
+/// Returns how many were removed.
+int wx_temp_remove_stale(const char *folder, bool (*is_ours)(const char *name, void *context),
+                         void *context);
 
 /// Flushes `tmp` to disk and renames it to `path`; removes `tmp` on failure.
 wx_result wx_atomic_commit(const char *tmp, const char *path, wx_error *err);

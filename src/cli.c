@@ -151,10 +151,16 @@ static int parse_args(int argc, char **argv, cli_args *args)
             if (!missing && args->out_dir[0] == '\0') {
                 return usage_error("%s needs a folder name", "--out");
             }
+            if (!missing && strlen(args->out_dir) >= WX_PATH_MAX) {
+                return usage_error("--out: a folder name of at most %s characters", "4095");
+            }
         } else if (is_option(arg, "--stats")) {
             args->stats_path = option_value(argc, argv, &i, "--stats", &missing);
             if (!missing && args->stats_path[0] == '\0') {
                 return usage_error("%s needs a file name", "--stats");
+            }
+            if (!missing && strlen(args->stats_path) >= WX_PATH_MAX) {
+                return usage_error("--stats: a file name of at most %s characters", "4095");
             }
         } else if (is_option(arg, "--seed")) {
             const char *v = option_value(argc, argv, &i, "--seed", &missing);
@@ -333,12 +339,6 @@ static int command_info(const cli_args *args)
 
 // --- bake, simulate, gather, run ------------------------------------------------
 
-typedef enum phase {
-    PHASE_BAKE = 1 << 0,
-    PHASE_SIMULATE = 1 << 1,
-    PHASE_GATHER = 1 << 2,
-} phase;
-
 // True when some <View> camera has no map files in the scene; marks those
 // cameras' maps as the output folder's own (bake is about to write them there).
 static bool needs_bake(wx_scene *scene)
@@ -377,37 +377,45 @@ static int run_phases(const cli_args *args, unsigned phases)
     }
     wx_error err;
     wx_result r = WX_OK;
-    if ((phases & PHASE_GATHER) && scene.output_index < 0) {
+    if ((phases & WX_PHASE_GATHER) && scene.output_index < 0) {
         r = wx_error_set(&err, WX_BAD_INPUT,
                          "%s: has no output camera (<Ortho out=\"true\">); `%s` needs one",
                          scene.path, args->command);
     }
     if (r == WX_OK) {
         // Refused before any work (or any folder) is made: docs/reliability.md.
-        r = wx_memory_check(&scene, (phases & PHASE_SIMULATE) != 0, &err);
+        r = wx_memory_check(&scene, (phases & WX_PHASE_SIMULATE) != 0, &err);
+    }
+    if (r == WX_OK && !(phases & WX_PHASE_BAKE)) {
+        r = wx_use_baked_maps(&scene, &opts, &err);
     }
     if (r == WX_OK) {
-        r = wx_output_prepare(&opts, &err);
+        if (phases & WX_PHASE_BAKE) {
+            needs_bake(&scene);
+        }
+        r = wx_check_outputs(&scene, &opts, phases, &err);
+    }
+    char created[WX_PATH_MAX] = "";
+    if (r == WX_OK) {
+        r = wx_output_prepare(&scene, &opts, created, &err);
     }
     times.load = wx_now_s() - start;
-    if (r == WX_OK && (phases & PHASE_BAKE)) {
+    if (r == WX_OK && (phases & WX_PHASE_BAKE)) {
         double t0 = wx_now_s();
         if (needs_bake(&scene)) {
             r = wx_bake_scene(&scene, &opts, &err);
-        } else if (phases == PHASE_BAKE && !opts.quiet) {
+        } else if (phases == WX_PHASE_BAKE && !opts.quiet) {
             fprintf(stderr, "weathering: %s: every camera has its maps; nothing to bake\n",
                     scene.path);
         }
         times.bake = wx_now_s() - t0;
-    } else if (r == WX_OK) {
-        r = wx_use_baked_maps(&scene, &opts, &err);
     }
-    if (r == WX_OK && (phases & PHASE_SIMULATE)) {
+    if (r == WX_OK && (phases & WX_PHASE_SIMULATE)) {
         double t0 = wx_now_s();
         r = wx_simulate_scene(&scene, &opts, &stats, &err);
         times.simulate = wx_now_s() - t0;
     }
-    if (r == WX_OK && (phases & PHASE_GATHER)) {
+    if (r == WX_OK && (phases & WX_PHASE_GATHER)) {
         double t0 = wx_now_s();
         r = wx_gather_scene(&scene, &opts, &err);
         times.gather = wx_now_s() - t0;
@@ -420,28 +428,31 @@ static int run_phases(const cli_args *args, unsigned phases)
         fprintf(stderr, "weathering: %s done in %.2f s; outputs in %s\n", args->command,
                 times.total, opts.out_dir);
     }
+    if (r != WX_OK) {
+        wx_output_remove_empty(opts.out_dir, created); // a failed run leaves no empty folder
+    }
     wx_scene_free(&scene);
     return report(r, &err);
 }
 
 static int command_bake(const cli_args *args)
 {
-    return run_phases(args, PHASE_BAKE);
+    return run_phases(args, WX_PHASE_BAKE);
 }
 
 static int command_simulate(const cli_args *args)
 {
-    return run_phases(args, PHASE_SIMULATE);
+    return run_phases(args, WX_PHASE_SIMULATE);
 }
 
 static int command_gather(const cli_args *args)
 {
-    return run_phases(args, PHASE_GATHER);
+    return run_phases(args, WX_PHASE_GATHER);
 }
 
 static int command_run(const cli_args *args)
 {
-    return run_phases(args, PHASE_BAKE | PHASE_SIMULATE | PHASE_GATHER);
+    return run_phases(args, WX_PHASE_BAKE | WX_PHASE_SIMULATE | WX_PHASE_GATHER);
 }
 
 // --- interrupts -------------------------------------------------------------------

@@ -44,14 +44,69 @@ typedef struct wx_phase_times {
     double total;
 } wx_phase_times;
 
-/// Default run options for a scene: out/<scene name>/, the scene's seed, all cores.
+/// Default run options for a scene: out/<scene name>/ (the name made safe: see
+/// wx_default_out_name), the scene's seed, all cores.
 void wx_run_options_default(const wx_scene *scene, wx_run_options *opts);
+
+/// The default output folder's name for a scene name: the name with every
+/// character but letters, digits, '_', '-' and '.' replaced by '_', leading dots
+/// too, so that out/NAME always lies inside out/ ("..": "__"; "": "scene").
+void wx_default_out_name(const char *scene_name, char *out, size_t cap);
 
 /// Number of online processors (at least 1).
 int wx_cpu_count(void);
 
-/// Creates the output folder (and its parents) and checks it is a folder.
-wx_result wx_output_prepare(const wx_run_options *opts, wx_error *err);
+/// The phases of a run, as bits.
+enum {
+    WX_PHASE_BAKE = 1 << 0,
+    WX_PHASE_SIMULATE = 1 << 1,
+    WX_PHASE_GATHER = 1 << 2,
+    WX_PHASE_ALL = 7,
+};
+
+/// Longest plain file name the program writes into an output folder.
+#define WX_OUTPUT_NAME_MAX 320
+
+/// The plain names of the files a run writes into its output folder.
+typedef struct wx_output_names {
+    int count;
+    char (*names)[WX_OUTPUT_NAME_MAX];
+} wx_output_names;
+
+/// Lists every file that the phases in `phases` write for `scene`: the maps
+/// `bake` writes (<camera>_depth.exr ... for each <View> camera without map
+/// files), the dirt map `simulate` writes for each input camera
+/// (<camera>_dirt.exr), the mask and its preview. WX_FAIL when out of memory.
+wx_result wx_output_names_list(const wx_scene *scene, unsigned phases, wx_output_names *out,
+                               wx_error *err);
+
+/// Frees the list; the struct is zeroed.
+void wx_output_names_free(wx_output_names *names);
+
+/// The preview's name for a mask's: its extension replaced by .png ("mask.exr"
+/// -> "mask.png"; "mask" -> "mask.png"; "mask.png" -> "mask.preview.png").
+void wx_preview_name(const char *mask_name, char *out, size_t cap);
+
+/// Checks made before any work or any folder: no file the phases will write
+/// is an input of the scene (the scene, a map or a mesh it names) or an
+/// existing non-regular file (a folder, a FIFO, a symbolic link), and the
+/// --stats file, when given, is neither an input nor one of the run's outputs
+/// nor an existing non-regular file, and lies in a folder that exists (or in
+/// the output folder). WX_BAD_INPUT with the path and the reason.
+wx_result wx_check_outputs(const wx_scene *scene, const wx_run_options *opts, unsigned phases,
+                           wx_error *err);
+
+/// Creates the output folder (and its parents), checks it is a folder, and
+/// removes the temporaries that killed runs of this program left there (only
+/// ".NAME.tmpPID" where NAME is one of the scene's output names or the --stats
+/// file's). `created` (may be NULL) gets the topmost folder this call made, or
+/// "" when the folder existed.
+wx_result wx_output_prepare(const wx_scene *scene, const wx_run_options *opts,
+                            char created[WX_PATH_MAX], wx_error *err);
+
+/// After a failed run: removes the output folder and the parents up to
+/// `created` (what wx_output_prepare made) when they are empty.
+void wx_output_remove_empty(const char *out_dir, const char *created);
 
 /// Memory a run needs, estimated before work starts (docs/reliability.md).
 typedef struct wx_memory_need {

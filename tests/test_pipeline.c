@@ -24,18 +24,19 @@ static int count_hidden_files(const char *dir)
 
 TEST(output_folder_is_created_with_parents)
 {
+    wx_scene scene = { .output_index = -1 };
     wx_run_options opts = { 0 };
     snprintf(opts.out_dir, sizeof opts.out_dir, "%s/a/b/c", ensure_tmpdir());
-    ENSURE(wx_output_prepare(&opts, NULL) == WX_OK);
+    ENSURE(wx_output_prepare(&scene, &opts, NULL, NULL) == WX_OK);
     struct stat st;
     ENSURE(stat(opts.out_dir, &st) == 0 && S_ISDIR(st.st_mode));
     // Again: an existing folder is fine.
-    ENSURE(wx_output_prepare(&opts, NULL) == WX_OK);
+    ENSURE(wx_output_prepare(&scene, &opts, NULL, NULL) == WX_OK);
     // A file in the way is bad input.
     const char *file = ensure_write_file(ensure_tmpdir(), "plain", "x");
     snprintf(opts.out_dir, sizeof opts.out_dir, "%s", file);
     wx_error err;
-    ENSURE(wx_output_prepare(&opts, &err) == WX_BAD_INPUT);
+    ENSURE(wx_output_prepare(&scene, &opts, NULL, &err) == WX_BAD_INPUT);
     ENSURE(ensure_contains(err.message, "not a folder"));
 }
 

@@ -416,7 +416,7 @@ static bool run_and_hash(int threads, int chunk_particles, uint64_t *files, uint
     snprintf(opts.out_dir, sizeof opts.out_dir, "%s/t%d_c%d", ensure_tmpdir(), threads,
              chunk_particles);
     wx_error err;
-    bool ok = wx_output_prepare(&opts, &err) == WX_OK &&
+    bool ok = wx_output_prepare(&f.scene, &opts, NULL, &err) == WX_OK &&
               wx_sim_write_dirt_maps(sim, &opts, &err) == WX_OK;
     *files = 1469598103934665603ull;
     const char *names[3] = { "front", "side", "top" };
@@ -621,7 +621,7 @@ TEST(thesis_format_scene_runs_with_defaults)
     opts.quiet = true;
     opts.threads = 2;
     wx_sim_stats st;
-    r = wx_output_prepare(&opts, &err);
+    r = wx_output_prepare(&scene, &opts, NULL, &err);
     if (r == WX_OK) {
         r = wx_simulate_scene(&scene, &opts, &st, &err);
     }

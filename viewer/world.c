@@ -509,7 +509,7 @@ bool vw_world_finished(const vw_world *world)
 wx_result vw_world_gather(vw_world *world, char saved[WX_PATH_MAX], wx_error *err)
 {
     snprintf(saved, WX_PATH_MAX, "%s", world->opts.out_dir);
-    wx_result r = wx_output_prepare(&world->opts, err);
+    wx_result r = wx_output_prepare(&world->scene, &world->opts, NULL, err);
     if (r == WX_OK) {
         r = wx_sim_write_dirt_maps(world->sim, &world->opts, err);
     }

@@ -240,7 +240,7 @@ static bool maps_world_load(maps_world *w, const char *scene_path, const char *o
     opts.threads = THREADS;
     opts.quiet = true;
     if (w->scene.mesh_count > 0 &&
-        (wx_output_prepare(&opts, &err) != WX_OK || wx_bake_scene(&w->scene, &opts, &err) != WX_OK ||
+        (wx_output_prepare(&w->scene, &opts, NULL, &err) != WX_OK || wx_bake_scene(&w->scene, &opts, &err) != WX_OK ||
          wx_use_baked_maps(&w->scene, &opts, &err) != WX_OK)) {
         fprintf(stderr, "bench_embree: %s\n", err.message);
         return false;
