@@ -20,6 +20,78 @@ static float length3(const float v[3])
     return sqrtf(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
 }
 
+bool wx_matrix_is_orthographic(const float m[16])
+{
+    double scale = 0.0;
+    for (int k = 0; k < 16; ++k) {
+        if (!isfinite(m[k])) {
+            return false;
+        }
+        scale = fmax(scale, fabs((double)m[k]));
+    }
+    double w = m[15];
+    double skew = fabs((double)m[3]) + fabs((double)m[7]) + fabs((double)m[11]);
+    double diagonal = fabs((double)m[0]) + fabs((double)m[5]) + fabs((double)m[10]) + fabs(w);
+    bool each_small = fabs((double)m[3]) <= 1e-6 * diagonal &&
+                      fabs((double)m[7]) <= 1e-6 * diagonal &&
+                      fabs((double)m[11]) <= 1e-6 * diagonal;
+    return fabs(w) > 1e-12 * scale && skew <= 1e-6 * scale && each_small;
+}
+
+bool wx_invert3(const double a[9], double inv[9])
+{
+    double c00 = a[4] * a[8] - a[5] * a[7];
+    double c01 = a[5] * a[6] - a[3] * a[8];
+    double c02 = a[3] * a[7] - a[4] * a[6];
+    double det = a[0] * c00 + a[1] * c01 + a[2] * c02;
+    double scale = 0.0;
+    for (int i = 0; i < 9; ++i) {
+        scale = fmax(scale, fabs(a[i]));
+    }
+    if (!(fabs(det) > 1e-12 * scale * scale * scale) || !isfinite(det)) {
+        return false;
+    }
+    double r = 1.0 / det;
+    inv[0] = c00 * r;
+    inv[1] = (a[2] * a[7] - a[1] * a[8]) * r;
+    inv[2] = (a[1] * a[5] - a[2] * a[4]) * r;
+    inv[3] = c01 * r;
+    inv[4] = (a[0] * a[8] - a[2] * a[6]) * r;
+    inv[5] = (a[2] * a[3] - a[0] * a[5]) * r;
+    inv[6] = c02 * r;
+    inv[7] = (a[1] * a[6] - a[0] * a[7]) * r;
+    inv[8] = (a[0] * a[4] - a[1] * a[3]) * r;
+    return true;
+}
+
+const char *wx_camera_problem(const wx_camera *camera)
+{
+    for (int k = 0; k < 16; ++k) {
+        if (!isfinite(camera->wtc[k]) || !isfinite(camera->ctw[k])) {
+            return "its matrices are not finite in single precision";
+        }
+    }
+    if (!wx_matrix_is_orthographic(camera->wtc) || !wx_matrix_is_orthographic(camera->ctw)) {
+        const float *m = camera->wtc;
+        bool skewed = fabsf(m[3]) + fabsf(m[7]) + fabsf(m[11]) > 1e-6f * fabsf(m[15]);
+        return skewed ? "its matrices are not orthographic (the last column must be 0 0 0 1)"
+                      : "its matrices mix numbers of very different sizes (the camera lies too "
+                        "far from the origin, or its frame is too large, for single precision)";
+    }
+    double a[9], inv[9];
+    double w = camera->wtc[15];
+    for (int r = 0; r < 3; ++r) {
+        for (int c = 0; c < 3; ++c) {
+            a[r * 3 + c] = camera->wtc[r * 4 + c] / w;
+        }
+    }
+    if (!wx_invert3(a, inv)) {
+        return "its world-to-map matrix is singular (or its frame is too large or too small "
+               "against its depth scale to invert in single precision)";
+    }
+    return NULL;
+}
+
 wx_result wx_camera_from_view(const wx_view *view, wx_camera *out, wx_error *err)
 {
     if (!(view->width_ws > 0.0f) || !(view->height_ws > 0.0f)) {
@@ -28,13 +100,17 @@ wx_result wx_camera_from_view(const wx_view *view, wx_camera *out, wx_error *err
     if (view->width_px < 1 || view->height_px < 1) {
         return wx_error_set(err, WX_BAD_INPUT, "view resolution must be at least 1 pixel");
     }
-    vec3 forward = { view->target[0] - view->eye[0], view->target[1] - view->eye[1],
-                     view->target[2] - view->eye[2] };
-    float distance = glm_vec3_norm(forward);
-    if (!(distance > 0.0f) || !isfinite(distance)) {
+    double delta[3], distance2 = 0.0;
+    for (int k = 0; k < 3; ++k) {
+        delta[k] = (double)view->target[k] - (double)view->eye[k];
+        distance2 += delta[k] * delta[k];
+    }
+    double distance = sqrt(distance2); // in double: |eye - target| may pass FLT_MAX squared
+    if (!(distance > 0.0) || !isfinite(distance)) {
         return wx_error_set(err, WX_BAD_INPUT, "view eye and target are the same point");
     }
-    glm_vec3_scale(forward, 1.0f / distance, forward);
+    vec3 forward = { (float)(delta[0] / distance), (float)(delta[1] / distance),
+                     (float)(delta[2] / distance) };
     vec3 up = { view->up[0], view->up[1], view->up[2] };
     vec3 right;
     glm_vec3_cross(forward, up, right);

@@ -43,6 +43,22 @@ bool wx_camera_invert(const float wtc[16], float ctw[16]);
 /// are from being inverses of one another (relative to their scale).
 float wx_camera_inverse_error(const float wtc[16], const float ctw[16]);
 
+/// The one orthographic test of the program (scene loading, collider, gather):
+/// every entry finite, the last column (0, 0, 0, w) with w != 0, relative to
+/// the matrix's scale (|w| > 1e-12 of the largest entry; |m[3]|, |m[7]|,
+/// |m[11]| at most 1e-6 of that entry and of |m0| + |m5| + |m10| + |w|).
+bool wx_matrix_is_orthographic(const float m[16]);
+
+/// Inverse of a 3x3 matrix (row-major) in double; false when singular relative
+/// to its scale (|det| <= 1e-12 * (largest entry)^3) or not finite.
+bool wx_invert3(const double a[9], double inv[9]);
+
+/// Why the camera's matrices cannot be used (a phrase for a message), or NULL
+/// when they can: every entry finite in single precision, both matrices
+/// orthographic (wx_matrix_is_orthographic), the linear part of wtc invertible
+/// (wx_invert3, as the collider inverts it).
+const char *wx_camera_problem(const wx_camera *camera);
+
 /// [x y z 1] * m, divided by w. Returns false when w is 0 or not finite.
 bool wx_transform_point(const float m[16], const float p[3], float out[3]);
 

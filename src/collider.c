@@ -11,41 +11,12 @@
 
 // --- building ----------------------------------------------------------------
 
-// Inverse of a 3x3 matrix (row-major); false when singular.
-static bool invert3(const double a[9], double inv[9])
-{
-    double c00 = a[4] * a[8] - a[5] * a[7];
-    double c01 = a[5] * a[6] - a[3] * a[8];
-    double c02 = a[3] * a[7] - a[4] * a[6];
-    double det = a[0] * c00 + a[1] * c01 + a[2] * c02;
-    double scale = 0.0;
-    for (int i = 0; i < 9; ++i) {
-        scale = fmax(scale, fabs(a[i]));
-    }
-    if (!(fabs(det) > 1e-12 * scale * scale * scale) || !isfinite(det)) {
-        return false;
-    }
-    double r = 1.0 / det;
-    inv[0] = c00 * r;
-    inv[1] = (a[2] * a[7] - a[1] * a[8]) * r;
-    inv[2] = (a[1] * a[5] - a[2] * a[4]) * r;
-    inv[3] = c01 * r;
-    inv[4] = (a[0] * a[8] - a[2] * a[6]) * r;
-    inv[5] = (a[2] * a[3] - a[0] * a[5]) * r;
-    inv[6] = c02 * r;
-    inv[7] = (a[1] * a[6] - a[0] * a[7]) * r;
-    inv[8] = (a[0] * a[4] - a[1] * a[3]) * r;
-    return true;
-}
-
 static wx_result setup_matrices(wx_collider_camera *cam, const float wtc[16], int index,
                                 wx_error *err)
 {
     // [x y z 1] * wtc = [u v d w]; the collider needs w constant (orthographic).
     double w = wtc[15];
-    double scale = fabs(wtc[0]) + fabs(wtc[5]) + fabs(wtc[10]) + fabs(w);
-    if (!(fabs(w) > 0.0) || fabs(wtc[3]) > 1e-6 * scale || fabs(wtc[7]) > 1e-6 * scale ||
-        fabs(wtc[11]) > 1e-6 * scale) {
+    if (!wx_matrix_is_orthographic(wtc)) {
         return wx_error_set(err, WX_BAD_INPUT,
                             "input camera %d: projective (perspective) matrices are not "
                             "supported by the collider; use orthographic cameras",
@@ -70,7 +41,7 @@ static wx_result setup_matrices(wx_collider_camera *cam, const float wtc[16], in
         a[r * 3 + 1] = wtc[r * 4 + 1] / w;
         a[r * 3 + 2] = wtc[r * 4 + 2] / w;
     }
-    if (!invert3(a, inv)) {
+    if (!wx_invert3(a, inv)) {
         return wx_error_set(err, WX_BAD_INPUT, "input camera %d: singular matrix", index);
     }
     // Row k of inv is the world displacement per unit of u, v, d.

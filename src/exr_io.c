@@ -13,6 +13,7 @@
 #include "exr_io.h"
 
 #include "atomic_file.h"
+#include "input_file.h"
 
 #include <assert.h>
 #include <errno.h>
@@ -175,14 +176,16 @@ static const uint8_t exr_magic[4] = {0x76, 0x2f, 0x31, 0x01};
 static wx_result reader_open(exr_reader *r, const char *path, wx_error *err)
 {
     memset(r, 0, sizeof *r);
-    r->stream.fd = open(path, O_RDONLY | O_CLOEXEC);
+    char why[WX_INPUT_WHY_MAX];
+    r->stream.fd = wx_open_regular(path, why, NULL); // a FIFO is refused, never waited on
     if (r->stream.fd < 0) {
-        return wx_error_set(err, WX_BAD_INPUT, "%s: cannot open (%s)", path, strerror(errno));
+        return wx_error_set(err, WX_BAD_INPUT, "%s: %s", path, why);
     }
     struct stat st;
-    if (fstat(r->stream.fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+    if (fstat(r->stream.fd, &st) != 0) {
+        int e = errno;
         reader_close(r);
-        return wx_error_set(err, WX_BAD_INPUT, "%s: not a regular file", path);
+        return wx_error_set(err, WX_BAD_INPUT, "%s: cannot open (%s)", path, strerror(e));
     }
     uint8_t magic[4];
     int64_t got = stream_read(NULL, &r->stream, magic, sizeof magic, 0, NULL);

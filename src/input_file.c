@@ -31,9 +31,7 @@ static void explain_errno(int e, char why[WX_INPUT_WHY_MAX], bool *not_found)
     if (not_found != NULL) {
         *not_found = e == ENOENT || e == ENOTDIR;
     }
-    if (e == ENOENT || e == ENOTDIR) {
-        snprintf(why, WX_INPUT_WHY_MAX, "not found");
-    } else if (e == ELOOP) {
+    if (e == ELOOP) {
         snprintf(why, WX_INPUT_WHY_MAX, "is not a regular file (a loop of symbolic links)");
     } else {
         snprintf(why, WX_INPUT_WHY_MAX, "cannot open (%s)", strerror(e));

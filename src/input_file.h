@@ -13,8 +13,8 @@
 
 /// Opens `path` read-only when it is a regular file. Returns the descriptor
 /// (close-on-exec, blocking reads), or -1 with `why` set to a short phrase for
-/// a message: "not found", "is not a regular file (a FIFO)", "cannot open
-/// (Permission denied)". `not_found` (may be NULL) tells the first case apart.
+/// a message: "is not a regular file (a FIFO)", "cannot open (No such file or
+/// directory)". `not_found` (may be NULL) is set when the file does not exist.
 int wx_open_regular(const char *path, char why[WX_INPUT_WHY_MAX], bool *not_found);
 
 /// The same test without opening the file (stat): true when `path` names a

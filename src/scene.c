@@ -24,6 +24,7 @@
 #include <string.h>
 #include <strings.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <libxml/parser.h>
 #include <libxml/tree.h>
@@ -31,6 +32,7 @@
 
 #include "collider.h"
 #include "exr_io.h"
+#include "input_file.h"
 
 /// Limits that bound memory before anything else is checked.
 #define SCENE_MAX_BYTES (64L * 1024 * 1024)
@@ -189,20 +191,21 @@ static wx_result read_file(const char *path, char **text, size_t *size, wx_error
 {
     *text = NULL;
     *size = 0;
-    FILE *f = fopen(path, "rb");
+    char why[WX_INPUT_WHY_MAX];
+    int fd = wx_open_regular(path, why, NULL); // never waits on a FIFO
+    FILE *f = fd >= 0 ? fdopen(fd, "rb") : NULL;
     if (f == NULL) {
-        return wx_error_set(err, WX_BAD_INPUT, "%s: cannot open (%s)", path, strerror(errno));
+        if (fd >= 0) {
+            snprintf(why, sizeof why, "cannot open (%s)", strerror(errno));
+            close(fd);
+        }
+        return wx_error_set(err, WX_BAD_INPUT, "%s: %s", path, why);
     }
     struct stat st;
     if (fstat(fileno(f), &st) != 0) {
         int e = errno;
         fclose(f);
         return wx_error_set(err, WX_BAD_INPUT, "%s: cannot open (%s)", path, strerror(e));
-    }
-    if (!S_ISREG(st.st_mode)) {
-        fclose(f);
-        return wx_error_set(err, WX_BAD_INPUT, "%s: cannot open (%s)", path,
-                            S_ISDIR(st.st_mode) ? strerror(EISDIR) : "not a regular file");
     }
     if (st.st_size > SCENE_MAX_BYTES) {
         fclose(f);
@@ -847,12 +850,6 @@ static wx_result parse_children(parser *p, const xmlNode *parent, const child_sp
 // ---------------------------------------------------------------------------
 // Paths
 
-static bool is_regular_file(const char *path)
-{
-    struct stat st;
-    return stat(path, &st) == 0 && S_ISREG(st.st_mode);
-}
-
 /// Resolves `file` against the scene's folder (absolute paths stay as they are).
 static wx_result resolve_path(parser *p, const xmlNode *node, const char *file,
                               char out[WX_PATH_MAX])
@@ -1272,6 +1269,17 @@ static const child_spec ortho_children[] = {
     { "OutputMap", parse_output_map, false }, { "View", parse_view, false },
 };
 
+/// Every later phase can use the camera's matrices (the collider's and the
+/// gather's tests, made here so that a bad camera is refused at its line).
+static wx_result check_camera(parser *p, const xmlNode *node, const wx_scene_camera *cam)
+{
+    const char *problem = wx_camera_problem(&cam->camera);
+    if (problem != NULL) {
+        return fail(p, node, "camera '%s': %s", cam->name, problem);
+    }
+    return WX_OK;
+}
+
 /// The matrices of a camera: from its <View>, or both given (and checked), or
 /// one given and the other its inverse.
 static wx_result camera_matrices(parser *p, const xmlNode *node, ortho_def *o)
@@ -1287,7 +1295,7 @@ static wx_result camera_matrices(parser *p, const xmlNode *node, ortho_def *o)
         if (wx_camera_from_view(&cam->view, &cam->camera, &view_err) != WX_OK) {
             return fail(p, o->view_node, "camera '%s': %s", cam->name, view_err.message);
         }
-        return WX_OK;
+        return check_camera(p, o->view_node, cam);
     }
     if (o->wtc_node == NULL && o->ctw_node == NULL) {
         return fail(p, node, "camera '%s' needs a <WTCMatrix> (and/or <CTWMatrix>) or a <View>",
@@ -1314,7 +1322,7 @@ static wx_result camera_matrices(parser *p, const xmlNode *node, ortho_def *o)
             return fail(p, o->ctw_node, "<CTWMatrix> of camera '%s' is singular", cam->name);
         }
     }
-    return WX_OK;
+    return check_camera(p, o->wtc_node != NULL ? o->wtc_node : o->ctw_node, cam);
 }
 
 /// Which maps a camera must name, the ones it names, and their sizes.
@@ -1353,12 +1361,10 @@ static wx_result camera_maps(parser *p, const xmlNode *node, ortho_def *o)
         if (r != WX_OK) {
             return r;
         }
-        struct stat st;
-        if (stat(paths[k], &st) != 0) {
-            return fail(p, map, "map file '%s' not found", file);
-        }
-        if (!S_ISREG(st.st_mode)) {
-            return fail(p, map, "map file '%s' is not a regular file", file);
+        char why[WX_INPUT_WHY_MAX];
+        bool missing = false;
+        if (!wx_is_regular_file(paths[k], why, &missing)) {
+            return fail(p, map, "map file '%s' %s", file, missing ? "not found" : why);
         }
         wx_image header;
         wx_error exr_err;
@@ -1612,9 +1618,11 @@ static wx_result parse_mesh(parser *p, const xmlNode *node, void *user)
         return out_of_memory(p);
     }
     wx_result r = ATTRS(mesh_attrs, file, NULL);
+    char why[WX_INPUT_WHY_MAX];
+    bool missing = false;
     if (r == WX_OK && (r = resolve_path(p, node, file->file, mesh->path)) == WX_OK &&
-        !is_regular_file(mesh->path)) {
-        r = fail(p, node, "mesh file '%s' not found", file->file);
+        !wx_is_regular_file(mesh->path, why, &missing)) {
+        r = fail(p, node, "mesh file '%s' %s", file->file, missing ? "not found" : why);
     }
     free(file);
     mesh_state m = { .mesh = mesh };

@@ -604,7 +604,13 @@ TEST(missing_scene_file)
     ENSURE(s.cameras == NULL);
     wx_scene_free(&s);
     ENSURE(wx_scene_load(ensure_tmpdir(), &s, &err) == WX_BAD_INPUT); // a folder
-    ENSURE(ensure_contains(err.message, "cannot open"));
+    ENSURE(ensure_contains(err.message, "is not a regular file (a folder)"));
+    // A FIFO with no writer is refused at once, never waited on (issue 13).
+    char fifo[4200];
+    snprintf(fifo, sizeof fifo, "%s/scene_fifo.xml", ensure_tmpdir());
+    ENSURE(mkfifo(fifo, 0600) == 0);
+    ENSURE(wx_scene_load(fifo, &s, &err) == WX_BAD_INPUT);
+    ENSURE(ensure_contains(err.message, "scene_fifo.xml: is not a regular file (a FIFO)"));
 }
 
 // Absolute map paths stay as they are; relative ones resolve against the scene.
