@@ -1,6 +1,8 @@
 # Weathering: particle-driven weathering masks.
 #   make          build build/weathering (installs missing Debian packages first)
 #   make test     build and run the test suite
+#   make test-blender
+#                 docs/mask.md's Blender recipe, run headless in Blender
 #   make run      run the shipped default scene into out/building/
 #   make bench    benchmarks (speed and memory targets)
 #   make sanitize, make tsan, make valgrind, make fuzz
@@ -44,13 +46,13 @@ VIEWER_BIN := $(if $(VIEWER_SRC),$(BUILD)/weathering-viewer)
 # `weathering bake` in a child process when a scene's maps are still to bake.
 VIEWER_LIBS := -lglfw -lGL -lOpenEXRCore-3_1 -lxml2 -lpng -lm -lpthread
 
-.PHONY: all deps bench-deps test run bench clean sanitize tsan fuzz valgrind
+.PHONY: all deps bench-deps test test-blender run bench clean sanitize tsan fuzz valgrind
 all: $(BUILD)/weathering $(VIEWER_BIN)
 
 # Installs whatever Debian package is missing (apt-get update first), as root or
 # through sudo. Checked on every make: dpkg -s is quick.
-deps:
-	@missing=""; for p in $(DEB_PACKAGES); do \
+define install_missing
+	@missing=""; for p in $(1); do \
 	    dpkg -s $$p >/dev/null 2>&1 || missing="$$missing $$p"; done; \
 	if [ -n "$$missing" ]; then \
 	    echo "installing missing Debian packages:$$missing"; \
@@ -58,6 +60,9 @@ deps:
 	    $$sudo apt-get update -q && \
 	    DEBIAN_FRONTEND=noninteractive $$sudo apt-get install -y -q $$missing; \
 	fi
+endef
+deps:
+	$(call install_missing,$(DEB_PACKAGES))
 
 $(BUILD)/obj/%.o: src/%.c | deps
 	@mkdir -p $(dir $@)
@@ -104,16 +109,19 @@ $(BUILD)/tests/%: $(BUILD)/obj/tests/%.o $(TEST_SUPPORT_OBJ) $(BUILD)/libweather
 test: $(BUILD)/weathering $(VIEWER_BIN) $(TEST_BIN)
 	WX_BUILD=$(BUILD) WX_TESTS=tests tests/run.sh $(BUILD)/tests
 
+# make test-blender: docs/mask.md's Blender recipe run for real (tests/blender/):
+# two masks of building.obj are rendered back through Blender 3.4 (Cycles) and
+# compared with mask.exr and mask.png; about 10 s. Installs Debian's blender like
+# deps, after the build (so never while deps' apt-get runs). Outputs in
+# $(BUILD)/blender-test/.
+BLENDER_DEB_PACKAGES := blender
+test-blender: $(BUILD)/weathering
+	$(call install_missing,$(BLENDER_DEB_PACKAGES))
+	tests/blender/run.sh $(BUILD)
+
 # Like deps, for the packages only the benchmarks need.
 bench-deps:
-	@missing=""; for p in $(BENCH_DEB_PACKAGES); do \
-	    dpkg -s $$p >/dev/null 2>&1 || missing="$$missing $$p"; done; \
-	if [ -n "$$missing" ]; then \
-	    echo "installing missing Debian packages:$$missing"; \
-	    sudo=""; [ "$$(id -u)" -eq 0 ] || sudo=sudo; \
-	    $$sudo apt-get update -q && \
-	    DEBIAN_FRONTEND=noninteractive $$sudo apt-get install -y -q $$missing; \
-	fi
+	$(call install_missing,$(BENCH_DEB_PACKAGES))
 
 # Each benchmark prints its own table and appends its figures to $(BENCH_CSV);
 # report.sh prints them as one table. A missed target is a MISSED row, never a
