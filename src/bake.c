@@ -28,6 +28,7 @@
 
 #include "exr_io.h"
 #include "maps.h"
+#include "geometry.h"
 #include "mesh.h"
 #include "progress.h"
 #include "shaders.h"
@@ -107,16 +108,6 @@ typedef struct baker {
 
 // ---------------------------------------------------------------------------
 // Messages.
-
-// The mesh path as the scene file wrote it (relative to the scene's folder).
-static const char *mesh_name(const wx_scene *scene, const wx_mesh *mesh)
-{
-    size_t n = strlen(scene->dir);
-    if (n > 0 && strncmp(mesh->path, scene->dir, n) == 0 && mesh->path[n] == '/') {
-        return mesh->path + n + 1;
-    }
-    return mesh->path;
-}
 
 #define warn(b, ...) wx_warn((b)->opts->quiet, __VA_ARGS__)
 
@@ -403,49 +394,12 @@ static void local_matrix(const float wtc[16], const double origin[3], float out[
     }
 }
 
-static const char *color_use_name(wx_color_use use)
+// Fills 2 RGBA texels per material of a mesh from its matched <Surface>:
+// (absorption, bounce, dirt, deposit), (erosion, colour use, 0, 0).
+static void material_props(const wx_mesh *mesh, const wx_geometry_mesh *g, float *props)
 {
-    return use == WX_COLOR_IMPACT ? "impact" : "dirt";
-}
-
-// Maps each material of the mesh to a <Surface> and fills 2 RGBA texels per
-// material: (absorption, bounce, dirt, deposit), (erosion, colour use, 0, 0).
-static wx_result map_materials(baker *b, const wx_mesh *mesh, const wx_mesh_data *data,
-                               float *props, wx_error *err)
-{
-    const wx_scene *scene = b->scene;
-    for (int m = 0; m < data->material_count; ++m) {
-        const char *name = data->material_names[m];
-        const wx_surface *match = NULL, *any = NULL;
-        for (int s = 0; s < mesh->surface_count; ++s) {
-            const wx_surface *surf = &mesh->surfaces[s];
-            if (strcmp(surf->material, name) == 0 && match == NULL) {
-                match = surf;
-            } else if (strcmp(surf->material, "*") == 0 && any == NULL) {
-                any = surf;
-            }
-        }
-        match = match != NULL ? match : any;
-        if (match == NULL) {
-            char list[512] = "";
-            size_t used = 0;
-            for (int k = 0; k < data->material_count && used + 1 < sizeof list; ++k) {
-                int n = snprintf(list + used, sizeof list - used, "%s%s", k > 0 ? ", " : "",
-                                 data->material_names[k]);
-                used += n > 0 ? (size_t)n : 0;
-            }
-            return wx_error_set(err, WX_BAD_INPUT,
-                                "%s:%d: mesh '%s' has material '%s' that no <Surface> matches "
-                                "(materials in the file: %s)",
-                                scene->path, mesh->line, mesh_name(scene, mesh), name, list);
-        }
-        if (match->colors != WX_COLOR_NONE && !data->material_colored[m]) {
-            return wx_error_set(err, WX_BAD_INPUT,
-                                "%s:%d: <Surface material=\"%s\"> takes its %s values from vertex "
-                                "colours, but mesh '%s' has none for material '%s'",
-                                scene->path, match->line, match->material,
-                                color_use_name(match->colors), mesh_name(scene, mesh), name);
-        }
+    for (int m = 0; m < g->data.material_count; ++m) {
+        const wx_surface *match = &mesh->surfaces[g->surface[m]];
         float *p = &props[8 * m];
         p[0] = match->absorption;
         p[1] = match->bounce;
@@ -454,11 +408,7 @@ static wx_result map_materials(baker *b, const wx_mesh *mesh, const wx_mesh_data
         p[4] = match->erosion;
         p[5] = (float)match->colors; // 0 none, 1 impact, 2 dirt (bake_frag.glsl)
         p[6] = p[7] = 0.0f;
-        if (match->dirt > 0.0f || match->colors == WX_COLOR_DIRT) {
-            b->has_dirt = true;
-        }
     }
-    return WX_OK;
 }
 
 // Projects every vertex into every camera to bake: depth range, and warnings for
@@ -498,58 +448,53 @@ static void survey_vertices(baker *b, const wx_mesh *mesh, const wx_mesh_data *d
         if (outside > 0) {
             warn(b, "%s: camera '%s': %lld of %lld vertices of mesh '%s' fall outside its frame",
                  scene->path, sc->name, (long long)outside, (long long)data->vertex_count,
-                 mesh_name(scene, mesh));
+                 wx_mesh_display_name(scene, mesh));
         }
         if (behind > 0) {
             warn(b,
                  "%s: camera '%s': %lld of %lld vertices of mesh '%s' lie behind its eye (d < 0) "
                  "and are not seen",
                  scene->path, sc->name, (long long)behind, (long long)data->vertex_count,
-                 mesh_name(scene, mesh));
+                 wx_mesh_display_name(scene, mesh));
         }
     }
 }
 
-static wx_result load_meshes(baker *b, wx_error *err)
+// Uploads every mesh of the geometry (its arrays are released on the way).
+static wx_result load_meshes(baker *b, wx_geometry *geometry, wx_error *err)
 {
     wx_scene *scene = b->scene;
     b->meshes = calloc(scene->mesh_count > 0 ? (size_t)scene->mesh_count : 1, sizeof *b->meshes);
     if (b->meshes == NULL) {
         return wx_error_set(err, WX_FAIL, "bake: out of memory");
     }
-    for (int i = 0; i < scene->mesh_count; ++i) {
+    b->stats->import_s += geometry->import_s;
+    for (int i = 0; i < geometry->count; ++i) {
         const wx_mesh *mesh = &scene->meshes[i];
-        double t0 = wx_now_s();
-        wx_mesh_data data;
-        wx_result r = wx_mesh_import(mesh->path, &data, err);
-        double t1 = wx_now_s();
-        b->stats->import_s += t1 - t0;
-        if (r != WX_OK) {
-            wx_error_prefix(err, "%s:%d", scene->path, mesh->line);
-            return r;
-        }
-        if (data.triangle_count == 0) {
-            warn(b, "%s:%d: mesh '%s' has no triangles", scene->path, mesh->line,
-                 mesh_name(scene, mesh));
-            wx_mesh_data_free(&data);
+        wx_geometry_mesh *g = &geometry->meshes[i];
+        wx_mesh_data *data = &g->data;
+        if (data->triangle_count == 0) {
             continue;
         }
-        float *props = malloc((size_t)data.material_count * 8 * sizeof(float));
-        r = props != NULL ? map_materials(b, mesh, &data, props, err)
-                          : wx_error_set(err, WX_FAIL, "bake: out of memory");
-        if (r == WX_OK) {
-            survey_vertices(b, mesh, &data);
-            r = upload_mesh(b, &data, props, &b->meshes[b->mesh_count], err);
+        double t1 = wx_now_s();
+        float *props = malloc((size_t)data->material_count * 8 * sizeof(float));
+        wx_result r = WX_OK;
+        if (props == NULL) {
+            r = wx_error_set(err, WX_FAIL, "bake: out of memory");
+        } else {
+            material_props(mesh, g, props);
+            survey_vertices(b, mesh, data);
+            r = upload_mesh(b, data, props, &b->meshes[b->mesh_count], err);
             b->mesh_count++; // counted even when incomplete, so that it is deleted
             if (r != WX_OK) {
                 wx_error_prefix(err, "%s:%d: mesh '%s'", scene->path, mesh->line,
-                                mesh_name(scene, mesh));
+                                wx_mesh_display_name(scene, mesh));
             }
         }
-        b->stats->triangles += data.triangle_count;
-        b->stats->vertices += data.vertex_count;
+        b->stats->triangles += data->triangle_count;
+        b->stats->vertices += data->vertex_count;
         free(props);
-        wx_mesh_data_free(&data);
+        wx_mesh_data_release_arrays(data);
         b->stats->setup_s += wx_now_s() - t1;
         if (r != WX_OK) {
             return r;
@@ -561,6 +506,7 @@ static wx_result load_meshes(baker *b, wx_error *err)
                             "given by <View> from",
                             scene->path);
     }
+    b->has_dirt = geometry->has_dirt;
     return WX_OK;
 }
 
@@ -1077,8 +1023,8 @@ static wx_result check_sizes(baker *b, wx_error *err)
     return WX_OK;
 }
 
-wx_result wx_bake_scene_stats(wx_scene *scene, const wx_run_options *opts,
-                              wx_bake_stats *stats, wx_error *err)
+wx_result wx_bake_geometry(wx_scene *scene, const wx_run_options *opts, wx_geometry *geometry,
+                           wx_bake_stats *stats, wx_error *err)
 {
     wx_bake_stats local;
     if (stats == NULL) {
@@ -1128,7 +1074,7 @@ wx_result wx_bake_scene_stats(wx_scene *scene, const wx_run_options *opts,
     }
     stats->setup_s += wx_now_s() - t0;
     if (r == WX_OK) {
-        r = load_meshes(b, err);
+        r = load_meshes(b, geometry, err);
     }
 
     // Initial dirt needs every input camera's depth before any dirt map is final.
@@ -1155,6 +1101,26 @@ wx_result wx_bake_scene_stats(wx_scene *scene, const wx_run_options *opts,
     stats->cameras_s = wx_now_s() - cameras_start;
     baker_free(b);
     stats->total_s = wx_now_s() - start;
+    return r;
+}
+
+wx_result wx_bake_scene_stats(wx_scene *scene, const wx_run_options *opts,
+                              wx_bake_stats *stats, wx_error *err)
+{
+    wx_geometry geometry;
+    memset(&geometry, 0, sizeof geometry);
+    bool bakes = false;
+    for (int c = 0; c < scene->camera_count; ++c) {
+        bakes = bakes || (scene->cameras[c].has_view && scene->cameras[c].depth_path[0] == '\0');
+    }
+    wx_result r = WX_OK;
+    if (bakes && scene->mesh_count > 0) {
+        r = wx_geometry_load(scene, opts->quiet, &geometry, err);
+    }
+    if (r == WX_OK) {
+        r = wx_bake_geometry(scene, opts, &geometry, stats, err);
+    }
+    wx_geometry_free(&geometry);
     return r;
 }
 

@@ -17,6 +17,7 @@
 #include <stdint.h>
 
 #include "error.h"
+#include "geometry.h"
 #include "pipeline.h"
 #include "scene.h"
 
@@ -42,6 +43,11 @@ typedef struct wx_bake_stats {
 /// WX_FAIL for GL or I/O failures. Warnings (geometry outside a frame or behind
 /// an eye) go to stderr unless opts->quiet.
 wx_result wx_bake_scene(wx_scene *scene, const wx_run_options *opts, wx_error *err);
+
+/// wx_bake_scene with the scene's geometry already imported and matched
+/// (wx_geometry_load); its mesh arrays are released as they are uploaded.
+wx_result wx_bake_geometry(wx_scene *scene, const wx_run_options *opts, wx_geometry *geometry,
+                           wx_bake_stats *stats, wx_error *err);
 
 /// wx_bake_scene, also filling `stats` (may be NULL).
 wx_result wx_bake_scene_stats(wx_scene *scene, const wx_run_options *opts,

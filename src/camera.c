@@ -109,8 +109,16 @@ wx_result wx_camera_from_view(const wx_view *view, wx_camera *out, wx_error *err
     if (!(distance > 0.0) || !isfinite(distance)) {
         return wx_error_set(err, WX_BAD_INPUT, "view eye and target are the same point");
     }
-    vec3 forward = { (float)(delta[0] / distance), (float)(delta[1] / distance),
-                     (float)(delta[2] / distance) };
+    vec3 forward = { view->target[0] - view->eye[0], view->target[1] - view->eye[1],
+                     view->target[2] - view->eye[2] };
+    float norm = glm_vec3_norm(forward);
+    if (isfinite(norm) && norm > 0.0f) {
+        glm_vec3_scale(forward, 1.0f / norm, forward);
+    } else { // beyond float's range squared: the scene check refuses such a camera
+        for (int k = 0; k < 3; ++k) {
+            forward[k] = (float)(delta[k] / distance);
+        }
+    }
     vec3 up = { view->up[0], view->up[1], view->up[2] };
     vec3 right;
     glm_vec3_cross(forward, up, right);

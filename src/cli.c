@@ -14,12 +14,10 @@
 #include <unistd.h>
 
 #include "atomic_file.h"
-#include "bake.h"
-#include "gather.h"
 #include "pipeline.h"
+#include "run.h"
 #include "progress.h"
 #include "scene.h"
-#include "simulate.h"
 
 #define WX_VERSION "0.1.0"
 
@@ -339,21 +337,6 @@ static int command_info(const cli_args *args)
 
 // --- bake, simulate, gather, run ------------------------------------------------
 
-// True when some <View> camera has no map files in the scene; marks those
-// cameras' maps as the output folder's own (bake is about to write them there).
-static bool needs_bake(wx_scene *scene)
-{
-    bool any = false;
-    for (int c = 0; c < scene->camera_count; ++c) {
-        wx_scene_camera *cam = &scene->cameras[c];
-        if (cam->has_view && cam->depth_path[0] == '\0') {
-            cam->maps_in_output = true;
-            any = true;
-        }
-    }
-    return any;
-}
-
 static int report(wx_result r, const wx_error *err)
 {
     if (r != WX_OK) {
@@ -367,14 +350,15 @@ static int report(wx_result r, const wx_error *err)
 static int run_phases(const cli_args *args, unsigned phases)
 {
     double start = wx_now_s();
-    wx_phase_times times = { 0 };
-    wx_sim_stats stats = { 0 };
+    wx_run_report run;
+    memset(&run, 0, sizeof run);
     wx_scene scene;
     wx_run_options opts;
     int status = load_scene(args, &scene, &opts);
     if (status != WX_OK) {
         return status;
     }
+    run.times.load = wx_now_s() - start;
     wx_error err;
     wx_result r = WX_OK;
     if ((phases & WX_PHASE_GATHER) && scene.output_index < 0) {
@@ -383,53 +367,15 @@ static int run_phases(const cli_args *args, unsigned phases)
                          scene.path, args->command);
     }
     if (r == WX_OK) {
-        // Refused before any work (or any folder) is made: docs/reliability.md.
-        r = wx_memory_check(&scene, (phases & WX_PHASE_SIMULATE) != 0, &err);
+        r = wx_run_phases(&scene, &opts, phases, &run, &err);
     }
-    if (r == WX_OK && !(phases & WX_PHASE_BAKE)) {
-        r = wx_use_baked_maps(&scene, &opts, &err);
-    }
-    if (r == WX_OK) {
-        if (phases & WX_PHASE_BAKE) {
-            needs_bake(&scene);
-        }
-        r = wx_check_outputs(&scene, &opts, phases, &err);
-    }
-    char created[WX_PATH_MAX] = "";
-    if (r == WX_OK) {
-        r = wx_output_prepare(&scene, &opts, created, &err);
-    }
-    times.load = wx_now_s() - start;
-    if (r == WX_OK && (phases & WX_PHASE_BAKE)) {
-        double t0 = wx_now_s();
-        if (needs_bake(&scene)) {
-            r = wx_bake_scene(&scene, &opts, &err);
-        } else if (phases == WX_PHASE_BAKE && !opts.quiet) {
-            fprintf(stderr, "weathering: %s: every camera has its maps; nothing to bake\n",
-                    scene.path);
-        }
-        times.bake = wx_now_s() - t0;
-    }
-    if (r == WX_OK && (phases & WX_PHASE_SIMULATE)) {
-        double t0 = wx_now_s();
-        r = wx_simulate_scene(&scene, &opts, &stats, &err);
-        times.simulate = wx_now_s() - t0;
-    }
-    if (r == WX_OK && (phases & WX_PHASE_GATHER)) {
-        double t0 = wx_now_s();
-        r = wx_gather_scene(&scene, &opts, &err);
-        times.gather = wx_now_s() - t0;
-    }
-    times.total = wx_now_s() - start;
+    run.times.total = wx_now_s() - start;
     if (r == WX_OK && opts.stats_path != NULL) {
-        r = wx_write_stats(opts.stats_path, &opts, &stats, &times, &err);
+        r = wx_write_stats(opts.stats_path, &opts, &run.stats, &run.times, &err);
     }
     if (r == WX_OK && !opts.quiet) {
         fprintf(stderr, "weathering: %s done in %.2f s; outputs in %s\n", args->command,
-                times.total, opts.out_dir);
-    }
-    if (r != WX_OK) {
-        wx_output_remove_empty(opts.out_dir, created); // a failed run leaves no empty folder
+                run.times.total, opts.out_dir);
     }
     wx_scene_free(&scene);
     return report(r, &err);

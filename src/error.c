@@ -99,6 +99,14 @@ void wx_error_prefix(wx_error *err, const char *fmt, ...)
     snprintf(err->message, sizeof err->message, "%.*s", WX_ERROR_MAX - 1, joined);
 }
 
+void wx_list_append(char *list, size_t cap, const char *item)
+{
+    size_t used = strlen(list);
+    if (used + 1 < cap) {
+        snprintf(list + used, cap - used, "%s%s", used > 0 ? ", " : "", item);
+    }
+}
+
 static void vprint_labelled(bool quiet, const char *label, const char *fmt, va_list args)
 {
     if (quiet) {

@@ -37,6 +37,11 @@ void wx_error_prefix(wx_error *err, const char *fmt, ...) __attribute__((format(
 /// \xNN); truncated to fit.
 void wx_printable(const char *text, char *out, size_t cap);
 
+/// Appends ", item" (or "item" to an empty list) to the list in `list` (cap
+/// bytes with the NUL), for messages such as "(allowed: a, b, c)"; truncated
+/// to fit.
+void wx_list_append(char *list, size_t cap, const char *item);
+
 /// Prints "weathering: warning: MESSAGE" on stderr (unless quiet), the message
 /// made printable as wx_error_set's.
 void wx_warn(bool quiet, const char *fmt, ...) __attribute__((format(printf, 2, 3)));

@@ -778,51 +778,26 @@ wx_result wx_gather_compute(const wx_gather_def *def, float *mask_out, wx_gather
 // ---------------------------------------------------------------------------
 // The gather phase on files.
 
-// The preview's name: the mask's with its extension replaced by .png
-// ("mask.exr" -> "mask.png"; "mask" -> "mask.png"; "mask.png" -> "mask.preview.png").
-static void preview_name(const char *mask_name, char *out, size_t cap)
-{
-    const char *dot = strrchr(mask_name, '.');
-    int stem = dot != NULL && dot != mask_name ? (int)(dot - mask_name) : (int)strlen(mask_name);
-    bool is_png = dot != NULL && dot != mask_name && strcmp(dot, ".png") == 0;
-    snprintf(out, cap, "%.*s%s", stem, mask_name, is_png ? ".preview.png" : ".png");
-}
-
-static wx_result load_input(const wx_scene *scene, const wx_run_options *opts,
-                            const wx_scene_camera *cam, wx_maps *maps, wx_error *err)
-{
-    char simulated[WX_PATH_MAX];
-    int n = snprintf(simulated, sizeof simulated, "%s/%s_dirt.exr", opts->out_dir, cam->name);
-    if (n < 0 || n >= (int)sizeof simulated) {
-        return wx_error_set(err, WX_BAD_INPUT, "%s: output path too long", opts->out_dir);
-    }
-    const char *dirt_path = simulated;
-    if (access(simulated, R_OK) != 0) {
-        if (cam->dirt_path[0] == '\0') {
-            return wx_error_set(err, WX_BAD_INPUT,
-                                "%s: camera '%s' has no dirt map (no %s); run `weathering "
-                                "simulate %s --out %s` first",
-                                scene->path, cam->name, simulated, scene->path, opts->out_dir);
-        }
-        dirt_path = cam->dirt_path;
-        wx_note(opts->quiet,
-                "gather: no simulated dirt map %s; camera '%s' uses its scene dirt map %s",
-                simulated, cam->name, dirt_path);
-    }
-    wx_result result = wx_maps_load(maps, WX_MAPS_DEPTH | WX_MAPS_NORMAL | WX_MAPS_DIRT,
-                                    cam->depth_path, cam->normal_path, NULL, dirt_path, err);
-    if (result != WX_OK) {
-        wx_error_prefix(err, "camera '%s'", cam->name);
-        return result;
-    }
-    // Only the dirt plane is read: release deposit and erosion now.
-    free(maps->deposit);
-    free(maps->erosion);
-    maps->deposit = maps->erosion = NULL;
-    return WX_OK;
-}
-
 wx_result wx_gather_scene(const wx_scene *scene, const wx_run_options *opts, wx_error *err)
+{
+    int input_count = scene->input_count;
+    wx_maps *in_maps = calloc((size_t)input_count + 1, sizeof *in_maps);
+    if (in_maps == NULL) {
+        return wx_error_set(err, WX_FAIL, "gather: out of memory");
+    }
+    wx_result result = wx_load_gather_maps(scene, opts, in_maps, err);
+    if (result == WX_OK) {
+        result = wx_gather_maps(scene, opts, in_maps, err);
+    }
+    for (int c = 0; c < input_count; ++c) {
+        wx_maps_free(&in_maps[c]);
+    }
+    free(in_maps);
+    return result;
+}
+
+wx_result wx_gather_maps(const wx_scene *scene, const wx_run_options *opts, const wx_maps *in_maps,
+                         wx_error *err)
 {
     if (scene->output_index < 0 || scene->output_index >= scene->camera_count) {
         return wx_error_set(err, WX_BAD_INPUT,
@@ -830,8 +805,8 @@ wx_result wx_gather_scene(const wx_scene *scene, const wx_run_options *opts, wx_
                             scene->path);
     }
     const wx_scene_camera *out = &scene->cameras[scene->output_index];
-    char mask_path[WX_PATH_MAX], png_path[WX_PATH_MAX], png_name[300];
-    preview_name(out->output_file, png_name, sizeof png_name);
+    char mask_path[WX_PATH_MAX], png_path[WX_PATH_MAX], png_name[WX_OUTPUT_NAME_MAX];
+    wx_preview_name(out->output_file, png_name, sizeof png_name);
     wx_result result = wx_output_path(scene, opts, out->output_file, mask_path, err);
     if (result == WX_OK) {
         result = wx_output_path(scene, opts, png_name, png_path, err);
@@ -840,17 +815,12 @@ wx_result wx_gather_scene(const wx_scene *scene, const wx_run_options *opts, wx_
         return result;
     }
 
-    int input_count = 0;
-    for (int c = 0; c < scene->camera_count; ++c) {
-        input_count += !scene->cameras[c].is_output;
-    }
+    int input_count = scene->input_count;
     wx_maps out_maps;
     memset(&out_maps, 0, sizeof out_maps);
-    wx_maps *in_maps = calloc((size_t)input_count + 1, sizeof *in_maps);
     wx_gather_view *views = calloc((size_t)input_count + 1, sizeof *views);
     wx_image *image = calloc(1, sizeof *image);
-    if (in_maps == NULL || views == NULL || image == NULL) {
-        free(in_maps);
+    if (views == NULL || image == NULL) {
         free(views);
         free(image);
         return wx_error_set(err, WX_FAIL, "gather: out of memory");
@@ -870,16 +840,11 @@ wx_result wx_gather_scene(const wx_scene *scene, const wx_run_options *opts, wx_
     int k = 0;
     for (int c = 0; c < scene->camera_count && result == WX_OK; ++c) {
         const wx_scene_camera *cam = &scene->cameras[c];
-        if (cam->is_output) {
-            continue;
-        }
-        result = load_input(scene, opts, cam, &in_maps[k], err);
-        if (result == WX_OK) {
+        if (!cam->is_output) {
             views[k] = wx_gather_view_from_maps(&cam->camera, &in_maps[k]);
             k++;
         }
     }
-
     if (result == WX_OK) {
         static const char *const names[] = { "Y" };
         result = wx_image_alloc(image, out_maps.width, out_maps.height, 1, names, err);
@@ -914,10 +879,6 @@ wx_result wx_gather_scene(const wx_scene *scene, const wx_run_options *opts, wx_
 
     wx_image_free(image);
     free(image);
-    for (int c = 0; c < input_count; ++c) {
-        wx_maps_free(&in_maps[c]);
-    }
-    free(in_maps);
     free(views);
     wx_maps_free(&out_maps);
     return result;

@@ -98,4 +98,10 @@ void wx_mask_world_to_camera(const wx_camera *camera, float m[16]);
 /// in its header) and the PNG preview beside it (extension replaced by .png).
 wx_result wx_gather_scene(const wx_scene *scene, const wx_run_options *opts, wx_error *err);
 
+/// The `gather` phase with the input cameras' maps already in memory (one per
+/// input camera in scene order: depth, normal and the dirt to gather): reads
+/// the output camera's maps, computes and writes the mask and its preview.
+wx_result wx_gather_maps(const wx_scene *scene, const wx_run_options *opts, const wx_maps *in_maps,
+                         wx_error *err);
+
 #endif

@@ -150,6 +150,16 @@ wx_result wx_maps_load(wx_maps *maps, unsigned which, const char *depth_path,
                 image->channels[0] = image->channels[1] = image->channels[2] = NULL;
                 result = check_size(&check, dirt_path, image->width, image->height, err);
             }
+            if (result == WX_OK && image->attr_count > 0) {
+                maps->dirt_attrs = malloc((size_t)image->attr_count * sizeof *maps->dirt_attrs);
+                if (maps->dirt_attrs == NULL) {
+                    result = wx_error_set(err, WX_FAIL, "%s: out of memory", dirt_path);
+                } else {
+                    memcpy(maps->dirt_attrs, image->attrs,
+                           (size_t)image->attr_count * sizeof *maps->dirt_attrs);
+                    maps->dirt_attr_count = image->attr_count;
+                }
+            }
             for (int c = 0; c < 3 && result == WX_OK; c++) {
                 const char *name[1] = { image->channel_names[c] };
                 result = check_finite(dirt_path, "dirt",
@@ -179,5 +189,6 @@ void wx_maps_free(wx_maps *maps)
     free(maps->dirt);
     free(maps->deposit);
     free(maps->erosion);
+    free(maps->dirt_attrs);
     memset(maps, 0, sizeof *maps);
 }

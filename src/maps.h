@@ -10,6 +10,7 @@
 #include <stdbool.h>
 
 #include "error.h"
+#include "exr_io.h"
 
 typedef struct wx_maps {
     int width;
@@ -20,6 +21,11 @@ typedef struct wx_maps {
     float *dirt;    ///< width*height, dirt amount on the texel's surface patch
     float *deposit; ///< width*height, deposit fraction
     float *erosion; ///< width*height, erosion fraction
+    /// The dirt map file's header attributes (camera matrices, name), kept so
+    /// that the simulated dirt map is written with them without reading the
+    /// file again.
+    int dirt_attr_count;
+    wx_attr *dirt_attrs;
 } wx_maps;
 
 /// Which maps to load.

@@ -8,6 +8,7 @@
 #include <stdint.h>
 
 #include "error.h"
+#include "maps.h"
 #include "scene.h"
 
 /// Options shared by every phase (command line: --out, --seed, --threads, -q, --stats).
@@ -152,6 +153,21 @@ wx_result wx_output_path(const wx_scene *scene, const wx_run_options *opts, cons
 /// checks those files exist (else: "run `weathering bake` first"); marks them
 /// maps_in_output.
 wx_result wx_use_baked_maps(wx_scene *scene, const wx_run_options *opts, wx_error *err);
+
+/// Loads the maps of every input camera (scene order; `maps` has
+/// scene->input_count entries) as the simulation reads them: depth, normal,
+/// impact and, when the camera has one, its dirt map (from the channel
+/// initialDirt when an earlier `simulate` wrote it, so a second run starts
+/// where the first started). Errors name the camera and the file.
+wx_result wx_load_simulation_maps(const wx_scene *scene, wx_maps *maps, wx_error *err);
+
+/// Loads the maps of every input camera as the gather reads them: depth,
+/// normal, and the dirt `simulate` left in the output folder
+/// (<camera>_dirt.exr); without it the camera's scene dirt map, with a note.
+/// A dirt map that holds only the baked initial dirt (never simulated) is used
+/// with a note too.
+wx_result wx_load_gather_maps(const wx_scene *scene, const wx_run_options *opts, wx_maps *maps,
+                              wx_error *err);
 
 /// Writes the --stats JSON atomically.
 wx_result wx_write_stats(const char *path, const wx_run_options *opts, const wx_sim_stats *stats,

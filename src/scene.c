@@ -655,8 +655,7 @@ static wx_result parse_keyword_value(parser *p, const xmlNode *node, const attr_
             memcpy(dst, &i, sizeof i);
             return WX_OK;
         }
-        size_t used = strlen(list);
-        snprintf(list + used, sizeof list - used, "%s%s", i > 0 ? ", " : "", s->choices[i]);
+        wx_list_append(list, sizeof list, s->choices[i]);
     }
     return fail(p, node, "<%s> %s=\"%s\" must be one of: %s", name_of(node), s->name, shown,
                 list);
@@ -756,9 +755,7 @@ static wx_result parse_attributes(parser *p, const xmlNode *node, const attr_spe
         if (i == count) {
             char allowed[512] = "";
             for (int k = 0; k < count; ++k) {
-                size_t used = strlen(allowed);
-                snprintf(allowed + used, sizeof allowed - used, "%s%s", k > 0 ? ", " : "",
-                         specs[k].name);
+                wx_list_append(allowed, sizeof allowed, specs[k].name);
             }
             return fail(p, node, "unknown attribute '%s' of <%s> (allowed: %s)", name,
                         name_of(node), count > 0 ? allowed : "none");
@@ -817,9 +814,7 @@ static wx_result parse_children(parser *p, const xmlNode *parent, const child_sp
         if (i == count) {
             char allowed[512] = "";
             for (int k = 0; k < count; ++k) {
-                size_t used = strlen(allowed);
-                snprintf(allowed + used, sizeof allowed - used, "%s%s", k > 0 ? ", " : "",
-                         specs[k].name);
+                wx_list_append(allowed, sizeof allowed, specs[k].name);
             }
             return fail(p, n, "unknown element <%s%s%s> in <%s> (allowed: %s)",
                         n->ns != NULL && n->ns->prefix != NULL ? (const char *)n->ns->prefix : "",

@@ -736,34 +736,13 @@ wx_sim_config wx_sim_default_config(const wx_scene *scene)
 
 static wx_result load_maps(wx_sim *sim, wx_error *err)
 {
-    const wx_scene *scene = sim->scene;
     sim->owned_maps = calloc((size_t)(sim->input_count > 0 ? sim->input_count : 1),
                              sizeof *sim->owned_maps);
     if (sim->owned_maps == NULL) {
         return wx_error_set(err, WX_FAIL, "out of memory (maps)");
     }
-    for (int c = 0; c < sim->input_count; ++c) {
-        const wx_scene_camera *cam = &scene->cameras[sim->input_camera[c]];
-        if (cam->depth_path[0] == '\0') {
-            return wx_error_set(err, WX_BAD_INPUT,
-                                "%s: camera '%s' has no maps yet; run `weathering bake` first",
-                                scene->path, cam->name);
-        }
-        unsigned which = WX_MAPS_DEPTH | WX_MAPS_NORMAL | WX_MAPS_IMPACT;
-        if (cam->dirt_path[0] != '\0') {
-            // A dirt map that an earlier `simulate` wrote starts from the dirt it
-            // started from (channel initialDirt), so running again is repeatable.
-            which |= WX_MAPS_DIRT | WX_MAPS_INITIAL_DIRT;
-        }
-        wx_result r = wx_maps_load(&sim->owned_maps[c], which, cam->depth_path, cam->normal_path,
-                                   cam->impact_path, cam->dirt_path, err);
-        if (r != WX_OK) {
-            wx_error_prefix(err, "camera '%s'", cam->name);
-            return r;
-        }
-    }
     sim->maps = sim->owned_maps;
-    return WX_OK;
+    return wx_load_simulation_maps(sim->scene, sim->owned_maps, err);
 }
 
 static wx_result start_pool(wx_sim *sim, wx_error *err)
@@ -1036,7 +1015,7 @@ wx_result wx_sim_spawn(wx_sim *sim, const float position[3], const float velocit
 // --- output -----------------------------------------------------------------------
 
 static wx_result write_one(const wx_sim *sim, const wx_run_options *opts, int c, wx_image *image,
-                           wx_image *header, wx_error *err)
+                           wx_error *err)
 {
     const wx_scene_camera *cam = &sim->scene->cameras[sim->input_camera[c]];
     const wx_dirt_map *map = &sim->dirt[c];
@@ -1062,13 +1041,10 @@ static wx_result write_one(const wx_sim *sim, const wx_run_options *opts, int c,
         image->channels[2][t] = maps->erosion != NULL ? maps->erosion[t] : 0.0f;
         image->channels[3][t] = maps->dirt != NULL ? maps->dirt[t] : 0.0f;
     }
-    // The input dirt map's header travels with it.
-    if (cam->dirt_path[0] != '\0' && wx_exr_read_header(cam->dirt_path, header, err) == WX_OK) {
-        for (int a = 0; a < header->attr_count && image->attr_count < WX_IMAGE_MAX_ATTRS; ++a) {
-            image->attrs[image->attr_count++] = header->attrs[a];
-        }
+    // The input dirt map's header travels with it (kept when the map was read).
+    for (int a = 0; a < maps->dirt_attr_count && image->attr_count < WX_IMAGE_MAX_ATTRS; ++a) {
+        image->attrs[image->attr_count++] = maps->dirt_attrs[a];
     }
-    wx_image_free(header);
     if (wx_image_find_attr(image, "WTCMatrix") == NULL) {
         wx_image_set_m44f(image, "WTCMatrix", cam->camera.wtc);
     }
@@ -1086,24 +1062,25 @@ static wx_result write_one(const wx_sim *sim, const wx_run_options *opts, int c,
 wx_result wx_sim_write_dirt_maps(const wx_sim *sim, const wx_run_options *opts, wx_error *err)
 {
     // Images carry their attributes inline (tens of kilobytes): not on the stack.
-    wx_image *images = calloc(2, sizeof *images);
-    if (images == NULL) {
+    wx_image *image = calloc(1, sizeof *image);
+    if (image == NULL) {
         return wx_error_set(err, WX_FAIL, "out of memory (dirt maps)");
     }
     wx_result r = WX_OK;
     for (int c = 0; c < sim->input_count && r == WX_OK; ++c) {
-        r = write_one(sim, opts, c, &images[0], &images[1], err);
+        r = write_one(sim, opts, c, image, err);
     }
-    free(images);
+    free(image);
     return r;
 }
 
-wx_result wx_simulate_scene(const wx_scene *scene, const wx_run_options *opts,
-                            wx_sim_stats *stats, wx_error *err)
+wx_result wx_simulate_maps(const wx_scene *scene, const wx_run_options *opts, wx_maps *maps,
+                           wx_sim_stats *stats, wx_error *err)
 {
     wx_sim_config config = wx_sim_default_config(scene);
     config.seed = opts->seed;
     config.threads = opts->threads;
+    config.maps = maps;
     wx_sim *sim = NULL;
     wx_result r = wx_sim_create(scene, &config, &sim, err);
     if (r != WX_OK) {
@@ -1122,6 +1099,45 @@ wx_result wx_simulate_scene(const wx_scene *scene, const wx_run_options *opts,
     if (stats != NULL) {
         wx_sim_get_stats(sim, stats);
     }
+    // What the gather reads: the dirt as the written maps hold it (float), the
+    // planes only the simulation needed released.
+    for (int c = 0; c < sim->input_count && r == WX_OK; ++c) {
+        wx_maps *m = &maps[c];
+        size_t texels = (size_t)m->width * (size_t)m->height;
+        if (m->dirt == NULL) {
+            m->dirt = malloc(texels * sizeof *m->dirt);
+            if (m->dirt == NULL) {
+                r = wx_error_set(err, WX_FAIL, "out of memory (dirt maps)");
+                break;
+            }
+        }
+        const wx_dirt_map *dirt = &sim->dirt[c];
+        for (size_t t = 0; t < texels; ++t) {
+            m->dirt[t] = (float)dirt->texels[t].dirt;
+        }
+        free(m->impact);
+        free(m->deposit);
+        free(m->erosion);
+        m->impact = m->deposit = m->erosion = NULL;
+    }
     wx_sim_destroy(sim);
+    return r;
+}
+
+wx_result wx_simulate_scene(const wx_scene *scene, const wx_run_options *opts,
+                            wx_sim_stats *stats, wx_error *err)
+{
+    wx_maps *maps = calloc((size_t)scene->input_count + 1, sizeof *maps);
+    if (maps == NULL) {
+        return wx_error_set(err, WX_FAIL, "out of memory (maps)");
+    }
+    wx_result r = wx_load_simulation_maps(scene, maps, err);
+    if (r == WX_OK) {
+        r = wx_simulate_maps(scene, opts, maps, stats, err);
+    }
+    for (int c = 0; c < scene->input_count; ++c) {
+        wx_maps_free(&maps[c]);
+    }
+    free(maps);
     return r;
 }

@@ -107,6 +107,14 @@ wx_result wx_sim_spawn(wx_sim *sim, const float position[3], const float velocit
 /// the camera when it has none).
 wx_result wx_sim_write_dirt_maps(const wx_sim *sim, const wx_run_options *opts, wx_error *err);
 
+/// The `simulate` phase on maps already in memory (one per input camera, scene
+/// order, as wx_load_simulation_maps reads them): runs scene->steps steps,
+/// writes opts->out_dir/<camera>_dirt.exr for each input camera, fills
+/// `stats`, and leaves in each maps[c].dirt the simulated dirt as written
+/// (impact, deposit and erosion released): what the gather reads next.
+wx_result wx_simulate_maps(const wx_scene *scene, const wx_run_options *opts, wx_maps *maps,
+                           wx_sim_stats *stats, wx_error *err);
+
 /// The `simulate` phase: loads every input camera's maps from the scene's
 /// paths, runs scene->steps steps (progress bar unless opts->quiet), writes
 /// opts->out_dir/<camera>_dirt.exr for each input camera and fills `stats`.
