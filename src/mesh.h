@@ -5,6 +5,15 @@
 // none (smoothing across edges sharper than WX_MESH_SMOOTHING_ANGLE_DEG is not
 // done, so a box keeps flat faces), joins identical vertices and applies the
 // node transforms. The aiScene is released as soon as the arrays are built.
+// Assimp reads through our own file system: regular files only (a FIFO, a
+// device or a folder is refused, never waited on), and besides the mesh file
+// only files inside the mesh's folder (after realpath), so an OBJ's mtllib or a
+// glTF buffer URI cannot reach elsewhere. A referenced file that is not there
+// is no refusal: Assimp does without it, as before (an OBJ without its .mtl).
+// Positions come out in metres where the file states a unit Assimp leaves to
+// us: FBX's UnitScaleFactor (centimetres per file unit). Collada's <unit> and
+// 3DS's master scale are applied by Assimp; glTF is metres; OBJ, PLY and STL
+// have no unit and are taken as metres.
 // Positions are stored relative to `origin` (the centre of the bounds), so that
 // float keeps its precision for models far from the world origin. Every vertex
 // belongs to triangles of one material only (each Assimp mesh has one material
@@ -41,10 +50,16 @@ typedef struct wx_mesh_data {
     double bounds_max[3];
 } wx_mesh_data;
 
-/// Imports a mesh file. A missing, unreadable or unsupported file, or one with a
-/// vertex that is not finite, gives WX_BAD_INPUT with a message naming the file
-/// and Assimp's reason; WX_FAIL when out of memory. A file without triangles
-/// imports with triangle_count 0. On failure `out` is left empty (safe to free).
+/// Imports a mesh file. WX_BAD_INPUT, with a message naming the file, when it
+/// is missing ("not found"), not a regular file, unreadable or unsupported
+/// (Assimp's reason), when it refers to a file that is not a regular file or
+/// lies outside its folder ("refers to 'x.mtl', which is not a regular file (a
+/// FIFO)", "refers to '../a.bin', outside the mesh's folder"), when a vertex
+/// position, a vertex colour or a normal given in the file is not a finite
+/// number, or when an FBX unit is not positive. Normals Assimp generates for
+/// triangles too large for float stay 0. WX_FAIL when out of memory, inside
+/// Assimp (std::bad_alloc) too. A file without triangles imports with
+/// triangle_count 0. On failure `out` is left empty (safe to free).
 wx_result wx_mesh_import(const char *path, wx_mesh_data *out, wx_error *err);
 
 /// Frees the vertex and triangle arrays only (once uploaded), keeping counts,

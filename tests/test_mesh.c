@@ -1,9 +1,25 @@
-// test_mesh.c: Assimp import into flat arrays (src/mesh.c).
+// test_mesh.c: Assimp import into flat arrays (src/mesh.c): the file system
+// Assimp reads through (regular files inside the mesh's folder only), values
+// refused at import, out of memory inside Assimp, and the FBX unit.
+#include <signal.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include "ensure.h"
 #include "mesh.h"
+
+#if defined(__SANITIZE_ADDRESS__)
+#define WX_ASAN 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define WX_ASAN 1
+#endif
+#endif
 
 static const char *data_path(const char *name)
 {
@@ -159,8 +175,9 @@ TEST(missing_file_names_it)
     wx_error err = { "" };
     const char *path = data_path("bake_no_such_mesh.obj");
     ENSURE(wx_mesh_import(path, &m, &err) == WX_BAD_INPUT);
-    ENSURE(ensure_contains(err.message, "bake_no_such_mesh.obj"));
-    ENSURE(ensure_contains(err.message, "cannot import"));
+    char want[4200];
+    snprintf(want, sizeof want, "%s: not found", path);
+    ENSURE(strcmp(err.message, want) == 0);
     ENSURE(m.positions == NULL && m.triangle_count == 0);
     wx_mesh_data_free(&m);
 }
@@ -187,6 +204,463 @@ TEST(lines_only_give_no_triangles)
     wx_mesh_data_free(&m);
 }
 
+
+// --- helpers ------------------------------------------------------------------
+
+static const char *const TRIANGLE_OBJ = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+
+// A folder `name` in this program's temporary folder; returns its path.
+static const char *make_dir(const char *name)
+{
+    static char paths[4][4096];
+    static int next;
+    char *p = paths[next];
+    next = (next + 1) % 4;
+    snprintf(p, 4096, "%s/%s", ensure_tmpdir(), name);
+    mkdir(p, 0777);
+    return p;
+}
+
+// `dir`/`name` as a path (ring of 8).
+static const char *join(const char *dir, const char *name)
+{
+    static char paths[8][4200];
+    static int next;
+    char *p = paths[next];
+    next = (next + 1) % 8;
+    snprintf(p, 4200, "%s/%s", dir, name);
+    return p;
+}
+
+// The triangle (0,0,0) (2,0,0) (0,3,0) as glTF's 36 bytes of little-endian floats.
+static bool write_triangle_bin(const char *path)
+{
+    const float v[9] = { 0, 0, 0, 2, 0, 0, 0, 3, 0 };
+    FILE *f = fopen(path, "wb");
+    bool ok = f != NULL && fwrite(v, sizeof v, 1, f) == 1;
+    return f != NULL && fclose(f) == 0 && ok;
+}
+
+// A glTF with one triangle whose 36-byte buffer is at `uri`.
+static const char *write_gltf(const char *dir, const char *name, const char *uri)
+{
+    char text[4600];
+    snprintf(text, sizeof text,
+             "{ \"asset\": { \"version\": \"2.0\" }, \"scene\": 0,\n"
+             "  \"scenes\": [ { \"nodes\": [ 0 ] } ], \"nodes\": [ { \"mesh\": 0 } ],\n"
+             "  \"meshes\": [ { \"primitives\": [ { \"attributes\": { \"POSITION\": 0 } } ] } ],\n"
+             "  \"buffers\": [ { \"byteLength\": 36, \"uri\": \"%s\" } ],\n"
+             "  \"bufferViews\": [ { \"buffer\": 0, \"byteOffset\": 0, \"byteLength\": 36 } ],\n"
+             "  \"accessors\": [ { \"bufferView\": 0, \"componentType\": 5126, \"count\": 3,\n"
+             "                   \"type\": \"VEC3\" } ] }\n",
+             uri);
+    return ensure_write_file(dir, name, text);
+}
+
+// Imports `path` and compares the message with "<path>: <rest>" exactly.
+static bool refused_with(const char *path, wx_result code, const char *rest)
+{
+    wx_mesh_data m;
+    wx_error err = { "" };
+    wx_result r = wx_mesh_import(path, &m, &err);
+    char want[WX_ERROR_MAX + 8];
+    snprintf(want, sizeof want, "%s: %s", path, rest);
+    bool ok = r == code && strcmp(err.message, want) == 0 && m.positions == NULL &&
+              m.triangle_count == 0;
+    if (!ok) {
+        fprintf(stderr, "    expected %d \"%s\"\n    got      %d \"%s\"\n", (int)code, want,
+                (int)r, err.message);
+    }
+    wx_mesh_data_free(&m);
+    return ok;
+}
+
+// The result of wx_mesh_import in a child process (after chdir to `dir` when
+// not NULL, under an address-space limit `extra_bytes` above its present size
+// when > 0). False when the child did not exit normally.
+typedef struct child_result {
+    int code;
+    long long triangles;
+    char message[WX_ERROR_MAX];
+} child_result;
+
+static long long address_space_bytes(void)
+{
+    FILE *f = fopen("/proc/self/statm", "r");
+    long long pages = 0;
+    if (f == NULL || fscanf(f, "%lld", &pages) != 1) {
+        pages = 0;
+    }
+    if (f != NULL) {
+        fclose(f);
+    }
+    return pages * (long long)sysconf(_SC_PAGESIZE);
+}
+
+static bool import_in_child(const char *dir, const char *path, long long extra_bytes,
+                            child_result *out)
+{
+    memset(out, 0, sizeof *out);
+    int fds[2];
+    if (pipe(fds) != 0) {
+        return false;
+    }
+    fflush(NULL);
+    pid_t pid = fork();
+    if (pid == 0) {
+        close(fds[0]);
+        alarm(60);
+        if (dir != NULL && chdir(dir) != 0) {
+            _exit(3);
+        }
+        if (extra_bytes > 0) {
+            struct rlimit rl;
+            rl.rlim_cur = rl.rlim_max = (rlim_t)(address_space_bytes() + extra_bytes);
+            if (setrlimit(RLIMIT_AS, &rl) != 0) {
+                _exit(4);
+            }
+        }
+        wx_mesh_data m;
+        child_result res = { 0 };
+        wx_error err = { "" };
+        res.code = (int)wx_mesh_import(path, &m, &err);
+        res.triangles = m.triangle_count;
+        memcpy(res.message, err.message, sizeof res.message);
+        ssize_t n = write(fds[1], &res, sizeof res);
+        _exit(n == (ssize_t)sizeof res ? 0 : 5); // _exit: no atexit (ensure's tmpdir removal)
+    }
+    close(fds[1]);
+    ssize_t got = 0;
+    while (pid > 0 && got < (ssize_t)sizeof *out) {
+        ssize_t n = read(fds[0], (char *)out + got, sizeof *out - (size_t)got);
+        if (n <= 0) {
+            break;
+        }
+        got += n;
+    }
+    close(fds[0]);
+    int status = 0;
+    if (pid < 0 || waitpid(pid, &status, 0) != pid) {
+        return false;
+    }
+    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+        fprintf(stderr, "    child: %s %d\n", WIFEXITED(status) ? "exit" : "signal",
+                WIFEXITED(status) ? WEXITSTATUS(status) : WTERMSIG(status));
+        return false;
+    }
+    return got == (ssize_t)sizeof *out;
+}
+
+// --- the mesh file itself -------------------------------------------------------
+
+TEST(mesh_file_must_be_a_regular_file)
+{
+    const char *dir = make_dir("itself");
+    alarm(30); // a FIFO opened for reading without O_NONBLOCK would wait here forever
+    const char *fifo = join(dir, "fifo.obj");
+    ENSURE(mkfifo(fifo, 0666) == 0);
+    ENSURE(refused_with(fifo, WX_BAD_INPUT, "is not a regular file (a FIFO)"));
+    alarm(0);
+    const char *folder = join(dir, "folder.obj");
+    ENSURE(mkdir(folder, 0777) == 0);
+    ENSURE(refused_with(folder, WX_BAD_INPUT, "is not a regular file (a folder)"));
+    const char *loop = join(dir, "loop.obj");
+    ENSURE(symlink("loop.obj", loop) == 0);
+    ENSURE(refused_with(loop, WX_BAD_INPUT, "is not a regular file (a loop of symbolic links)"));
+    ENSURE(refused_with("/dev/null", WX_BAD_INPUT, "is not a regular file (a device)"));
+    ENSURE(refused_with(join(dir, "nowhere.obj"), WX_BAD_INPUT, "not found"));
+    // A symbolic link to a regular file is that file.
+    ensure_write_file(dir, "real.obj", TRIANGLE_OBJ);
+    ENSURE(symlink("real.obj", join(dir, "link.obj")) == 0);
+    wx_mesh_data m;
+    wx_error err = { "" };
+    ENSURE(wx_mesh_import(join(dir, "link.obj"), &m, &err) == WX_OK);
+    ENSURE(m.triangle_count == 1);
+    wx_mesh_data_free(&m);
+}
+
+// --- the files a mesh refers to ---------------------------------------------------
+
+TEST(obj_mtllib_fifo_is_refused_without_blocking)
+{
+    const char *dir = make_dir("fifo_mtl");
+    const char *obj = ensure_write_file(dir, "a.obj",
+                                        "mtllib x.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\n"
+                                        "usemtl Wood\nf 1 2 3\n");
+    ENSURE(mkfifo(join(dir, "x.mtl"), 0666) == 0);
+    alarm(30);
+    ENSURE(refused_with(obj, WX_BAD_INPUT,
+                        "refers to 'x.mtl', which is not a regular file (a FIFO)"));
+    alarm(0);
+}
+
+TEST(obj_mtllib_outside_or_a_folder_is_refused)
+{
+    const char *dir = make_dir("mtl_outside");
+    const char *sub = make_dir("mtl_outside/m");
+    ensure_write_file(dir, "shared.mtl", "newmtl Wood\nKd 1 0 0\n");
+    const char *obj = ensure_write_file(sub, "a.obj",
+                                        "mtllib ../shared.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\n"
+                                        "usemtl Wood\nf 1 2 3\n");
+    ENSURE(refused_with(obj, WX_BAD_INPUT, "refers to '../shared.mtl', outside the mesh's folder"));
+    // Through a symbolic link inside the folder: realpath sees where it leads.
+    ENSURE(symlink("../shared.mtl", join(sub, "link.mtl")) == 0);
+    obj = ensure_write_file(sub, "b.obj", "mtllib link.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    ENSURE(refused_with(obj, WX_BAD_INPUT, "refers to 'link.mtl', outside the mesh's folder"));
+    // The mesh's own folder named as the library.
+    obj = ensure_write_file(sub, "c.obj", "mtllib .\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    ENSURE(refused_with(obj, WX_BAD_INPUT,
+                        "refers to '.', which is not a regular file (a folder)"));
+    // The same library inside the folder (a subfolder) is read: its material name arrives.
+    const char *lib = make_dir("mtl_outside/m/lib");
+    ensure_write_file(lib, "shared.mtl", "newmtl Wood\nKd 1 0 0\n");
+    obj = ensure_write_file(sub, "d.obj",
+                            "mtllib lib/shared.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl Wood\n"
+                            "f 1 2 3\n");
+    wx_mesh_data m;
+    wx_error err = { "" };
+    ENSURE(wx_mesh_import(obj, &m, &err) == WX_OK);
+    ENSURE(m.material_count == 1 && strcmp(m.material_names[0], "Wood") == 0);
+    wx_mesh_data_free(&m);
+}
+
+TEST(obj_without_its_mtl_imports_as_before)
+{
+    // A library that is not there is only a probe: Assimp carries on, as it did
+    // with its own IO system.
+    const char *dir = make_dir("mtl_missing");
+    const char *obj = ensure_write_file(dir, "a.obj",
+                                        "mtllib missing.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\n"
+                                        "usemtl Wood\nf 1 2 3\n");
+    wx_mesh_data m;
+    wx_error err = { "" };
+    ENSURE(wx_mesh_import(obj, &m, &err) == WX_OK);
+    ENSURE(m.triangle_count == 1);
+    // Assimp 5.2.5 makes a material of the usemtl name (and DefaultMaterial, unused).
+    ENSURE(m.material_count == 1 && strcmp(m.material_names[0], "Wood") == 0);
+    wx_mesh_data_free(&m);
+    // Without usemtl the triangle has Assimp's DefaultMaterial.
+    obj = ensure_write_file(dir, "b.obj",
+                            "mtllib missing.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    ENSURE(wx_mesh_import(obj, &m, &err) == WX_OK);
+    ENSURE(m.material_count == 1 && strcmp(m.material_names[0], "DefaultMaterial") == 0);
+    wx_mesh_data_free(&m);
+}
+
+TEST(gltf_buffers_inside_the_folder_are_read)
+{
+    const char *dir = make_dir("gltf_inside");
+    const char *bin = make_dir("gltf_inside/bin");
+    ENSURE(write_triangle_bin(join(bin, "tri.bin")));
+    ENSURE(symlink("bin/tri.bin", join(dir, "link.bin")) == 0); // a link that stays inside
+    const char *uris[] = { "bin/tri.bin", "link.bin", "./bin/../bin/tri.bin" };
+    for (int k = 0; k < 3; ++k) {
+        const char *gltf = write_gltf(dir, "a.gltf", uris[k]);
+        wx_mesh_data m;
+        wx_error err = { "" };
+        ENSURE(wx_mesh_import(gltf, &m, &err) == WX_OK);
+        ENSURE(m.triangle_count == 1 && m.vertex_count == 3);
+        ENSURE_NEAR(m.bounds_min[0], 0.0, 0.0);
+        ENSURE_NEAR(m.bounds_max[0], 2.0, 0.0);
+        ENSURE_NEAR(m.bounds_max[1], 3.0, 0.0);
+        ENSURE_NEAR(m.bounds_max[2], 0.0, 0.0);
+        wx_mesh_data_free(&m);
+    }
+}
+
+TEST(gltf_buffer_outside_the_folder_is_refused)
+{
+    // outer.bin is a valid buffer: without the check each of these imports it.
+    const char *dir = make_dir("gltf_outside");
+    const char *sub = make_dir("gltf_outside/m");
+    ENSURE(write_triangle_bin(join(dir, "outer.bin")));
+    const char *gltf = write_gltf(sub, "a.gltf", "../outer.bin");
+    ENSURE(refused_with(gltf, WX_BAD_INPUT, "refers to '../outer.bin', outside the mesh's folder"));
+    ENSURE(symlink("../outer.bin", join(sub, "link.bin")) == 0);
+    gltf = write_gltf(sub, "b.gltf", "link.bin");
+    ENSURE(refused_with(gltf, WX_BAD_INPUT, "refers to 'link.bin', outside the mesh's folder"));
+    // An absolute URI: Assimp 5.2.5 joins it to the mesh's folder ("m//etc/passwd",
+    // that is m/etc/passwd), which is not there: its own message, nothing read.
+    gltf = write_gltf(sub, "d.gltf", "/etc/passwd");
+    ENSURE(refused_with(gltf, WX_BAD_INPUT,
+                        "cannot import mesh: GLTF: could not open referenced file "
+                        "\"/etc/passwd\""));
+    // A climbing URI that names nothing is only a probe: Assimp's own message.
+    gltf = write_gltf(sub, "e.gltf", "../missing.bin");
+    ENSURE(refused_with(gltf, WX_BAD_INPUT,
+                        "cannot import mesh: GLTF: could not open referenced file "
+                        "\"../missing.bin\""));
+    // A mesh named without a folder: Assimp then opens an absolute URI as it is
+    // (the default IO system would read /etc/passwd as the buffer).
+    gltf = write_gltf(sub, "f.gltf", "/etc/passwd");
+    child_result res;
+    ENSURE(import_in_child(sub, "f.gltf", 0, &res));
+    ENSURE(res.code == WX_BAD_INPUT);
+    ENSURE(strcmp(res.message, "f.gltf: refers to '/etc/passwd', outside the mesh's folder") == 0);
+    gltf = write_gltf(sub, "g.gltf", "../outer.bin");
+    ENSURE(import_in_child(sub, "g.gltf", 0, &res));
+    ENSURE(res.code == WX_BAD_INPUT);
+    ENSURE(strcmp(res.message, "g.gltf: refers to '../outer.bin', outside the mesh's folder") == 0);
+}
+
+// --- values refused at import ----------------------------------------------------------
+
+TEST(non_finite_vertex_colours_are_refused)
+{
+    const char *dir = make_dir("colours");
+    const char *obj = ensure_write_file(dir, "nan.obj",
+                                        "v 0 0 0 0.5 0.5 0.5\nv 1 0 0 nan 0.5 0.5\n"
+                                        "v 0 1 0 0.5 0.5 0.5\nf 1 2 3\n");
+    ENSURE(refused_with(obj, WX_BAD_INPUT,
+                        "the vertex at (1, 0, 0) has a colour that is not a finite number "
+                        "(nan, 0.5, 0.5, 1)"));
+    obj = ensure_write_file(dir, "inf.obj",
+                            "v 0 0 0 0.5 0.5 0.5\nv 1 0 0 0.5 0.5 0.5\n"
+                            "v 0 2 0 0.5 0.5 inf\nf 1 2 3\n");
+    ENSURE(refused_with(obj, WX_BAD_INPUT,
+                        "the vertex at (0, 2, 0) has a colour that is not a finite number "
+                        "(0.5, 0.5, inf, 1)"));
+    // Finite colours of an OBJ arrive as they are (alpha 1).
+    obj = ensure_write_file(dir, "ok.obj",
+                            "v 0 0 0 0.25 0.5 0.75\nv 1 0 0 0.25 0.5 0.75\n"
+                            "v 0 1 0 0.25 0.5 0.75\nf 1 2 3\n");
+    wx_mesh_data m;
+    wx_error err = { "" };
+    ENSURE(wx_mesh_import(obj, &m, &err) == WX_OK);
+    ENSURE(m.colors != NULL && m.vertex_count == 3);
+    for (int64_t v = 0; v < m.vertex_count; ++v) {
+        ENSURE(m.colors[4 * v] == 0.25f && m.colors[4 * v + 1] == 0.5f);
+        ENSURE(m.colors[4 * v + 2] == 0.75f && m.colors[4 * v + 3] == 1.0f);
+    }
+    wx_mesh_data_free(&m);
+}
+
+TEST(non_finite_normals_of_the_file_are_refused)
+{
+    const char *dir = make_dir("normals");
+    const char *obj = ensure_write_file(dir, "nan.obj",
+                                        "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nvn nan 0 1\n"
+                                        "f 1//1 2//2 3//1\n");
+    ENSURE(refused_with(obj, WX_BAD_INPUT,
+                        "the vertex at (1, 0, 0) has a normal that is not a finite number "
+                        "(nan, 0, 1)"));
+    obj = ensure_write_file(dir, "inf.obj",
+                            "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nvn 0 -inf 0\n"
+                            "f 1//1 2//1 3//2\n");
+    ENSURE(refused_with(obj, WX_BAD_INPUT,
+                        "the vertex at (0, 1, 0) has a normal that is not a finite number "
+                        "(0, -inf, 0)"));
+}
+
+TEST(generated_normals_of_huge_triangles_stay_zero)
+{
+    // Finite positions whose cross product overflows float: Assimp generates NaN
+    // normals, which are Assimp's doing, not the file's: kept as 0 (degenerate).
+    const char *obj = ensure_write_file(make_dir("huge"), "huge.obj",
+                                        "v 0 0 0\nv 1e20 0 0\nv 0 1e20 0\nf 1 2 3\n");
+    wx_mesh_data m;
+    wx_error err = { "" };
+    ENSURE(wx_mesh_import(obj, &m, &err) == WX_OK);
+    ENSURE(m.triangle_count == 1);
+    ENSURE_NEAR(m.bounds_max[0], 1e20, 1e13);
+    for (int64_t k = 0; k < 3 * m.vertex_count; ++k) {
+        ENSURE(m.normals[k] == 0.0f);
+    }
+    wx_mesh_data_free(&m);
+}
+
+// --- out of memory -----------------------------------------------------------------------
+
+TEST(out_of_memory_inside_assimp_is_a_failure_not_bad_input)
+{
+#ifdef WX_ASAN
+    printf("        (skipped under AddressSanitizer, which aborts when its own mappings fail)\n");
+    return;
+#endif
+    const char *preload = getenv("LD_PRELOAD");
+    if (preload != NULL && strstr(preload, "valgrind") != NULL) {
+        printf("        (skipped under valgrind, which aborts when operator new fails)\n");
+        return;
+    }
+    // The bunny (69,451 triangles, 2.4 MB) needs about 90 MB of address space
+    // to import; with 16 MiB more than the child has, Assimp's allocations fail.
+    char bunny[4200];
+    snprintf(bunny, sizeof bunny, "%s/../xml_scenes/meshes/stanford-bunny.obj",
+             ensure_tests_dir());
+    child_result res;
+    ENSURE(import_in_child(NULL, bunny, 16LL << 20, &res));
+    ENSURE(res.code == WX_FAIL);
+    char want[4400];
+    // What Assimp 5.2.5 reports: std::bad_alloc's what(), caught in the importer.
+    snprintf(want, sizeof want,
+             "%s: out of memory while importing the mesh (Assimp: std::bad_alloc)", bunny);
+    if (strcmp(res.message, want) != 0) {
+        fprintf(stderr, "    got \"%s\"\n", res.message);
+    }
+    ENSURE(strcmp(res.message, want) == 0);
+    ENSURE(res.triangles == 0);
+    // The same child with room enough imports it.
+    ENSURE(import_in_child(NULL, bunny, 1LL << 30, &res));
+    ENSURE(res.code == WX_OK);
+    ENSURE(res.triangles == 69451);
+}
+
+// --- units -------------------------------------------------------------------------------
+
+TEST(fbx_from_blender_arrives_in_metres)
+{
+    // tests/data/mesh_cube_2m_fbx.py: a 2 m cube at Blender (1, 2, 3), which the
+    // exporter's axes put at (1, 3, -2). mesh_cube_2m.fbx is in centimetres
+    // (UnitScaleFactor 1, object scale 100, translation (100, 300, -200)),
+    // mesh_cube_2m_units.fbx in metres (UnitScaleFactor 100, scale 1).
+    const char *files[] = { "mesh_cube_2m.fbx", "mesh_cube_2m_units.fbx" };
+    for (int f = 0; f < 2; ++f) {
+        wx_mesh_data m;
+        wx_error err = { "" };
+        ENSURE(wx_mesh_import(data_path(files[f]), &m, &err) == WX_OK);
+        ENSURE(m.triangle_count == 12 && m.vertex_count == 24);
+        const double lo[3] = { 0, 2, -3 }, hi[3] = { 2, 4, -1 }, mid[3] = { 1, 3, -2 };
+        for (int i = 0; i < 3; ++i) {
+            ENSURE_NEAR(m.bounds_min[i], lo[i], 1e-4);
+            ENSURE_NEAR(m.bounds_max[i], hi[i], 1e-4);
+            ENSURE_NEAR(m.origin[i], mid[i], 1e-4);
+        }
+        for (int64_t v = 0; v < m.vertex_count; ++v) {
+            // Every corner is 1 m from the centre along each axis; normals stay unit.
+            const float *p = &m.positions[3 * v], *n = &m.normals[3 * v];
+            double len = 0.0;
+            for (int i = 0; i < 3; ++i) {
+                ENSURE_NEAR(fabs(p[i]), 1.0, 1e-4);
+                len += (double)n[i] * n[i];
+            }
+            ENSURE_NEAR(len, 1.0, 1e-6);
+        }
+        wx_mesh_data_free(&m);
+    }
+}
+
+TEST(fbx_unit_that_is_not_positive_is_refused)
+{
+    // mesh_cube_2m.fbx with UnitScaleFactor -1 (tests/bad/mesh/).
+    char path[4200];
+    snprintf(path, sizeof path, "%s/bad/mesh/fbx_negative_unit.fbx", ensure_tests_dir());
+    ENSURE(refused_with(path, WX_BAD_INPUT,
+                        "the FBX unit (UnitScaleFactor -1 centimetres) is not a positive number"));
+}
+
+TEST(formats_without_a_unit_are_left_as_they_are)
+{
+    // OBJ and glTF: no scale applied (bake_box.obj spans -1..1; the transform test
+    // covers glTF node transforms).
+    wx_mesh_data m;
+    wx_error err = { "" };
+    ENSURE(wx_mesh_import(data_path("bake_box.obj"), &m, &err) == WX_OK);
+    for (int i = 0; i < 3; ++i) {
+        ENSURE(m.bounds_min[i] == -1.0 && m.bounds_max[i] == 1.0);
+    }
+    wx_mesh_data_free(&m);
+}
+
 int main(void)
 {
     RUN(two_materials_keep_their_names);
@@ -196,5 +670,18 @@ int main(void)
     RUN(missing_file_names_it);
     RUN(unsupported_file_names_it);
     RUN(lines_only_give_no_triangles);
+    RUN(mesh_file_must_be_a_regular_file);
+    RUN(obj_mtllib_fifo_is_refused_without_blocking);
+    RUN(obj_mtllib_outside_or_a_folder_is_refused);
+    RUN(obj_without_its_mtl_imports_as_before);
+    RUN(gltf_buffers_inside_the_folder_are_read);
+    RUN(gltf_buffer_outside_the_folder_is_refused);
+    RUN(non_finite_vertex_colours_are_refused);
+    RUN(non_finite_normals_of_the_file_are_refused);
+    RUN(generated_normals_of_huge_triangles_stay_zero);
+    RUN(out_of_memory_inside_assimp_is_a_failure_not_bad_input);
+    RUN(fbx_from_blender_arrives_in_metres);
+    RUN(fbx_unit_that_is_not_positive_is_refused);
+    RUN(formats_without_a_unit_are_left_as_they_are);
     return ensure_summary();
 }
