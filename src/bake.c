@@ -272,10 +272,14 @@ static wx_result ensure_framebuffer(baker *b, int width, int height, wx_error *e
     }
     GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
     if (status != GL_FRAMEBUFFER_COMPLETE) {
+        // llvmpipe reports a storage it could not allocate as an incomplete
+        // attachment, not as GL_OUT_OF_MEMORY: every format here is renderable.
         b->fb_width = b->fb_height = 0;
+        double mib = (double)width * (double)height * 40.0 / (1024.0 * 1024.0);
         return wx_error_set(err, WX_FAIL,
-                            "bake: the %d x %d float framebuffer is incomplete (status 0x%04x)",
-                            width, height, (unsigned)status);
+                            "bake: out of memory for the %d x %d float framebuffer (about %.0f "
+                            "MiB; OpenGL status 0x%04x)",
+                            width, height, mib, (unsigned)status);
     }
     b->fb_width = width;
     b->fb_height = height;
@@ -1109,12 +1113,8 @@ wx_result wx_bake_scene_stats(wx_scene *scene, const wx_run_options *opts,
 {
     wx_geometry geometry;
     memset(&geometry, 0, sizeof geometry);
-    bool bakes = false;
-    for (int c = 0; c < scene->camera_count; ++c) {
-        bakes = bakes || (scene->cameras[c].has_view && scene->cameras[c].depth_path[0] == '\0');
-    }
     wx_result r = WX_OK;
-    if (bakes && scene->mesh_count > 0) {
+    if (wx_scene_needs_bake(scene) && scene->mesh_count > 0) {
         r = wx_geometry_load(scene, opts->quiet, &geometry, err);
     }
     if (r == WX_OK) {

@@ -14,6 +14,8 @@
 #include <unistd.h>
 
 #include "atomic_file.h"
+#include "emitter.h"
+#include "geometry.h"
 #include "pipeline.h"
 #include "run.h"
 #include "progress.h"
@@ -229,12 +231,6 @@ static const char *field_name(wx_field_kind kind)
     return "?";
 }
 
-static double emitter_particle_count(const wx_emitter *e, double duration)
-{
-    double end = e->end < duration ? e->end : duration;
-    return end > e->start ? floor(e->rate * (end - e->start)) : 0.0;
-}
-
 static void print_camera(const wx_scene_camera *sc)
 {
     const wx_camera *cam = &sc->camera;
@@ -265,6 +261,20 @@ static int command_info(const cli_args *args)
     if (status != WX_OK) {
         return status;
     }
+    // The meshes are read as bake reads them, so that info refuses what bake
+    // would, before it prints anything.
+    wx_geometry geometry;
+    memset(&geometry, 0, sizeof geometry);
+    bool imported = wx_scene_needs_bake(&scene) && scene.mesh_count > 0;
+    if (imported) {
+        wx_error err;
+        wx_result r = wx_geometry_load(&scene, args->quiet, &geometry, &err);
+        if (r != WX_OK) {
+            fprintf(stderr, "weathering: %s\n", err.message);
+            wx_scene_free(&scene);
+            return r;
+        }
+    }
     printf("scene %s\n", scene.path);
     printf("solver: bounding box %g m centred at (%g, %g, %g); %" PRId64
            " steps of %g s (%g s simulated); seed %" PRIu64 "\n",
@@ -284,9 +294,10 @@ static int command_info(const cli_args *args)
         if (em->kind == WX_EMITTER_HEMISPHERE) {
             printf(" radius %g", em->radius);
         }
-        printf(", %g/s from %g to %g s (%.0f particles), speed %g, mass %g, dirt %g, "
+        printf(", %g/s from %g to %g s (%lld particles), speed %g, mass %g, dirt %g, "
                "max collisions %d\n",
-               em->rate, em->start, em->end, emitter_particle_count(em, duration), em->speed,
+               em->rate, em->start, em->end, (long long)wx_emitter_count_at(em, duration),
+               em->speed,
                em->mass, em->dirt, em->max_collisions);
     }
     printf("force fields (%d):\n", scene.field_count);
@@ -319,12 +330,31 @@ static int command_info(const cli_args *args)
                    sf->deposit, sf->erosion);
         }
         printf("\n");
+        if (imported) {
+            const wx_geometry_mesh *g = &geometry.meshes[m];
+            char shown[WX_ERROR_MAX];
+            printf("    %lld triangles, %lld vertices, bounds (%g, %g, %g) to (%g, %g, %g)\n",
+                   (long long)g->data.triangle_count, (long long)g->data.vertex_count,
+                   g->data.bounds_min[0], g->data.bounds_min[1], g->data.bounds_min[2],
+                   g->data.bounds_max[0], g->data.bounds_max[1], g->data.bounds_max[2]);
+            for (int k = 0; k < g->data.material_count; ++k) {
+                wx_printable(g->data.material_names[k], shown, sizeof shown);
+                printf("    material '%s' -> <Surface material=\"%s\">\n", shown,
+                       mesh->surfaces[g->surface[k]].material);
+            }
+        }
     }
+    wx_geometry_free(&geometry);
     wx_memory_need need;
-    wx_memory_estimate(&scene, true, &need);
+    wx_memory_estimate(&scene, WX_PHASE_ALL, &need);
     double available = wx_memory_available();
-    printf("memory: about %.0f MiB (maps, and %.0f particles if all were alive at once)",
-           need.total_bytes / (1024.0 * 1024.0), need.particles);
+    const double mib = 1024.0 * 1024.0;
+    printf("memory: about %.0f MiB at the peak (the %s: program %.0f, bake %.0f with %.0f for "
+           "the meshes, simulation %.0f with %.0f for %lld particles if all were alive at "
+           "once, gather %.0f; MiB)",
+           need.total_bytes / mib, need.phase, need.baseline_bytes / mib, need.bake_bytes / mib,
+           need.mesh_bytes / mib, (need.sim_map_bytes + need.particle_bytes) / mib,
+           need.particle_bytes / mib, (long long)need.particles, need.gather_bytes / mib);
     if (available >= 0.0) {
         printf(" of %.0f MiB available%s", available / (1024.0 * 1024.0),
                need.total_bytes > available ? ": too much, a run would be refused" : "");

@@ -15,6 +15,7 @@
 #include <unistd.h>
 
 #include "atomic_file.h"
+#include "emitter.h"
 #include "exr_io.h"
 #include "progress.h"
 
@@ -249,39 +250,82 @@ void wx_output_remove_empty(const char *out_dir, const char *created)
 
 // --- memory limits (docs/reliability.md) ---------------------------------------
 
-static double emitter_particles(const wx_emitter *e, double duration)
-{
-    double end = e->end < duration ? e->end : duration;
-    return end > e->start ? floor(e->rate * (end - e->start)) : 0.0;
-}
-
-void wx_memory_estimate(const wx_scene *scene, bool with_particles, wx_memory_need *need)
+void wx_memory_estimate(const wx_scene *scene, unsigned phases, wx_memory_need *need)
 {
     memset(need, 0, sizeof *need);
+    need->baseline_bytes = WX_MEMORY_BASELINE;
     need->camera_line = scene->path[0] != '\0' ? 1 : 0;
-    double largest = -1.0;
+    double largest = -1.0, input_texels = 0.0, largest_input = 0.0, output_texels = 0.0;
+    double framebuffer = 0.0, images = 0.0, baked_inputs = 0.0;
+    bool bake = (phases & WX_PHASE_BAKE) && wx_scene_needs_bake(scene);
     for (int c = 0; c < scene->camera_count; ++c) {
         const wx_scene_camera *sc = &scene->cameras[c];
         double texels = (double)sc->camera.width * (double)sc->camera.height;
-        double floats = sc->is_output ? WX_OUTPUT_FLOATS_PER_TEXEL : WX_INPUT_FLOATS_PER_TEXEL;
-        need->map_bytes += texels * floats * (double)sizeof(float);
+        if (sc->is_output) {
+            output_texels = texels;
+        } else {
+            input_texels += texels;
+            largest_input = fmax(largest_input, texels);
+        }
         if (texels > largest) {
             largest = texels;
             need->camera_line = sc->line;
         }
-    }
-    largest = -1.0;
-    double duration = wx_scene_duration(scene);
-    for (int e = 0; e < scene->emitter_count && with_particles; ++e) {
-        double n = emitter_particles(&scene->emitters[e], duration);
-        need->particles += n;
-        if (n > largest) {
-            largest = n;
-            need->emitter_line = scene->emitters[e].line;
+        if (bake && sc->has_view && sc->depth_path[0] == '\0') {
+            framebuffer = fmax(framebuffer, WX_BAKE_FRAMEBUFFER_BYTES_PER_TEXEL * texels);
+            images = fmax(images, texels * (sc->is_output ? WX_BAKE_OUTPUT_IMAGE_BYTES_PER_TEXEL
+                                                          : WX_BAKE_INPUT_IMAGE_BYTES_PER_TEXEL));
+            baked_inputs += sc->is_output ? 0.0 : texels;
         }
     }
-    need->particle_bytes = need->particles * WX_BYTES_PER_PARTICLE;
-    need->total_bytes = need->map_bytes + need->particle_bytes;
+    if (bake) {
+        double largest_file = -1.0;
+        for (int m = 0; m < scene->mesh_count; ++m) {
+            struct stat st;
+            double bytes = stat(scene->meshes[m].path, &st) == 0 ? (double)st.st_size : 0.0;
+            need->mesh_bytes += WX_MESH_BYTES_PER_FILE_BYTE * bytes;
+            if (bytes > largest_file) {
+                largest_file = bytes;
+                need->mesh_line = scene->meshes[m].line;
+            }
+        }
+        // Two cameras' images at once, the visibility test's depth planes, the
+        // readback strip (1 Mi floats), and the meshes as imported and uploaded.
+        need->bake_bytes = WX_BAKE_CONTEXT_BYTES + framebuffer + 2.0 * images +
+                           4.0 * (input_texels > baked_inputs ? input_texels : baked_inputs) +
+                           4.0 * 1024.0 * 1024.0 + need->mesh_bytes;
+    }
+    if (phases & WX_PHASE_SIMULATE) {
+        need->sim_map_bytes = WX_SIM_BYTES_PER_INPUT_TEXEL * input_texels +
+                              WX_SIM_WRITE_BYTES_PER_TEXEL * largest_input;
+        largest = -1.0;
+        double duration = wx_scene_duration(scene);
+        for (int e = 0; e < scene->emitter_count; ++e) {
+            double n = (double)wx_emitter_count_at(&scene->emitters[e], duration);
+            need->particles += n;
+            if (n > largest) {
+                largest = n;
+                need->emitter_line = scene->emitters[e].line;
+            }
+        }
+        need->particle_bytes = need->particles * WX_BYTES_PER_PARTICLE;
+    }
+    if (phases & WX_PHASE_GATHER) {
+        need->gather_bytes = WX_GATHER_BYTES_PER_INPUT_TEXEL * input_texels +
+                             WX_GATHER_BYTES_PER_OUTPUT_TEXEL * output_texels;
+    }
+    double sim = need->sim_map_bytes + need->particle_bytes;
+    double peak = need->bake_bytes;
+    need->phase = "bake";
+    if (sim > peak) {
+        peak = sim;
+        need->phase = "simulate";
+    }
+    if (need->gather_bytes > peak) {
+        peak = need->gather_bytes;
+        need->phase = "gather";
+    }
+    need->total_bytes = need->baseline_bytes + WX_MEMORY_MARGIN * peak;
 }
 
 // A "Key:   1234 kB" line of /proc/meminfo, in bytes; < 0 when absent.
@@ -365,29 +409,38 @@ static double gib(double bytes)
     return bytes / (1024.0 * 1024.0 * 1024.0);
 }
 
-wx_result wx_memory_check(const wx_scene *scene, bool with_particles, wx_error *err)
+wx_result wx_memory_check(const wx_scene *scene, unsigned phases, wx_error *err)
 {
     wx_memory_need need;
-    wx_memory_estimate(scene, with_particles, &need);
+    wx_memory_estimate(scene, phases, &need);
     double available = wx_memory_available();
     if (available < 0.0 || need.total_bytes <= available) {
         return WX_OK;
     }
-    if (need.particle_bytes > need.map_bytes) {
+    if (strcmp(need.phase, "simulate") == 0 && need.particle_bytes > need.sim_map_bytes) {
         return wx_error_set(err, WX_BAD_INPUT,
                             "%s:%d: the emitters would emit %.4g particles: with the maps that "
                             "needs about %.3g GiB (%.0f bytes per particle, %.3g GiB of maps), "
                             "but only %.3g GiB of memory is available; lower the rate or the "
                             "duration (see docs/reliability.md)",
                             scene->path, need.emitter_line, need.particles, gib(need.total_bytes),
-                            WX_BYTES_PER_PARTICLE, gib(need.map_bytes), gib(available));
+                            WX_BYTES_PER_PARTICLE, gib(need.sim_map_bytes), gib(available));
+    }
+    if (strcmp(need.phase, "bake") == 0 && need.mesh_bytes > need.bake_bytes - need.mesh_bytes) {
+        return wx_error_set(err, WX_BAD_INPUT,
+                            "%s:%d: importing and baking the meshes needs about %.3g GiB (%.3g "
+                            "GiB to import %.0f MiB of mesh files), but only %.3g GiB of memory "
+                            "is available (see docs/reliability.md)",
+                            scene->path, need.mesh_line, gib(need.total_bytes),
+                            gib(need.mesh_bytes),
+                            need.mesh_bytes / WX_MESH_BYTES_PER_FILE_BYTE / (1024.0 * 1024.0),
+                            gib(available));
     }
     return wx_error_set(err, WX_BAD_INPUT,
-                        "%s:%d: the maps need about %.3g GiB (%.3g GiB with the particles), but "
-                        "only %.3g GiB of memory is available; use smaller maps (see "
-                        "docs/reliability.md)",
-                        scene->path, need.camera_line, gib(need.map_bytes),
-                        gib(need.total_bytes), gib(available));
+                        "%s:%d: the maps need about %.3g GiB at the peak (the %s), but only %.3g "
+                        "GiB of memory is available; use smaller maps (see docs/reliability.md)",
+                        scene->path, need.camera_line, gib(need.total_bytes), need.phase,
+                        gib(available));
 }
 
 static bool same_file(const struct stat *a, const char *path)
@@ -581,6 +634,16 @@ wx_result wx_check_outputs(const wx_scene *scene, const wx_run_options *opts, un
     }
     wx_output_names_free(&names);
     return r;
+}
+
+bool wx_scene_needs_bake(const wx_scene *scene)
+{
+    for (int c = 0; c < scene->camera_count; ++c) {
+        if (scene->cameras[c].has_view && scene->cameras[c].depth_path[0] == '\0') {
+            return true;
+        }
+    }
+    return false;
 }
 
 wx_result wx_use_baked_maps(wx_scene *scene, const wx_run_options *opts, wx_error *err)

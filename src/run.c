@@ -12,17 +12,14 @@
 #include "progress.h"
 #include "simulate.h"
 
-// True when some <View> camera has no map files in the scene; marks those
-// cameras' maps as the output folder's own (bake is about to write them there).
+// Marks the maps of the cameras bake renders as the output folder's own (bake
+// is about to write them there); true when there is any.
 static bool mark_baked_cameras(wx_scene *scene)
 {
-    bool any = false;
+    bool any = wx_scene_needs_bake(scene);
     for (int c = 0; c < scene->camera_count; ++c) {
         wx_scene_camera *cam = &scene->cameras[c];
-        if (cam->has_view && cam->depth_path[0] == '\0') {
-            cam->maps_in_output = true;
-            any = true;
-        }
+        cam->maps_in_output = cam->maps_in_output || (cam->has_view && cam->depth_path[0] == '\0');
     }
     return any;
 }
@@ -55,7 +52,7 @@ wx_result wx_run_phases(wx_scene *scene, const wx_run_options *opts, unsigned ph
         r = wx_geometry_load(scene, opts->quiet, &geometry, err);
     }
     if (r == WX_OK) {
-        r = wx_memory_check(scene, (phases & WX_PHASE_SIMULATE) != 0, err);
+        r = wx_memory_check(scene, phases, err);
     }
     if (r == WX_OK) {
         r = wx_check_outputs(scene, opts, phases, err);

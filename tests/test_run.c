@@ -2,10 +2,16 @@
 // `simulate` and `gather` run one after the other; running a phase again into the
 // same folder gives the same bytes (a simulated dirt map keeps the dirt it started
 // from); every shipped scene validates.
+#define _DEFAULT_SOURCE // wait4
 #include <dirent.h>
+#include <fcntl.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
 
 #include "ensure.h"
 #include "exr_io.h"
@@ -300,6 +306,195 @@ TEST(every_shipped_scene_validates)
     ENSURE(scenes >= 2);
 }
 
+
+// Runs `weathering run SCENE --out DIR -q` from the repository's root and
+// returns its peak resident memory in MiB (wait4's ru_maxrss), or -1.
+static double run_peak_mib(const char *scene, const char *dir)
+{
+    char program[4200];
+    snprintf(program, sizeof program, "%s/weathering", ensure_build_dir());
+    pid_t pid = fork();
+    if (pid == 0) {
+        int null = open("/dev/null", O_WRONLY);
+        dup2(null, STDOUT_FILENO);
+        dup2(null, STDERR_FILENO);
+        execl(program, program, "run", scene, "--out", dir, "-q", (char *)NULL);
+        _exit(98);
+    }
+    int status = 0;
+    struct rusage usage;
+    if (pid < 0 || wait4(pid, &status, 0, &usage) != pid || !WIFEXITED(status) ||
+        WEXITSTATUS(status) != 0) {
+        return -1.0;
+    }
+    return (double)usage.ru_maxrss / 1024.0;
+}
+
+// info's "memory: about N MiB at the peak" of a scene, or -1.
+static double estimate_mib(const char *scene)
+{
+    static char log[16384];
+    if (ensure_shell(log, sizeof log, "'%s/weathering' info '%s'", ensure_build_dir(), scene) != 0) {
+        return -1.0;
+    }
+    const char *at = strstr(log, "memory: about ");
+    return at != NULL ? atof(at + strlen("memory: about ")) : -1.0;
+}
+
+// The memory estimate is an upper bound of what a run really takes at its peak,
+// and not more than 3 times it (issue 13): every shipped scene, measured.
+TEST(memory_estimate_bounds_every_shipped_scene)
+{
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+    fprintf(stderr, "        skipped: sanitizers change the memory a run takes\n");
+    return;
+#endif
+    char dir[4200];
+    snprintf(dir, sizeof dir, "%s/../xml_scenes", ensure_tests_dir());
+    DIR *d = opendir(dir);
+    ENSURE(d != NULL);
+    int scenes = 0, failures = 0;
+    struct dirent *e;
+    while ((e = readdir(d)) != NULL) {
+        size_t n = strlen(e->d_name);
+        if (n < 5 || strcmp(e->d_name + n - 4, ".xml") != 0) {
+            continue;
+        }
+        char scene[4500];
+        snprintf(scene, sizeof scene, "%s/%s", dir, e->d_name);
+        double estimate = estimate_mib(scene);
+        double peak = run_peak_mib(scene, out_dir(e->d_name));
+        fprintf(stderr, "        %-16s estimate %6.0f MiB, peak %6.0f MiB (%.2fx)\n", e->d_name,
+                estimate, peak, estimate / peak);
+        failures += !(peak > 0.0 && estimate >= peak && estimate <= 3.0 * peak);
+        scenes++;
+    }
+    closedir(d);
+    ENSURE(scenes >= 5);
+    ENSURE(failures == 0);
+}
+
+// `text` with its first `from` replaced by `to` (malloc'd).
+static char *replace_once(const char *text, const char *from, const char *to)
+{
+    const char *at = strstr(text, from);
+    if (at == NULL) {
+        return NULL;
+    }
+    size_t head = (size_t)(at - text), n = strlen(text) - strlen(from) + strlen(to);
+    char *out = malloc(n + 1);
+    if (out != NULL) {
+        snprintf(out, n + 1, "%.*s%s%s", (int)head, text, to, at + strlen(from));
+    }
+    return out;
+}
+
+// A run in which no particle reaches the geometry ends with exit 0, an all-zero
+// mask and a warning that says so (issue 13).
+TEST(a_run_without_a_single_hit_warns)
+{
+    // The drops start 2 m above the top of a solver box of 10 m around the
+    // origin: every one of the 1000 leaves it at once.
+    char *far = replace_once(SCENE_XML, "centerY=\"3\"", "centerY=\"7\"");
+    char *xml = far != NULL ? replace_once(far, "<Solver>", "<Solver><BoundingBox size=\"10\"/>")
+                            : NULL;
+    free(far);
+    ENSURE(xml != NULL);
+    const char *path = ensure_write_file(scene_dir(), "far.xml", xml);
+    free(xml);
+    const char *dir = out_dir("no_hit");
+    char log[8192];
+    int status = ensure_shell(log, sizeof log, "'%s/weathering' run '%s' --out '%s'",
+                              ensure_build_dir(), path, dir);
+    ENSURE(status == 0);
+    ENSURE(ensure_contains(log, "weathering: warning: "));
+    ENSURE(ensure_contains(log, "no particle hit a surface (1000 emitted, 1000 escaped"));
+    // -q keeps it quiet.
+    status = ensure_shell(log, sizeof log, "'%s/weathering' run '%s' --out '%s' -q",
+                          ensure_build_dir(), path, dir);
+    ENSURE(status == 0 && log[0] == '\0');
+}
+
+// Every input is read once per run: the simulation's maps are the gather's. A
+// map replaced while the run flies its particles changes nothing (issue 13).
+TEST(inputs_are_read_once_per_run)
+{
+    const char *dir = out_dir("read_once");
+    char log[8192];
+    // The thesis box (given maps) with a longer simulation, and its maps copied.
+    int status = ensure_shell(
+        log, sizeof log,
+        "set -e; mkdir -p '%s/maps'; cp maps/thesis_box_* '%s/maps/'; "
+        "sed -e 's|../maps/|maps/|g' -e 's|<BoundingBox|<Simulation steps=\"4000\"/><BoundingBox|' "
+        "-e 's|end=\"2\"|end=\"40\"|' xml_scenes/thesis_box.xml > '%s/scene.xml'",
+        dir, dir, dir);
+    ENSURE(status == 0);
+    status = ensure_shell(log, sizeof log, "'%s/weathering' run '%s/scene.xml' --out '%s/a' -q",
+                          ensure_build_dir(), dir, dir);
+    ENSURE(status == 0);
+    // Again, replacing the front camera's depth map with the top camera's while
+    // the particles fly: the mask must not change.
+    status = ensure_shell(
+        log, sizeof log,
+        "'%s/weathering' run '%s/scene.xml' --out '%s/b' -q & pid=$!; "
+        "while [ ! -e '%s/b' ]; do sleep 0.01; done; sleep 0.3; "
+        "cp '%s/maps/thesis_box_top_depth.exr' '%s/maps/thesis_box_front_depth.exr'; "
+        "cp '%s/maps/thesis_box_top_normal.exr' '%s/maps/thesis_box_front_normal.exr'; "
+        "wait $pid",
+        ensure_build_dir(), dir, dir, dir, dir, dir, dir, dir);
+    ENSURE(status == 0);
+    char a[4300], b[4300];
+    snprintf(a, sizeof a, "%s/a", dir);
+    snprintf(b, sizeof b, "%s/b", dir);
+    ENSURE(same_bytes(a, b, "thesis_box_mask.exr"));
+}
+
+// A phase that fails leaves no folder it made, and a scene whose output would
+// replace one of its inputs is refused before anything is written (issue 13).
+TEST(failures_leave_nothing_behind)
+{
+    const char *dir = out_dir("failed");
+    mkdir(dir, 0777);
+    char log[8192];
+    // A mesh that is not a mesh: the geometry is refused before the folder exists.
+    const char *bad = ensure_write_file(dir, "bad.xml", SCENE_XML);
+    ENSURE(ensure_shell(log, sizeof log, "cp '%s/data/bake_not_a_mesh.txt' '%s/box.obj'",
+                        ensure_tests_dir(), dir) == 0);
+    int status = ensure_shell(log, sizeof log, "'%s/weathering' run '%s' --out '%s/new/deeper'",
+                              ensure_build_dir(), bad, dir);
+    ENSURE(status == 2);
+    char path[4300];
+    snprintf(path, sizeof path, "%s/new", dir);
+    struct stat st;
+    ENSURE(stat(path, &st) != 0);
+    // simulate without a bake: the missing maps are refused, no folder made.
+    status = ensure_shell(log, sizeof log, "'%s/weathering' simulate '%s' --out '%s/new'",
+                          ensure_build_dir(), bad, dir);
+    ENSURE(status == 2);
+    ENSURE(ensure_contains(log, "run `weathering bake"));
+    ENSURE(stat(path, &st) != 0);
+    // The thesis box run into the folder of its own maps: front_dirt.exr would
+    // replace an input. Refused at once: the 22 files of bake and simulate are
+    // never written (the check used to come after the simulation).
+    status = ensure_shell(
+        log, sizeof log,
+        "set -e; mkdir -p '%s/inputs'; cd '%s/inputs'; m=$OLDPWD/maps/thesis_box_; "
+        "for c in front top; do for k in depth normal impact dirt; do "
+        "cp $m${c}_$k.exr ${c}_$k.exr; done; done; "
+        "cp ${m}out_depth.exr out_depth.exr; cp ${m}out_normal.exr out_normal.exr; "
+        "sed -e 's|../maps/thesis_box_||g' "
+        "-e 's|<BoundingBox|<Simulation steps=\"100000\"/><BoundingBox|' "
+        "$OLDPWD/xml_scenes/thesis_box.xml > scene.xml",
+        dir, dir);
+    ENSURE(status == 0);
+    double t0 = (double)time(NULL);
+    status = ensure_shell(log, sizeof log, "'%s/weathering' run '%s/inputs/scene.xml' --out '%s/inputs'",
+                          ensure_build_dir(), dir, dir);
+    ENSURE(status == 2);
+    ENSURE(ensure_contains(log, "front_dirt.exr: is an input of scene"));
+    ENSURE((double)time(NULL) - t0 < 5.0); // 100000 steps were never flown
+}
+
 int main(void)
 {
     RUN(run_equals_bake_simulate_gather);
@@ -307,5 +502,9 @@ int main(void)
     RUN(simulated_dirt_map_holds_result_and_initial_dirt);
     RUN(default_scene_has_a_clean_band_and_streaks_below_the_sills);
     RUN(every_shipped_scene_validates);
+    RUN(memory_estimate_bounds_every_shipped_scene);
+    RUN(a_run_without_a_single_hit_warns);
+    RUN(inputs_are_read_once_per_run);
+    RUN(failures_leave_nothing_behind);
     return ensure_summary();
 }

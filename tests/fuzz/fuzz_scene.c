@@ -31,7 +31,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     wx_result r = wx_scene_load(fuzz_input, &scene, &err);
     if (r == WX_OK) {
         wx_memory_need need;
-        wx_memory_estimate(&scene, true, &need);
+        wx_memory_estimate(&scene, WX_PHASE_ALL, &need);
         if (scene.camera_count < 1 || !(need.total_bytes >= 0.0)) {
             __builtin_trap();
         }
