@@ -1,4 +1,6 @@
 // test_cli.c: the `weathering` command line: options, exit statuses, messages.
+#define _XOPEN_SOURCE 700 // realpath
+#include <limits.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -93,6 +95,128 @@ TEST(info_on_a_bad_scene_gives_file_line_and_status_2)
     ENSURE(ensure_contains(out, expected));
 }
 
+
+// The build folder as an absolute path (the tests below change folders).
+static const char *build_dir(void)
+{
+    static char dir[PATH_MAX];
+    if (dir[0] == '\0' && realpath(ensure_build_dir(), dir) == NULL) {
+        snprintf(dir, sizeof dir, "%s", ensure_build_dir());
+    }
+    return dir;
+}
+
+// A scratch copy of the teapot scene and its mesh (issue 13's repro folder).
+static const char *teapot_copy(const char *name)
+{
+    static char dir[4200];
+    snprintf(dir, sizeof dir, "%s/%s", ensure_tmpdir(), name);
+    if (ensure_shell(NULL, 0,
+                     "mkdir -p '%s/meshes' && cp xml_scenes/teapot.xml '%s/s.xml' && "
+                     "cp xml_scenes/meshes/teapot.obj '%s/meshes/'",
+                     dir, dir, dir) != 0) {
+        return NULL;
+    }
+    return dir;
+}
+
+// --stats never replaces an input, an output of the run or a non-regular file,
+// and is refused before any work (issue 13).
+TEST(stats_never_overwrites_anything)
+{
+    const char *d = teapot_copy("stats");
+    ENSURE(d != NULL);
+    ENSURE(ensure_shell(NULL, 0, "cd '%s' && cksum s.xml meshes/teapot.obj > ../stats.sum && "
+                                 "ln -s /dev/null link.json && mkfifo fifo.json && mkdir o && "
+                                 "echo keep > o/mask.exr", d) == 0);
+    struct {
+        const char *stats, *message;
+    } cases[] = {
+        { "s.xml", "--stats s.xml: is an input of scene s.xml" },
+        { "meshes/teapot.obj", "--stats meshes/teapot.obj: is an input of scene" },
+        { "o/mask.exr", "--stats o/mask.exr: is the run's output mask.exr" },
+        { "o/../o/front_dirt.exr", "is the run's output front_dirt.exr" },
+        { "link.json", "--stats link.json: exists and is a symbolic link" },
+        { "fifo.json", "--stats fifo.json: exists and is a FIFO" },
+        { "nowhere/s.json", "folder" },
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
+        int status = ensure_shell(out, sizeof out, "cd '%s' && timeout 20 '%s/weathering' run s.xml "
+                                  "--out o --stats '%s'", d, build_dir(), cases[k].stats);
+        if (status != 2 || !ensure_contains(out, cases[k].message)) {
+            fprintf(stderr, "        --stats %s: status %d: %s", cases[k].stats, status, out);
+        }
+        ENSURE(status == 2);
+        ENSURE(ensure_contains(out, cases[k].message));
+    }
+    // Nothing was written: the inputs are unchanged, the folder holds only the
+    // user's file, the link still points at /dev/null.
+    ENSURE(ensure_shell(NULL, 0, "cd '%s' && cksum s.xml meshes/teapot.obj | cmp - ../stats.sum && "
+                                 "[ \"$(ls -A o)\" = mask.exr ] && [ \"$(cat o/mask.exr)\" = keep ] && "
+                                 "[ \"$(readlink link.json)\" = /dev/null ]", d) == 0);
+    // A new file in the output folder (made by the run) is fine.
+    ENSURE(ensure_shell(out, sizeof out, "cd '%s' && '%s/weathering' info s.xml --out new "
+                        "--stats new/stats.json", d, build_dir()) == 0);
+}
+
+// The cleanup of killed runs' temporaries touches only this program's own
+// output names, and a scene called "...xml" still writes inside out/.
+TEST(stale_cleanup_and_default_folder_stay_in_their_place)
+{
+    const char *d = teapot_copy("stale");
+    ENSURE(d != NULL);
+    ENSURE(ensure_shell(NULL, 0, "cd '%s' && mkdir -p out/s && "
+                                 "echo draft > out/s/.draft.txt.tmp999999998 && "
+                                 "echo dead > out/s/.mask.exr.tmp999999997 && "
+                                 "sed -e 's/teapot.obj/..\\/meshes\\/teapot.obj/' s.xml > ...xml", d) == 0);
+    ENSURE(ensure_shell(out, sizeof out, "cd '%s' && '%s/weathering' bake s.xml -q", d,
+                        build_dir()) == 0);
+    ENSURE(ensure_shell(NULL, 0, "cd '%s/out/s' && [ -e .draft.txt.tmp999999998 ] && "
+                                 "[ ! -e .mask.exr.tmp999999997 ]", d) == 0);
+    ENSURE(ensure_shell(out, sizeof out, "cd '%s' && '%s/weathering' info ...xml", d,
+                        build_dir()) == 0);
+    ENSURE(ensure_contains(out, "output folder: out/__\n"));
+}
+
+// --out and --stats longer than a path may be are refused, not cut (issue 13).
+TEST(overlong_paths_are_refused)
+{
+    char *args = malloc(10000);
+    ENSURE(args != NULL);
+    int n = snprintf(args, 10000, "info xml_scenes/thesis_box.xml --out ");
+    memset(args + n, 'a', 5000);
+    args[n + 5000] = '\0';
+    int status = weathering(args);
+    snprintf(args, 10000, "info xml_scenes/thesis_box.xml --stats ");
+    n = (int)strlen(args);
+    memset(args + n, 'b', 4200);
+    args[n + 4200] = '\0';
+    int stats_status = weathering(args);
+    free(args);
+    ENSURE(status == 2);
+    ENSURE(stats_status == 2);
+    ENSURE(ensure_contains(out, "--stats: a file name of at most 4095 characters"));
+}
+
+// Text from files is echoed escaped: a mesh's material name with ESC and BEL
+// cannot colour the terminal or fake a line (issue 13).
+TEST(control_characters_from_files_are_escaped)
+{
+    const char *d = teapot_copy("escape");
+    ENSURE(d != NULL);
+    ENSURE(ensure_shell(NULL, 0, "cd '%s' && printf 'newmtl red\\033[31m\\a\\n' > meshes/m.mtl && "
+                                 "(printf 'mtllib m.mtl\\nusemtl red\\033[31m\\a\\n'; "
+                                 "cat meshes/teapot.obj) > meshes/t.obj && "
+                                 "sed -e 's|teapot.obj|t.obj|' -e 's|material=\"\\*\"|material=\"x\"|' "
+                                 "s.xml > esc.xml", d) == 0);
+    int status = ensure_shell(out, sizeof out, "cd '%s' && '%s/weathering' info esc.xml", d,
+                              build_dir());
+    ENSURE(status == 2);
+    ENSURE(ensure_contains(out, "material 'red\\x1b[31m\\x07' that no <Surface> matches"));
+    ENSURE(strchr(out, '\033') == NULL && strchr(out, '\a') == NULL);
+    ENSURE(strchr(out, '\n') == out + strlen(out) - 1);
+}
+
 int main(void)
 {
     RUN(help_lists_commands_and_options);
@@ -103,5 +227,9 @@ int main(void)
     RUN(missing_scene_names_the_file);
     RUN(info_summarises_the_default_scene);
     RUN(info_on_a_bad_scene_gives_file_line_and_status_2);
+    RUN(stats_never_overwrites_anything);
+    RUN(stale_cleanup_and_default_folder_stay_in_their_place);
+    RUN(overlong_paths_are_refused);
+    RUN(control_characters_from_files_are_escaped);
     return ensure_summary();
 }

@@ -549,6 +549,43 @@ TEST(an_input_is_never_overwritten)
     ENSURE(count == 11); // nothing added: no temporary, no mask
 }
 
+
+// Out of memory in the bake (the framebuffer, the images) is exit status 1 with
+// "out of memory", never a bad input nor "framebuffer is incomplete" (issue 13).
+TEST(out_of_memory_in_the_bake_is_exit_1)
+{
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+    fprintf(stderr, "        skipped: a sanitizer's shadow memory does not fit under ulimit -v\n");
+    return;
+#endif
+    const char *dir = ensure_tmpdir();
+    ENSURE(ensure_shell(out, sizeof out,
+                        "mkdir -p %s/oom/meshes && cp xml_scenes/meshes/teapot.obj %s/oom/meshes/ && "
+                        "sed -e 's/resolution=\"[0-9]*\"/resolution=\"4096\"/' "
+                        "-e 's/width=\"1024\" height=\"1024\"/width=\"4096\" height=\"4096\"/' "
+                        "xml_scenes/teapot.xml > %s/oom/big.xml",
+                        dir, dir, dir) == 0);
+    int failed = 0;
+    const int limits_mb[] = { 900, 1200, 1500, 1800 };
+    for (int k = 0; k < 4; ++k) {
+        int status = ensure_shell(out, sizeof out,
+                                  "ulimit -v %d; WX_MEMORY_AVAILABLE_MB=100000 %s/weathering bake "
+                                  "%s/oom/big.xml --out %s/oom/out%d -q --threads 2",
+                                  limits_mb[k] * 1024, ensure_build_dir(), dir, dir, k);
+        if (status == 0) {
+            continue;
+        }
+        failed++;
+        if (status != 1 || !ensure_contains(out, "out of memory")) {
+            fprintf(stderr, "        ulimit %d MiB: status %d: %s", limits_mb[k], status, out);
+        }
+        ENSURE(status == 1);
+        ENSURE(ensure_contains(out, "out of memory"));
+        ENSURE(!ensure_contains(out, "incomplete"));
+    }
+    ENSURE(failed >= 2);
+}
+
 int main(void)
 {
     RUN(bad_inputs_exit_2_with_their_message);
@@ -556,6 +593,7 @@ int main(void)
     RUN(stale_temporaries_of_dead_processes_are_removed);
     RUN(interrupt_removes_only_unfinished_temporaries);
     RUN(an_input_is_never_overwritten);
+    RUN(out_of_memory_in_the_bake_is_exit_1);
     RUN(sigint_stops_a_run_cleanly);
     RUN(sigkill_never_leaves_a_torn_file);
     return ensure_summary();
