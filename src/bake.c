@@ -761,11 +761,11 @@ static wx_result compute_initial_dirt(baker *b, int c, const float *depth,
 // ---------------------------------------------------------------------------
 // Writing. The files of one camera are written by worker threads (one per
 // file) while the next camera renders; two sets of images alternate. Baked maps
-// are intermediate files that the later phases read back: they are stored
-// uncompressed, since ZIP cost several times the rendering (about 2 CPU-s per
-// 2048-pixel camera against 0.3 s raw; docs/performance.md). The outputs a user
-// keeps (simulated dirt maps, the mask) stay ZIP.
-#define WX_BAKE_COMPRESSION WX_EXR_NONE
+// are ZIP compressed like every other output: their background and flat
+// surfaces compress about 100-fold (the default scene's 137 MB of maps take
+// 0.45 MB), and at 2048 pixels the writing then costs less wall-clock time than
+// raw files do (docs/performance.md).
+#define WX_BAKE_COMPRESSION WX_EXR_ZIP
 
 static void *write_file_thread(void *arg)
 {

@@ -14,6 +14,7 @@
 
 #include "atomic_file.h"
 #include "input_file.h"
+#include "parallel.h"
 
 #include <assert.h>
 #include <errno.h>
@@ -645,16 +646,30 @@ static wx_result check_image(const char *path, const wx_image *image, wx_error *
     return WX_OK;
 }
 
+// The encoding state of one worker thread: its pipeline (OpenEXR Core's
+// pipelines are meant to run one per thread on the same context), the
+// library's compressor it wraps, and where the chunk it encodes is kept.
+typedef struct chunk_encoder {
+    exr_encode_pipeline_t enc;
+    bool initialized;
+    exr_result_t (*compress)(exr_encode_pipeline_t *enc);
+    struct chunk_slot *slot; ///< the chunk being encoded
+} chunk_encoder;
+
+// One encoded chunk, kept until it is written in file order.
+typedef struct chunk_slot {
+    int y;          ///< first scanline
+    void *data;     ///< malloc'd copy of the compressed (or raw) chunk
+    uint64_t bytes;
+    exr_result_t rv;
+} chunk_slot;
+
 // OpenEXR Core (3.1 to 3.4 at least) keeps a zlib stream that is exactly as long as
 // the raw data, and readers then take it for raw data (openexr issue #2306). Such a
 // chunk is stored raw instead, as the file format says.
-typedef struct compress_hook {
-    exr_result_t (*compress)(exr_encode_pipeline_t *enc);
-} compress_hook;
-
 static exr_result_t compress_unambiguously(exr_encode_pipeline_t *enc)
 {
-    const compress_hook *hook = enc->encoding_user_data;
+    const chunk_encoder *hook = enc->encoding_user_data;
     exr_result_t rv = hook->compress(enc);
     if (rv == EXR_ERR_SUCCESS && enc->compressed_bytes == enc->packed_bytes &&
         enc->compressed_buffer != NULL && enc->packed_buffer != NULL &&
@@ -662,6 +677,24 @@ static exr_result_t compress_unambiguously(exr_encode_pipeline_t *enc)
         memcpy(enc->compressed_buffer, enc->packed_buffer, enc->packed_bytes);
     }
     return rv;
+}
+
+// The pipeline's last stage: keep the chunk instead of writing it, so that the
+// chunks compressed on several threads are written in order by one.
+static exr_result_t keep_chunk(exr_encode_pipeline_t *enc)
+{
+    chunk_encoder *worker = enc->encoding_user_data;
+    chunk_slot *slot = worker->slot;
+    const void *bytes = enc->compressed_buffer != NULL ? enc->compressed_buffer
+                                                       : enc->packed_buffer;
+    uint64_t size = enc->compressed_buffer != NULL ? enc->compressed_bytes : enc->packed_bytes;
+    slot->data = malloc(size > 0 ? (size_t)size : 1);
+    if (slot->data == NULL) {
+        return EXR_ERR_OUT_OF_MEMORY;
+    }
+    memcpy(slot->data, bytes, (size_t)size);
+    slot->bytes = size;
+    return EXR_ERR_SUCCESS;
 }
 
 static wx_result write_failed(const char *path, const exr_stream *s, exr_result_t rv,
@@ -686,6 +719,115 @@ static exr_compression_t exr_compression(wx_exr_compression c)
         break;
     }
     return EXR_COMPRESSION_ZIP;
+}
+
+// The chunks of one batch, encoded by the workers of wx_parallel_for.
+typedef struct chunk_batch {
+    exr_context_t ctx;
+    int part;
+    const wx_image *image;
+    chunk_encoder *workers; ///< one per thread
+    chunk_slot *slots;
+} chunk_batch;
+
+// Packs and compresses chunks [begin, end) of the batch on worker `worker`.
+static void encode_chunks(int64_t begin, int64_t end, int worker, void *context)
+{
+    chunk_batch *batch = context;
+    chunk_encoder *w = &batch->workers[worker];
+    const wx_image *image = batch->image;
+    const size_t width = (size_t)image->width;
+    for (int64_t k = begin; k < end; ++k) {
+        chunk_slot *slot = &batch->slots[k];
+        exr_chunk_info_t ci;
+        exr_result_t rv = exr_write_scanline_chunk_info(batch->ctx, batch->part, slot->y, &ci);
+        if (rv == EXR_ERR_SUCCESS) {
+            rv = w->initialized ? exr_encoding_update(batch->ctx, batch->part, &ci, &w->enc)
+                                : exr_encoding_initialize(batch->ctx, batch->part, &ci, &w->enc);
+            w->initialized = w->initialized || rv == EXR_ERR_SUCCESS;
+        }
+        for (int c = 0; rv == EXR_ERR_SUCCESS && c < w->enc.channel_count; c++) {
+            exr_coding_channel_info_t *ch = &w->enc.channels[c];
+            const float *plane = NULL;
+            for (int i = 0; i < image->channel_count; i++) {
+                if (ch->channel_name != NULL &&
+                    strcmp(ch->channel_name, image->channel_names[i]) == 0) {
+                    plane = image->channels[i];
+                }
+            }
+            if (plane == NULL) {
+                rv = EXR_ERR_INVALID_ARGUMENT;
+                break;
+            }
+            ch->encode_from_ptr = (const uint8_t *)(plane + (size_t)slot->y * width);
+            ch->user_pixel_stride = (int32_t)sizeof(float);
+            ch->user_line_stride = (int32_t)(width * sizeof(float));
+            ch->user_data_type = EXR_PIXEL_FLOAT;
+            ch->user_bytes_per_element = (int16_t)sizeof(float);
+        }
+        if (rv == EXR_ERR_SUCCESS) {
+            rv = exr_encoding_choose_default_routines(batch->ctx, batch->part, &w->enc);
+        }
+        if (rv == EXR_ERR_SUCCESS) {
+            w->enc.encoding_user_data = w;
+            w->slot = slot;
+            if (w->enc.compress_fn != NULL) {
+                w->compress = w->enc.compress_fn;
+                w->enc.compress_fn = compress_unambiguously;
+            }
+            // Not written here: no waiting for the previous chunk (the library's
+            // yield fails a chunk that is not the next), kept for write_chunks.
+            w->enc.yield_until_ready_fn = NULL;
+            w->enc.write_fn = keep_chunk;
+            rv = exr_encoding_run(batch->ctx, batch->part, &w->enc);
+        }
+        slot->rv = rv;
+    }
+}
+
+// Chunks encoded per batch: enough to keep every thread busy, few enough that
+// the compressed chunks waiting to be written stay small.
+enum { CHUNKS_PER_BATCH = 64 };
+
+// Encodes every chunk (in parallel when `threads` > 1) and writes them in
+// scanline order. The bytes do not depend on the thread count: each chunk is
+// compressed on its own.
+static exr_result_t write_chunks(exr_context_t ctx, int part, int lines, const wx_image *image,
+                                 int threads)
+{
+    int chunk_count = (image->height + lines - 1) / lines;
+    int batch_size = CHUNKS_PER_BATCH * threads;
+    batch_size = batch_size < chunk_count ? batch_size : chunk_count;
+    chunk_batch batch = { .ctx = ctx, .part = part, .image = image };
+    batch.workers = calloc((size_t)threads, sizeof *batch.workers);
+    batch.slots = calloc((size_t)batch_size, sizeof *batch.slots);
+    exr_result_t rv = batch.workers != NULL && batch.slots != NULL ? EXR_ERR_SUCCESS
+                                                                   : EXR_ERR_OUT_OF_MEMORY;
+    for (int first = 0; rv == EXR_ERR_SUCCESS && first < chunk_count; first += batch_size) {
+        int n = chunk_count - first < batch_size ? chunk_count - first : batch_size;
+        for (int k = 0; k < n; ++k) {
+            batch.slots[k] = (chunk_slot){ .y = (first + k) * lines };
+        }
+        wx_parallel_for(threads, n, 1, encode_chunks, &batch);
+        for (int k = 0; k < n; ++k) {
+            chunk_slot *slot = &batch.slots[k];
+            if (rv == EXR_ERR_SUCCESS) {
+                rv = slot->rv != EXR_ERR_SUCCESS
+                         ? slot->rv
+                         : exr_write_scanline_chunk(ctx, part, slot->y, slot->data, slot->bytes);
+            }
+            free(slot->data);
+            slot->data = NULL;
+        }
+    }
+    for (int t = 0; batch.workers != NULL && t < threads; ++t) {
+        if (batch.workers[t].initialized) {
+            exr_encoding_destroy(ctx, &batch.workers[t].enc);
+        }
+    }
+    free(batch.workers);
+    free(batch.slots);
+    return rv;
 }
 
 // Writes the whole file through the stream (the temporary file).
@@ -741,52 +883,11 @@ static wx_result write_body(exr_stream *s, const char *path, const char *tmp_pat
     if (rv == EXR_ERR_SUCCESS && lines <= 0) {
         rv = EXR_ERR_INVALID_ARGUMENT;
     }
-    const size_t width = (size_t)image->width;
-    exr_encode_pipeline_t enc = EXR_ENCODE_PIPELINE_INITIALIZER;
-    compress_hook hook = {NULL};
-    bool initialized = false;
-    for (int y = 0; rv == EXR_ERR_SUCCESS && y < image->height; y += lines) {
-        exr_chunk_info_t ci;
-        rv = exr_write_scanline_chunk_info(ctx, part, y, &ci);
-        if (rv == EXR_ERR_SUCCESS) {
-            rv = initialized ? exr_encoding_update(ctx, part, &ci, &enc)
-                             : exr_encoding_initialize(ctx, part, &ci, &enc);
-            initialized = true;
-        }
-        for (int c = 0; rv == EXR_ERR_SUCCESS && c < enc.channel_count; c++) {
-            exr_coding_channel_info_t *ch = &enc.channels[c];
-            const float *plane = NULL;
-            for (int k = 0; k < image->channel_count; k++) {
-                if (ch->channel_name != NULL &&
-                    strcmp(ch->channel_name, image->channel_names[k]) == 0) {
-                    plane = image->channels[k];
-                }
-            }
-            if (plane == NULL) {
-                rv = EXR_ERR_INVALID_ARGUMENT;
-                break;
-            }
-            ch->encode_from_ptr = (const uint8_t *)(plane + (size_t)y * width);
-            ch->user_pixel_stride = (int32_t)sizeof(float);
-            ch->user_line_stride = (int32_t)(width * sizeof(float));
-            ch->user_data_type = EXR_PIXEL_FLOAT;
-            ch->user_bytes_per_element = (int16_t)sizeof(float);
-        }
-        if (rv == EXR_ERR_SUCCESS) {
-            rv = exr_encoding_choose_default_routines(ctx, part, &enc);
-        }
-        if (rv == EXR_ERR_SUCCESS && enc.compress_fn != NULL) {
-            hook.compress = enc.compress_fn;
-            enc.compress_fn = compress_unambiguously;
-            enc.encoding_user_data = &hook;
-        }
-        if (rv == EXR_ERR_SUCCESS) {
-            rv = exr_encoding_run(ctx, part, &enc);
-        }
+    if (rv != EXR_ERR_SUCCESS) {
+        exr_finish(&ctx);
+        return write_failed(path, s, rv, "", err);
     }
-    if (initialized) {
-        exr_encoding_destroy(ctx, &enc);
-    }
+    rv = write_chunks(ctx, part, lines, image, image->threads > 1 ? image->threads : 1);
     if (rv != EXR_ERR_SUCCESS) {
         exr_finish(&ctx);
         return write_failed(path, s, rv, "", err);

@@ -51,6 +51,9 @@ typedef struct wx_image {
     int width;
     int height;
     wx_exr_compression compression; ///< used by wx_exr_write only (reading accepts any)
+    /// Threads that compress the chunks in wx_exr_write (<= 1: the calling
+    /// thread only); the file's bytes are the same for every count.
+    int threads;
     int channel_count;
     char channel_names[WX_IMAGE_MAX_CHANNELS][WX_NAME_MAX];
     float *channels[WX_IMAGE_MAX_CHANNELS];

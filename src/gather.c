@@ -870,6 +870,7 @@ wx_result wx_gather_maps(const wx_scene *scene, const wx_run_options *opts, cons
         wx_image_set_m44f(image, "WTCMatrix", out->camera.wtc);
         wx_image_set_m44f(image, "CTWMatrix", out->camera.ctw);
         wx_image_set_string(image, "cameraName", out->name);
+        image->threads = opts->threads; // compresses chunks in parallel: same bytes
         result = wx_exr_write(mask_path, image, err);
     }
     if (result == WX_OK) {

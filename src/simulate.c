@@ -1054,6 +1054,7 @@ static wx_result write_one(const wx_sim *sim, const wx_run_options *opts, int c,
     if (wx_image_find_attr(image, "cameraName") == NULL) {
         wx_image_set_string(image, "cameraName", cam->name);
     }
+    image->threads = opts->threads; // compresses chunks in parallel: same bytes
     r = wx_exr_write(path, image, err);
     wx_image_free(image);
     return r;
