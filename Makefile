@@ -25,9 +25,12 @@ INCLUDES := -Isrc -I$(BUILD)/gen -I/usr/include/OpenEXR -I/usr/include/libxml2
 ALL_CFLAGS = $(WARN) $(DEFS) $(FPFLAGS) $(INCLUDES) $(CFLAGS) -MMD -MP -pthread
 LIBS := -lOpenEXRCore-3_1 -lxml2 -lassimp -lOSMesa -lpng -lm -lpthread
 
-LIB_SRC := $(filter-out src/cli.c,$(wildcard src/*.c))
+# The library's layers are the folders of src/ (docs/architecture.md); the
+# command line is cli/.
+LIB_SRC := $(wildcard src/*/*.c)
 LIB_OBJ := $(LIB_SRC:src/%.c=$(BUILD)/obj/%.o)
-CLI_OBJ := $(BUILD)/obj/cli.o
+CLI_SRC := $(wildcard cli/*.c)
+CLI_OBJ := $(CLI_SRC:cli/%.c=$(BUILD)/obj/cli/%.o)
 TEST_SRC := $(wildcard tests/test_*.c)
 TEST_BIN := $(TEST_SRC:tests/%.c=$(BUILD)/tests/%)
 TEST_SUPPORT_OBJ := $(BUILD)/obj/tests/ensure.o
@@ -65,6 +68,10 @@ deps:
 	$(call install_missing,$(DEB_PACKAGES))
 
 $(BUILD)/obj/%.o: src/%.c | deps
+	@mkdir -p $(dir $@)
+	$(CC) $(ALL_CFLAGS) -c $< -o $@
+
+$(BUILD)/obj/cli/%.o: cli/%.c | deps
 	@mkdir -p $(dir $@)
 	$(CC) $(ALL_CFLAGS) -c $< -o $@
 
@@ -226,4 +233,4 @@ FORCE:
 # test count stays the last line of its output (make would delete them after).
 .SECONDARY:
 
--include $(wildcard $(BUILD)/obj/*.d $(BUILD)/obj/tests/*.d $(BUILD)/obj/bench/*.d $(BUILD)/obj/viewer/*.d)
+-include $(wildcard $(BUILD)/obj/*/*.d)

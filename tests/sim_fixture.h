@@ -9,9 +9,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "camera.h"
-#include "maps.h"
-#include "scene.h"
+#include "model/camera.h"
+#include "model/maps.h"
+#include "model/scene.h"
 
 #define FX_MAX_PLANES 8
 #define FX_MAX_SOLIDS 8

@@ -11,12 +11,19 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "bake.h"
-#include "camera.h"
+#include "raster/bake.h"
+#include "model/camera.h"
 #include "ensure.h"
-#include "exr_io.h"
-#include "maps.h"
-#include "scene.h"
+#include "io/exr.h"
+#include "model/maps.h"
+#include "model/scene.h"
+#include "core/limits.h"
+#include "io/maps_file.h"
+#include "io/scene_xml.h"
+#include "model/image.h"
+#include "pipeline/bake_phase.h"
+#include "pipeline/outputs.h"
+#include "pipeline/pipeline.h"
 
 // ---------------------------------------------------------------------------
 // Scenes by hand.
@@ -112,7 +119,7 @@ static void scene_end(wx_scene *s)
     memset(s, 0, sizeof *s);
 }
 
-static void options_for(wx_run_options *o, const char *test)
+static void options_for(wx_run_def *o, const char *test)
 {
     memset(o, 0, sizeof *o);
     snprintf(o->out_dir, sizeof o->out_dir, "%s/%s", ensure_tmpdir(), test);
@@ -321,9 +328,9 @@ TEST(sphere_depth_and_normal)
     add_camera(&s, "diag", eye_diag, ORIGIN, UP_Y, 2.5f, 2.5f, 128, 128, false);
     wx_mesh *mesh = add_mesh(&s, sphere, 30);
     add_surface(mesh, "*", 0.2f, 0.3f, 0, 0.5f, 0.1f);
-    wx_run_options o;
+    wx_run_def o;
     options_for(&o, "sphere");
-    wx_error err = { "" };
+    wx_error err = { 0 };
     wx_bake_stats stats;
     wx_result r = wx_bake_scene_stats(&s, &o, &stats, &err);
     if (r != WX_OK) {
@@ -363,10 +370,10 @@ static void check_box(const char *file, const char *test, int threads)
     add_camera(&s, "top", eye_top, ORIGIN, up_top, 4, 4, 64, 64, false);
     wx_mesh *mesh = add_mesh(&s, data_path(file), 30);
     add_surface(mesh, "*", 0.5f, 0.5f, 0, 0, 0);
-    wx_run_options o;
+    wx_run_def o;
     options_for(&o, test);
     o.threads = threads;
-    wx_error err = { "" };
+    wx_error err = { 0 };
     wx_result r = wx_bake_scene(&s, &o, &err);
     if (r != WX_OK) {
         fprintf(stderr, "%s\n", err.message);
@@ -415,9 +422,9 @@ TEST(top_scanline_is_highest_v)
     add_camera(&s, "low", eye, target, UP_Y, 6, 6, 48, 48, false);
     wx_mesh *mesh = add_mesh(&s, data_path("bake_box.obj"), 30);
     add_surface(mesh, "*", 0, 0, 0, 0, 0);
-    wx_run_options o;
+    wx_run_def o;
     options_for(&o, "rows");
-    wx_error err = { "" };
+    wx_error err = { 0 };
     ENSURE(wx_bake_scene(&s, &o, &err) == WX_OK);
     maps4 m;
     ENSURE(read_maps(&s.cameras[0], &m));
@@ -447,9 +454,9 @@ TEST(two_materials_two_impacts)
     wx_mesh *mesh = add_mesh(&s, data_path("bake_two_materials.obj"), 30);
     add_surface(mesh, "Wood", 0.25f, 0.5f, 0, 0.1f, 0.2f);
     add_surface(mesh, "*", 0.75f, 0.125f, 0, 0.3f, 0.4f);
-    wx_run_options o;
+    wx_run_def o;
     options_for(&o, "materials");
-    wx_error err = { "" };
+    wx_error err = { 0 };
     ENSURE(wx_bake_scene(&s, &o, &err) == WX_OK);
     maps4 m;
     ENSURE(read_maps(&s.cameras[0], &m));
@@ -475,9 +482,9 @@ TEST(unmatched_material_lists_names)
     add_camera(&s, "front", eye, ORIGIN, UP_Y, 2, 2, 16, 16, false);
     wx_mesh *mesh = add_mesh(&s, data_path("bake_two_materials.obj"), 42);
     add_surface(mesh, "Glass", 0.25f, 0.5f, 0, 0, 0);
-    wx_run_options o;
+    wx_run_def o;
     options_for(&o, "unmatched");
-    wx_error err = { "" };
+    wx_error err = { 0 };
     ENSURE(wx_bake_scene(&s, &o, &err) == WX_BAD_INPUT);
     ENSURE(ensure_contains(err.message, "scene.xml:42: mesh '"));
     ENSURE(ensure_contains(err.message, "bake_two_materials.obj' has material 'Wood' that no "
@@ -496,9 +503,9 @@ TEST(vertex_colours_to_impact_and_dirt)
     wx_mesh *mesh = add_mesh(&s, data_path("bake_colors.ply"), 30);
     wx_surface *surf = add_surface(mesh, "*", 0.5f, 0.5f, 0, 0.7f, 0.7f);
     surf->colors = WX_COLOR_IMPACT;
-    wx_run_options o;
+    wx_run_def o;
     options_for(&o, "colors");
-    wx_error err = { "" };
+    wx_error err = { 0 };
     wx_result r = wx_bake_scene(&s, &o, &err);
     if (r != WX_OK) {
         fprintf(stderr, "%s\n", err.message);
@@ -546,9 +553,9 @@ TEST(vertex_colours_missing_is_an_error)
     add_camera(&s, "front", eye, ORIGIN, UP_Y, 2, 2, 16, 16, false);
     wx_mesh *mesh = add_mesh(&s, data_path("bake_box.obj"), 30);
     add_surface(mesh, "*", 0, 0, 0, 0, 0)->colors = WX_COLOR_IMPACT;
-    wx_run_options o;
+    wx_run_def o;
     options_for(&o, "nocolors");
-    wx_error err = { "" };
+    wx_error err = { 0 };
     ENSURE(wx_bake_scene(&s, &o, &err) == WX_BAD_INPUT);
     ENSURE(ensure_contains(err.message, "vertex colours"));
     ENSURE(ensure_contains(err.message, "bake_box.obj"));
@@ -584,9 +591,9 @@ TEST(initial_dirt_goes_to_the_most_head_on_camera)
     add_camera(&s, "head", head, ORIGIN, UP_Y, 4, 4, 64, 64, false);
     wx_mesh *mesh = add_mesh(&s, write_quad(), 30);
     add_surface(mesh, "*", 0, 0, density, 0.5f, 0.5f);
-    wx_run_options o;
+    wx_run_def o;
     options_for(&o, "dirt_head_on");
-    wx_error err = { "" };
+    wx_error err = { 0 };
     ENSURE(wx_bake_scene(&s, &o, &err) == WX_OK);
     maps4 a, b;
     ENSURE(read_maps(&s.cameras[0], &a));
@@ -621,9 +628,9 @@ TEST(initial_dirt_one_camera_divides_by_cosine)
     add_camera(&s, "slant", slant, ORIGIN, UP_Y, 4, 4, 64, 64, false);
     wx_mesh *mesh = add_mesh(&s, write_quad(), 30);
     add_surface(mesh, "*", 0, 0, density, 0, 0);
-    wx_run_options o;
+    wx_run_def o;
     options_for(&o, "dirt_cosine");
-    wx_error err = { "" };
+    wx_error err = { 0 };
     ENSURE(wx_bake_scene(&s, &o, &err) == WX_OK);
     maps4 a;
     ENSURE(read_maps(&s.cameras[0], &a));
@@ -649,9 +656,9 @@ TEST(initial_dirt_tie_goes_to_the_first_camera)
     add_camera(&s, "right", right, ORIGIN, UP_Y, 4, 4, 64, 64, false);
     wx_mesh *mesh = add_mesh(&s, write_quad(), 30);
     add_surface(mesh, "*", 0, 0, density, 0, 0);
-    wx_run_options o;
+    wx_run_def o;
     options_for(&o, "dirt_tie");
-    wx_error err = { "" };
+    wx_error err = { 0 };
     ENSURE(wx_bake_scene(&s, &o, &err) == WX_OK);
     maps4 a, b;
     ENSURE(read_maps(&s.cameras[0], &a));
@@ -683,9 +690,9 @@ TEST(initial_dirt_hidden_from_head_on_camera)
     const char *blocker = ensure_write_file(ensure_tmpdir(), "blocker.obj",
                                             "v -1 -1 1\nv 0 -1 1\nv 0 1 1\nv -1 1 1\nf 1 2 3 4\n");
     add_surface(add_mesh(&s, blocker, 40), "*", 0, 0, 0, 0, 0);
-    wx_run_options o;
+    wx_run_def o;
     options_for(&o, "dirt_hidden");
-    wx_error err = { "" };
+    wx_error err = { 0 };
     ENSURE(wx_bake_scene(&s, &o, &err) == WX_OK);
     maps4 a, b;
     ENSURE(read_maps(&s.cameras[0], &a));
@@ -713,9 +720,9 @@ TEST(output_camera_gets_depth_and_normal_only)
     wx_scene_camera *out = add_camera(&s, "shot", eye, ORIGIN, UP_Y, 4, 2, 40, 20, true);
     (void)out;
     add_surface(add_mesh(&s, data_path("bake_box.obj"), 30), "*", 0, 0, 0, 0, 0);
-    wx_run_options o;
+    wx_run_def o;
     options_for(&o, "output");
-    wx_error err = { "" };
+    wx_error err = { 0 };
     ENSURE(wx_bake_scene(&s, &o, &err) == WX_OK);
     const wx_scene_camera *shot = &s.cameras[1];
     ENSURE(ensure_contains(shot->depth_path, "shot_depth.exr"));
@@ -754,9 +761,9 @@ TEST(missing_and_unsupported_mesh_files)
         const float eye[3] = { 0, 0, 5 };
         add_camera(&s, "front", eye, ORIGIN, UP_Y, 4, 4, 16, 16, false);
         add_surface(add_mesh(&s, data_path(files[k]), 7), "*", 0, 0, 0, 0, 0);
-        wx_run_options o;
+        wx_run_def o;
         options_for(&o, "missing");
-        wx_error err = { "" };
+        wx_error err = { 0 };
         ENSURE(wx_bake_scene(&s, &o, &err) == WX_BAD_INPUT);
         ENSURE(ensure_contains(err.message, "scene.xml:7"));
         ENSURE(ensure_contains(err.message, files[k]));
@@ -771,9 +778,9 @@ TEST(no_geometry_is_an_error)
     scene_begin(&s);
     const float eye[3] = { 0, 0, 5 };
     add_camera(&s, "front", eye, ORIGIN, UP_Y, 4, 4, 16, 16, false);
-    wx_run_options o;
+    wx_run_def o;
     options_for(&o, "nogeometry");
-    wx_error err = { "" };
+    wx_error err = { 0 };
     ENSURE(wx_bake_scene(&s, &o, &err) == WX_BAD_INPUT);
     ENSURE(ensure_contains(err.message, "camera 'front'"));
     ENSURE(ensure_contains(err.message, "no <Geometry>"));
@@ -790,9 +797,9 @@ TEST(maps_beyond_the_renderer_are_refused)
     const float eye[3] = { 0, 0, 5 };
     add_camera(&s, "huge", eye, ORIGIN, UP_Y, 4, 4, WX_MAP_MAX_SIDE + 1, 16, false);
     add_surface(add_mesh(&s, data_path("bake_box.obj"), 30), "*", 0, 0, 0, 0, 0);
-    wx_run_options o;
+    wx_run_def o;
     options_for(&o, "huge");
-    wx_error err = { "" };
+    wx_error err = { 0 };
     ENSURE(wx_bake_scene(&s, &o, &err) == WX_BAD_INPUT);
     ENSURE(ensure_contains(err.message, "camera 'huge'"));
     ENSURE(ensure_contains(err.message, "at most"));
@@ -848,13 +855,13 @@ TEST(scene_file_bakes_maps_the_scene_reads_back)
 {
     const char *path = write_scene("scene_file", "box.obj");
     wx_scene s;
-    wx_error err = { "" };
+    wx_error err = { 0 };
     wx_result r = wx_scene_load(path, &s, &err);
     if (r != WX_OK) {
         fprintf(stderr, "%s\n", err.message);
     }
     ENSURE(r == WX_OK);
-    wx_run_options o;
+    wx_run_def o;
     options_for(&o, "scene_file_out");
     ENSURE(wx_bake_scene(&s, &o, &err) == WX_OK);
     double texel_area = (4.0 / 64) * (4.0 / 64);
@@ -923,7 +930,7 @@ TEST(scene_file_bakes_maps_the_scene_reads_back)
 }
 
 // Runs the bake with stderr captured into `out`.
-static wx_result bake_capturing_stderr(wx_scene *s, const wx_run_options *o, char *out,
+static wx_result bake_capturing_stderr(wx_scene *s, const wx_run_def *o, char *out,
                                        size_t cap, wx_error *err)
 {
     char path[4200];
@@ -952,10 +959,10 @@ TEST(warns_about_geometry_outside_the_frame_or_behind_the_eye)
     const float eye[3] = { 0, 0, 0.5f };
     add_camera(&s, "inside", eye, ORIGIN, UP_Y, 1, 1, 16, 16, false);
     add_surface(add_mesh(&s, data_path("bake_box.obj"), 30), "*", 0, 0, 0, 0, 0);
-    wx_run_options o;
+    wx_run_def o;
     options_for(&o, "warnings");
     o.quiet = false;
-    wx_error err = { "" };
+    wx_error err = { 0 };
     char text[4096];
     wx_result r = bake_capturing_stderr(&s, &o, text, sizeof text, &err);
     if (r != WX_OK) {

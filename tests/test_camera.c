@@ -2,8 +2,9 @@
 #include <math.h>
 #include <string.h>
 
-#include "camera.h"
+#include "model/camera.h"
 #include "ensure.h"
+#include "core/matrix.h"
 
 static wx_view front_view(void)
 {
@@ -56,9 +57,9 @@ TEST(view_matrices_invert)
                      .width_ws = 7, .height_ws = 3, .width_px = 64, .height_px = 32 };
     wx_camera cam;
     ENSURE(wx_camera_from_view(&view, &cam, NULL) == WX_OK);
-    ENSURE(wx_camera_inverse_error(cam.wtc, cam.ctw) < 1e-5f);
+    ENSURE(wx_matrix_inverse_error(cam.wtc, cam.ctw) < 1e-5f);
     float inverted[16];
-    ENSURE(wx_camera_invert(cam.wtc, inverted));
+    ENSURE(wx_matrix_invert(cam.wtc, inverted));
     for (int k = 0; k < 16; ++k) {
         ENSURE_NEAR(inverted[k], cam.ctw[k], 1e-4);
     }
@@ -127,7 +128,7 @@ TEST(thesis_identity_matrix)
     float identity[16] = { 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1 };
     wx_camera cam;
     memcpy(cam.wtc, identity, sizeof identity);
-    ENSURE(wx_camera_invert(cam.wtc, cam.ctw));
+    ENSURE(wx_matrix_invert(cam.wtc, cam.ctw));
     const float p[3] = { 0.25f, 0.5f, 2.0f };
     float uvd[3];
     wx_camera_world_to_map(&cam, p, uvd);
@@ -143,7 +144,7 @@ TEST(row_vector_translation_is_the_last_row)
     ENSURE(wx_transform_point(m, p, out));
     ENSURE(out[0] == 6.0f && out[1] == 8.0f && out[2] == 10.0f);
     float inv[16];
-    ENSURE(wx_camera_invert(m, inv));
+    ENSURE(wx_matrix_invert(m, inv));
     ENSURE_NEAR(inv[12], -5.0, 1e-6);
     ENSURE_NEAR(inv[13], -6.0, 1e-6);
     ENSURE_NEAR(inv[14], -7.0, 1e-6);
@@ -153,9 +154,9 @@ TEST(singular_and_bad_views_are_refused)
 {
     float singular[16] = { 1, 0, 0, 0, 2, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1 };
     float inv[16];
-    ENSURE(!wx_camera_invert(singular, inv));
+    ENSURE(!wx_matrix_invert(singular, inv));
     float with_nan[16] = { NAN, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1 };
-    ENSURE(!wx_camera_invert(with_nan, inv));
+    ENSURE(!wx_matrix_invert(with_nan, inv));
     wx_camera cam;
     wx_error err;
     wx_view same = { .eye = { 1, 1, 1 }, .target = { 1, 1, 1 }, .up = { 0, 1, 0 },
@@ -173,9 +174,9 @@ TEST(inverse_error_detects_a_wrong_inverse)
     wx_view view = front_view();
     wx_camera cam;
     ENSURE(wx_camera_from_view(&view, &cam, NULL) == WX_OK);
-    ENSURE(wx_camera_inverse_error(cam.wtc, cam.ctw) < 1e-6f);
+    ENSURE(wx_matrix_inverse_error(cam.wtc, cam.ctw) < 1e-6f);
     cam.ctw[12] += 0.5f;
-    ENSURE(wx_camera_inverse_error(cam.wtc, cam.ctw) > 0.01f);
+    ENSURE(wx_matrix_inverse_error(cam.wtc, cam.ctw) > 0.01f);
 }
 
 int main(void)

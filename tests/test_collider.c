@@ -3,9 +3,9 @@
 #include <math.h>
 #include <string.h>
 
-#include "collider.h"
+#include "sim/collider.h"
 #include "ensure.h"
-#include "particles.h"
+#include "sim/particles.h"
 #include "sim_fixture.h"
 
 // A camera above the origin looking down: u grows with x, v with -z.

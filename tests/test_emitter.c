@@ -2,11 +2,11 @@
 #include <math.h>
 #include <string.h>
 
-#include "emitter.h"
+#include "sim/emitter.h"
 #include "ensure.h"
-#include "particles.h"
+#include "sim/particles.h"
 #include "sim_fixture.h"
-#include "simulate.h"
+#include "sim/simulate.h"
 
 static wx_emitter point_emitter(double rate, double start, double end, float speed)
 {
@@ -50,7 +50,7 @@ TEST(simulation_emits_floor_counts)
     e->rate = 333;
     e->start = 0.1;
     e->end = 0.75;
-    wx_sim_config cfg = wx_sim_default_config(&f.scene);
+    wx_sim_def cfg = wx_default_sim_def(&f.scene);
     cfg.threads = 1;
     wx_sim *sim = NULL;
     wx_error err;

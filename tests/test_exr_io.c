@@ -13,7 +13,8 @@
 #include <openexr.h>
 
 #include "ensure.h"
-#include "exr_io.h"
+#include "io/exr.h"
+#include "model/image.h"
 
 // ---------------------------------------------------------------------------
 // Helpers.
@@ -212,7 +213,7 @@ static bool read_fails(const char *path, const char *needle)
 {
     static const char *const wanted[] = {"R"};
     wx_image image;
-    wx_error err = {{0}};
+    wx_error err = { 0 };
     wx_result r = wx_exr_read(path, wanted, 1, &image, &err);
     bool ok = r == WX_BAD_INPUT && ensure_contains(err.message, path) &&
               ensure_contains(err.message, needle) && image.channels[0] == NULL && image.width == 0;
@@ -243,7 +244,7 @@ TEST(float_round_trip_is_bit_exact)
     y[7] = FLT_MAX;
     y[W * H - 1] = 0.1f; // last texel of the partial chunk
     const char *path = path_in("round.exr");
-    wx_error err = {{0}};
+    wx_error err = { 0 };
     ENSURE(wx_exr_write(path, &image, &err) == WX_OK);
 
     static const char *const wanted[] = {"Z", "B", "Y", "R", "G"};
@@ -296,7 +297,7 @@ TEST(interleaved_read_orders_channels_as_asked)
     float *texels = NULL;
     int w = 0;
     int h = 0;
-    wx_error err = {{0}};
+    wx_error err = { 0 };
     ENSURE(wx_exr_read_interleaved(path, wanted, 3, &texels, &w, &h, &err) == WX_OK);
     ENSURE(w == W && h == H);
     // Texel (i=4, j=32): G = 1000 + 324, B = 2000 + 324, R = 324.
@@ -337,7 +338,7 @@ TEST(half_channels_are_read_as_float)
 
         static const char *const wanted[] = {"R", "G"};
         wx_image image;
-        wx_error err = {{0}};
+        wx_error err = { 0 };
         ENSURE(wx_exr_read(path, wanted, 2, &image, &err) == WX_OK);
         bool right = image.width == W && image.height == H;
         for (int t = 0; right && t < W * H; t++) {
@@ -502,7 +503,7 @@ TEST(attributes_round_trip)
     wx_image_set_string(&image, "cameraName", "back"); // replaces, does not add
     ENSURE(image.attr_count == 4);
     const char *path = path_in("attrs.exr");
-    wx_error err = {{0}};
+    wx_error err = { 0 };
     ENSURE(wx_exr_write(path, &image, &err) == WX_OK);
     wx_image_free(&image);
 
@@ -544,7 +545,7 @@ TEST(depth_alternatives_read_z)
     wx_image_free(&image);
     static const char *const wanted[] = {"R|Z"};
     wx_image back;
-    wx_error err = {{0}};
+    wx_error err = { 0 };
     ENSURE(wx_exr_read(path, wanted, 1, &back, &err) == WX_OK);
     bool right = strcmp(back.channel_names[0], "Z") == 0 && back.channels[0][4] == 42.5f &&
                  back.channels[0][5] == 12.0f;
@@ -567,7 +568,7 @@ TEST(missing_channel_lists_what_the_file_has)
     wx_image_free(&image);
     static const char *const wanted[] = {"R|Z"};
     wx_image back;
-    wx_error err = {{0}};
+    wx_error err = { 0 };
     ENSURE(wx_exr_read(path, wanted, 1, &back, &err) == WX_BAD_INPUT);
     ENSURE(ensure_contains(err.message, path));
     ENSURE(ensure_contains(err.message, ": no channel R or Z (has: B, G)"));
@@ -585,7 +586,7 @@ TEST(missing_file_is_bad_input)
 {
     ENSURE(read_fails(path_in("does_not_exist.exr"), "cannot open (No such file or directory)"));
     wx_image image;
-    wx_error err = {{0}};
+    wx_error err = { 0 };
     const char *path = path_in("does_not_exist_either.exr");
     ENSURE(wx_exr_read_header(path, &image, &err) == WX_BAD_INPUT);
     ENSURE(ensure_contains(err.message, path));
@@ -734,7 +735,7 @@ TEST(absurd_size_is_bad_input)
     ENSURE(patch_data_window(path, 99999, 99999));
     ENSURE(read_fails(path, "100000 x 100000 exceeds the largest map size 16384 x 16384"));
     wx_image image;
-    wx_error err = {{0}};
+    wx_error err = { 0 };
     ENSURE(wx_exr_read_header(path, &image, &err) == WX_BAD_INPUT);
     ENSURE(ensure_contains(err.message, "exceeds the largest map size"));
     // One side over the limit is enough.
@@ -770,7 +771,7 @@ TEST(write_to_missing_folder_fails_cleanly)
     wx_image image;
     ENSURE(make_image(&image, 4, 4, 1, names));
     const char *path = path_in("no_such_folder/out.exr");
-    wx_error err = {{0}};
+    wx_error err = { 0 };
     wx_result r = wx_exr_write(path, &image, &err);
     wx_image_free(&image);
     ENSURE(r == WX_FAIL);
@@ -856,7 +857,7 @@ TEST(write_failure_keeps_the_old_file)
     small.rlim_cur = 16384;
     void (*old_handler)(int) = signal(SIGXFSZ, SIG_IGN);
     ENSURE(setrlimit(RLIMIT_FSIZE, &small) == 0);
-    wx_error err = {{0}};
+    wx_error err = { 0 };
     wx_result r = wx_exr_write(path, &image, &err);
     setrlimit(RLIMIT_FSIZE, &saved);
     signal(SIGXFSZ, old_handler);
@@ -878,7 +879,7 @@ TEST(image_alloc_checks_sizes)
 {
     static const char *const names[] = {"R", "G"};
     wx_image image;
-    wx_error err = {{0}};
+    wx_error err = { 0 };
     ENSURE(wx_image_alloc(&image, 16385, 1, 1, names, &err) == WX_BAD_INPUT);
     ENSURE(image.channels[0] == NULL);
     ENSURE(wx_image_alloc(&image, 0, 5, 1, names, &err) == WX_BAD_INPUT);

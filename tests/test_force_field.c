@@ -3,8 +3,8 @@
 #include <string.h>
 
 #include "ensure.h"
-#include "force_field.h"
-#include "particles.h"
+#include "sim/force_field.h"
+#include "sim/particles.h"
 
 static wx_field field(wx_field_kind kind, float strength)
 {

@@ -7,11 +7,16 @@
 #include <string.h>
 #include <sys/stat.h>
 
-#include "camera.h"
+#include "model/camera.h"
 #include "ensure.h"
-#include "exr_io.h"
-#include "gather.h"
-#include "png_preview.h"
+#include "io/exr.h"
+#include "gather/gather.h"
+#include "io/png_preview.h"
+#include "core/limits.h"
+#include "core/matrix.h"
+#include "model/image.h"
+#include "pipeline/gather_phase.h"
+#include "pipeline/pipeline.h"
 
 #define PI 3.14159265358979323846
 
@@ -134,6 +139,13 @@ static wx_gather_view view_of(const test_maps *m)
     return v;
 }
 
+static wx_target target_of(const test_maps *m)
+{
+    wx_target t = { .kind = WX_TARGET_CAMERA, .camera = &m->cam, .width = m->w, .height = m->h,
+                    .depth = m->depth, .normal = m->normal };
+    return t;
+}
+
 static quad make_quad(double cx, double cy, double cz, double ax, double ay, double az, double bx,
                       double by, double bz, double nx, double ny, double nz)
 {
@@ -162,7 +174,7 @@ static float *run_gather(const test_maps *out, const test_maps *inputs, int coun
         views[k] = view_of(&inputs[k]);
     }
     wx_gather_def def = wx_default_gather_def();
-    def.output = view_of(out);
+    def.target = target_of(out);
     def.inputs = views;
     def.input_count = count;
     def.radius = radius;
@@ -501,7 +513,7 @@ TEST(normalize_scales_the_maximum_to_one)
     in.dirt[2 * 8 + 1] = 0.1f; // 0.4 per m^2
     wx_gather_view input = view_of(&in);
     wx_gather_def def = wx_default_gather_def();
-    def.output = view_of(&out);
+    def.target = target_of(&out);
     def.inputs = &input;
     def.input_count = 1;
     def.normalize = true;
@@ -542,7 +554,7 @@ TEST(bad_definitions_are_refused)
     quad wall = big_wall();
     test_maps out = render(front_camera(), &wall, 1, NULL);
     wx_gather_def def = wx_default_gather_def();
-    def.output = view_of(&out);
+    def.target = target_of(&out);
     float mask[32];
     wx_error err;
     def.radius = -1.0f;
@@ -553,11 +565,11 @@ TEST(bad_definitions_are_refused)
     def.radius = 0.0f;
     wx_camera persp = out.cam;
     persp.wtc[11] = 1.0f; // w depends on z: not orthographic
-    def.output.camera = &persp;
+    def.target.camera = &persp;
     ENSURE(wx_gather_compute(&def, mask, NULL, &err) == WX_BAD_INPUT);
     ENSURE(ensure_contains(err.message, "orthographic"));
-    def.output.camera = &out.cam;
-    def.output.width = 9; // camera is 8 x 4
+    def.target.camera = &out.cam;
+    def.target.width = 9; // camera is 8 x 4
     ENSURE(wx_gather_compute(&def, mask, NULL, &err) == WX_BAD_INPUT);
     maps_free(&out);
 }
@@ -665,7 +677,7 @@ static double patch_density(const double p[3], int q)
 typedef struct file_scene {
     wx_scene scene;
     wx_scene_camera cams[2];
-    wx_run_options opts;
+    wx_run_def opts;
     test_maps in, out;
     char dir[2048];
 } file_scene;

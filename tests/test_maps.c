@@ -3,8 +3,10 @@
 #include <string.h>
 
 #include "ensure.h"
-#include "exr_io.h"
-#include "maps.h"
+#include "io/exr.h"
+#include "model/maps.h"
+#include "io/maps_file.h"
+#include "model/image.h"
 
 enum { W = 8, H = 4 };
 
@@ -79,7 +81,7 @@ TEST(four_maps_load_in_simulation_layout)
     ENSURE(write_map(dirt_path, W, H, 3, RGB, NULL));
 
     wx_maps maps;
-    wx_error err = {{0}};
+    wx_error err = { 0 };
     ENSURE(wx_maps_load(&maps, WX_MAPS_ALL, depth_path, normal_path, impact_path, dirt_path,
                         &err) == WX_OK);
     ENSURE(maps.width == W && maps.height == H);
@@ -115,7 +117,7 @@ TEST(depth_is_read_from_z)
     const char *path = path_in("depth_z.exr");
     ENSURE(write_map(path, W, H, 1, Z, depth));
     wx_maps maps;
-    wx_error err = {{0}};
+    wx_error err = { 0 };
     ENSURE(wx_maps_load(&maps, WX_MAPS_DEPTH, path, NULL, NULL, NULL, &err) == WX_OK);
     bool right = isinf(maps.depth[0]) && isinf(maps.depth[2]) && maps.depth[9] == 10.0f &&
                  maps.normal == NULL && maps.dirt == NULL && maps.width == W;
@@ -130,7 +132,7 @@ TEST(only_selected_maps_are_loaded)
     ENSURE(write_map(dirt_path, W, H, 3, RGB, NULL));
     ENSURE(write_map(impact_path, W, H, 2, RGB, NULL));
     wx_maps maps;
-    wx_error err = {{0}};
+    wx_error err = { 0 };
     // The impact path is given but not selected: it is not read.
     ENSURE(wx_maps_load(&maps, WX_MAPS_DIRT, "", NULL, impact_path, dirt_path, &err) == WX_OK);
     bool right = maps.depth == NULL && maps.normal == NULL && maps.impact == NULL &&
@@ -152,7 +154,7 @@ TEST(mismatched_sizes_name_both_files)
     ENSURE(write_map(depth_path, W, H, 1, R, NULL));
     ENSURE(write_map(normal_path, 16, 8, 3, RGB, NULL));
     wx_maps maps;
-    wx_error err = {{0}};
+    wx_error err = { 0 };
     ENSURE(wx_maps_load(&maps, WX_MAPS_DEPTH | WX_MAPS_NORMAL, depth_path, normal_path, NULL, NULL,
                         &err) == WX_BAD_INPUT);
     ENSURE(ensure_contains(err.message, depth_path));
@@ -173,7 +175,7 @@ TEST(missing_channels_are_errors)
     ENSURE(write_map(dirt_path, W, H, 2, RG, NULL));
     ENSURE(write_map(depth_path, W, H, 1, RGB + 1, NULL)); // only G
     wx_maps maps;
-    wx_error err = {{0}};
+    wx_error err = { 0 };
     ENSURE(wx_maps_load(&maps, WX_MAPS_IMPACT, NULL, NULL, impact_path, NULL, &err) ==
            WX_BAD_INPUT);
     ENSURE(ensure_contains(err.message, impact_path));
@@ -194,7 +196,7 @@ TEST(a_bad_file_frees_the_maps_already_loaded)
     const char *dirt_path = ensure_write_file(ensure_tmpdir(), "dirt_text.exr", "not a map\n");
     ENSURE(write_map(depth_path, W, H, 1, R, NULL));
     wx_maps maps;
-    wx_error err = {{0}};
+    wx_error err = { 0 };
     ENSURE(wx_maps_load(&maps, WX_MAPS_DEPTH | WX_MAPS_DIRT, depth_path, NULL, NULL, dirt_path,
                         &err) == WX_BAD_INPUT);
     ENSURE(ensure_contains(err.message, dirt_path));

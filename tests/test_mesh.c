@@ -11,7 +11,8 @@
 #include <unistd.h>
 
 #include "ensure.h"
-#include "mesh.h"
+#include "model/mesh.h"
+#include "io/mesh_import.h"
 
 #if defined(__SANITIZE_ADDRESS__)
 #define WX_ASAN 1
@@ -52,7 +53,7 @@ static void world(const wx_mesh_data *m, int64_t v, double p[3])
 TEST(two_materials_keep_their_names)
 {
     wx_mesh_data m;
-    wx_error err = { "" };
+    wx_error err = { 0 };
     ENSURE(wx_mesh_import(data_path("bake_two_materials.obj"), &m, &err) == WX_OK);
     ENSURE(m.triangle_count == 4);
     ENSURE(m.vertex_count == 8); // one aiMesh per material: the shared edge is not shared
@@ -85,7 +86,7 @@ TEST(two_materials_keep_their_names)
 TEST(box_gets_flat_generated_normals)
 {
     wx_mesh_data m;
-    wx_error err = { "" };
+    wx_error err = { 0 };
     ENSURE(wx_mesh_import(data_path("bake_box.obj"), &m, &err) == WX_OK);
     ENSURE(m.triangle_count == 12);
     // Edges of 90 degrees are not smoothed: 4 vertices per face after joining.
@@ -119,7 +120,7 @@ TEST(box_gets_flat_generated_normals)
 TEST(ply_vertex_colours)
 {
     wx_mesh_data m;
-    wx_error err = { "" };
+    wx_error err = { 0 };
     ENSURE(wx_mesh_import(data_path("bake_colors.ply"), &m, &err) == WX_OK);
     ENSURE(m.triangle_count == 2);
     ENSURE(m.vertex_count == 4);
@@ -147,7 +148,7 @@ TEST(gltf_node_transforms_are_applied)
     // triangle (0,0,0) (1,0,0) (0,1,0) with normal +z lands on (10,0,0)
     // (10,0,-2) (10,2,0) with normal +x.
     wx_mesh_data m;
-    wx_error err = { "" };
+    wx_error err = { 0 };
     ENSURE(wx_mesh_import(data_path("bake_transform.gltf"), &m, &err) == WX_OK);
     ENSURE(m.triangle_count == 1 && m.vertex_count == 3);
     ENSURE(find_material(&m, "Painted") == 0);
@@ -172,7 +173,7 @@ TEST(gltf_node_transforms_are_applied)
 TEST(missing_file_names_it)
 {
     wx_mesh_data m;
-    wx_error err = { "" };
+    wx_error err = { 0 };
     const char *path = data_path("bake_no_such_mesh.obj");
     ENSURE(wx_mesh_import(path, &m, &err) == WX_BAD_INPUT);
     char want[4200];
@@ -185,7 +186,7 @@ TEST(missing_file_names_it)
 TEST(unsupported_file_names_it)
 {
     wx_mesh_data m;
-    wx_error err = { "" };
+    wx_error err = { 0 };
     ENSURE(wx_mesh_import(data_path("bake_not_a_mesh.txt"), &m, &err) == WX_BAD_INPUT);
     ENSURE(ensure_contains(err.message, "bake_not_a_mesh.txt"));
     wx_mesh_data_free(&m);
@@ -196,7 +197,7 @@ TEST(lines_only_give_no_triangles)
     const char *path = ensure_write_file(ensure_tmpdir(), "lines.obj",
                                          "v 0 0 0\nv 1 0 0\nv 1 1 0\nl 1 2\nl 2 3\n");
     wx_mesh_data m;
-    wx_error err = { "" };
+    wx_error err = { 0 };
     wx_result r = wx_mesh_import(path, &m, &err);
     // Assimp may refuse a file without faces; either way nothing is drawn.
     ENSURE(r == WX_OK || r == WX_BAD_INPUT);
@@ -261,7 +262,7 @@ static const char *write_gltf(const char *dir, const char *name, const char *uri
 static bool refused_with(const char *path, wx_result code, const char *rest)
 {
     wx_mesh_data m;
-    wx_error err = { "" };
+    wx_error err = { 0 };
     wx_result r = wx_mesh_import(path, &m, &err);
     char want[WX_ERROR_MAX + 8];
     snprintf(want, sizeof want, "%s: %s", path, rest);
@@ -322,7 +323,7 @@ static bool import_in_child(const char *dir, const char *path, long long extra_b
         }
         wx_mesh_data m;
         child_result res = { 0 };
-        wx_error err = { "" };
+        wx_error err = { 0 };
         res.code = (int)wx_mesh_import(path, &m, &err);
         res.triangles = m.triangle_count;
         memcpy(res.message, err.message, sizeof res.message);
@@ -373,7 +374,7 @@ TEST(mesh_file_must_be_a_regular_file)
     ensure_write_file(dir, "real.obj", TRIANGLE_OBJ);
     ENSURE(symlink("real.obj", join(dir, "link.obj")) == 0);
     wx_mesh_data m;
-    wx_error err = { "" };
+    wx_error err = { 0 };
     ENSURE(wx_mesh_import(join(dir, "link.obj"), &m, &err) == WX_OK);
     ENSURE(m.triangle_count == 1);
     wx_mesh_data_free(&m);
@@ -418,7 +419,7 @@ TEST(obj_mtllib_outside_or_a_folder_is_refused)
                             "mtllib lib/shared.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl Wood\n"
                             "f 1 2 3\n");
     wx_mesh_data m;
-    wx_error err = { "" };
+    wx_error err = { 0 };
     ENSURE(wx_mesh_import(obj, &m, &err) == WX_OK);
     ENSURE(m.material_count == 1 && strcmp(m.material_names[0], "Wood") == 0);
     wx_mesh_data_free(&m);
@@ -433,7 +434,7 @@ TEST(obj_without_its_mtl_imports_as_before)
                                         "mtllib missing.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\n"
                                         "usemtl Wood\nf 1 2 3\n");
     wx_mesh_data m;
-    wx_error err = { "" };
+    wx_error err = { 0 };
     ENSURE(wx_mesh_import(obj, &m, &err) == WX_OK);
     ENSURE(m.triangle_count == 1);
     // Assimp 5.2.5 makes a material of the usemtl name (and DefaultMaterial, unused).
@@ -457,7 +458,7 @@ TEST(gltf_buffers_inside_the_folder_are_read)
     for (int k = 0; k < 3; ++k) {
         const char *gltf = write_gltf(dir, "a.gltf", uris[k]);
         wx_mesh_data m;
-        wx_error err = { "" };
+        wx_error err = { 0 };
         ENSURE(wx_mesh_import(gltf, &m, &err) == WX_OK);
         ENSURE(m.triangle_count == 1 && m.vertex_count == 3);
         ENSURE_NEAR(m.bounds_min[0], 0.0, 0.0);
@@ -525,7 +526,7 @@ TEST(non_finite_vertex_colours_are_refused)
                             "v 0 0 0 0.25 0.5 0.75\nv 1 0 0 0.25 0.5 0.75\n"
                             "v 0 1 0 0.25 0.5 0.75\nf 1 2 3\n");
     wx_mesh_data m;
-    wx_error err = { "" };
+    wx_error err = { 0 };
     ENSURE(wx_mesh_import(obj, &m, &err) == WX_OK);
     ENSURE(m.colors != NULL && m.vertex_count == 3);
     for (int64_t v = 0; v < m.vertex_count; ++v) {
@@ -559,7 +560,7 @@ TEST(generated_normals_of_huge_triangles_stay_zero)
     const char *obj = ensure_write_file(make_dir("huge"), "huge.obj",
                                         "v 0 0 0\nv 1e20 0 0\nv 0 1e20 0\nf 1 2 3\n");
     wx_mesh_data m;
-    wx_error err = { "" };
+    wx_error err = { 0 };
     ENSURE(wx_mesh_import(obj, &m, &err) == WX_OK);
     ENSURE(m.triangle_count == 1);
     ENSURE_NEAR(m.bounds_max[0], 1e20, 1e13);
@@ -616,7 +617,7 @@ TEST(fbx_from_blender_arrives_in_metres)
     const char *files[] = { "mesh_cube_2m.fbx", "mesh_cube_2m_units.fbx" };
     for (int f = 0; f < 2; ++f) {
         wx_mesh_data m;
-        wx_error err = { "" };
+        wx_error err = { 0 };
         ENSURE(wx_mesh_import(data_path(files[f]), &m, &err) == WX_OK);
         ENSURE(m.triangle_count == 12 && m.vertex_count == 24);
         const double lo[3] = { 0, 2, -3 }, hi[3] = { 2, 4, -1 }, mid[3] = { 1, 3, -2 };
@@ -653,7 +654,7 @@ TEST(formats_without_a_unit_are_left_as_they_are)
     // OBJ and glTF: no scale applied (bake_box.obj spans -1..1; the transform test
     // covers glTF node transforms).
     wx_mesh_data m;
-    wx_error err = { "" };
+    wx_error err = { 0 };
     ENSURE(wx_mesh_import(data_path("bake_box.obj"), &m, &err) == WX_OK);
     for (int i = 0; i < 3; ++i) {
         ENSURE(m.bounds_min[i] == -1.0 && m.bounds_max[i] == 1.0);

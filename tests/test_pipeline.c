@@ -4,9 +4,13 @@
 #include <string.h>
 #include <sys/stat.h>
 
-#include "atomic_file.h"
+#include "core/atomic_file.h"
 #include "ensure.h"
-#include "pipeline.h"
+#include "pipeline/pipeline.h"
+#include "core/limits.h"
+#include "io/stats_json.h"
+#include "pipeline/outputs.h"
+#include "sim/simulate.h"
 
 static int count_hidden_files(const char *dir)
 {
@@ -25,7 +29,7 @@ static int count_hidden_files(const char *dir)
 TEST(output_folder_is_created_with_parents)
 {
     wx_scene scene = { .output_index = -1 };
-    wx_run_options opts = { 0 };
+    wx_run_def opts = { 0 };
     snprintf(opts.out_dir, sizeof opts.out_dir, "%s/a/b/c", ensure_tmpdir());
     ENSURE(wx_output_prepare(&scene, &opts, NULL, NULL) == WX_OK);
     struct stat st;
@@ -45,8 +49,8 @@ TEST(default_options_follow_the_scene)
     wx_scene scene = { 0 };
     snprintf(scene.name, sizeof scene.name, "house");
     scene.seed = 42;
-    wx_run_options opts;
-    wx_run_options_default(&scene, &opts);
+    wx_run_def opts;
+    opts = wx_default_run_def(&scene);
     ENSURE(strcmp(opts.out_dir, "out/house") == 0);
     ENSURE(opts.seed == 42);
     ENSURE(opts.threads >= 1);
@@ -63,7 +67,7 @@ TEST(an_input_file_is_never_an_output)
     snprintf(scene.path, sizeof scene.path, "%s", ensure_write_file(dir, "s.xml", "<x/>"));
     snprintf(cam.depth_path, sizeof cam.depth_path, "%s",
              ensure_write_file(dir, "front_depth.exr", "not really"));
-    wx_run_options opts = { 0 };
+    wx_run_def opts = { 0 };
     snprintf(opts.out_dir, sizeof opts.out_dir, "%s", dir);
     char path[WX_PATH_MAX];
     wx_error err;
@@ -104,14 +108,13 @@ TEST(stats_json_has_the_pinned_keys_and_values)
 {
     char path[4200];
     snprintf(path, sizeof path, "%s/stats.json", ensure_tmpdir());
-    wx_run_options opts = { .threads = 2, .seed = 9 };
     wx_sim_stats stats = { .particles_emitted = 100, .particle_steps = 5000, .collisions = 40,
                            .absorbed = 10, .settled = 20, .escaped = 30, .alive = 40,
                            .dirt_initial_surface = 1.5, .dirt_emitted = 100,
                            .dirt_final_surface = 60, .dirt_in_flight = 11.5,
                            .dirt_escaped = 30 };
     wx_phase_times times = { .load = 0.25, .simulate = 1.5, .total = 2 };
-    ENSURE(wx_write_stats(path, &opts, &stats, &times, NULL) == WX_OK);
+    ENSURE(wx_write_stats(path, &stats, &times, 2, 9, NULL) == WX_OK);
     char *json = ensure_read_file(path);
     ENSURE(json != NULL);
     ENSURE(ensure_contains(json, "\"particles_emitted\": 100,"));

@@ -14,11 +14,15 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "atomic_file.h"
-#include "pipeline.h"
-#include "scene.h"
+#include "core/atomic_file.h"
+#include "pipeline/pipeline.h"
+#include "model/scene.h"
 #include "ensure.h"
-#include "exr_io.h"
+#include "io/exr.h"
+#include "core/limits.h"
+#include "io/scene_xml.h"
+#include "model/image.h"
+#include "pipeline/outputs.h"
 
 static char out[65536];
 
@@ -428,8 +432,8 @@ TEST(sigkill_never_leaves_a_torn_file)
     wx_scene loaded;
     wx_error err;
     ENSURE(wx_scene_load(scene, &loaded, &err) == WX_OK);
-    wx_run_options opts;
-    wx_run_options_default(&loaded, &opts);
+    wx_run_def opts;
+    opts = wx_default_run_def(&loaded);
     snprintf(opts.out_dir, sizeof opts.out_dir, "%.4000s", out_dir);
     wx_result prepared = wx_output_prepare(&loaded, &opts, NULL, &err);
     wx_scene_free(&loaded);

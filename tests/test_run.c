@@ -14,8 +14,10 @@
 #include <unistd.h>
 
 #include "ensure.h"
-#include "exr_io.h"
-#include "maps.h"
+#include "io/exr.h"
+#include "model/maps.h"
+#include "io/maps_file.h"
+#include "model/image.h"
 
 // A cube [-1,1]^3 with dirt 0.5 on it, seen from the front and the top; drops fall
 // on it from a point above.

@@ -9,8 +9,11 @@
 #include <unistd.h>
 
 #include "ensure.h"
-#include "exr_io.h"
-#include "scene.h"
+#include "io/exr.h"
+#include "model/scene.h"
+#include "io/scene_xml.h"
+#include "model/camera.h"
+#include "model/image.h"
 
 // The matrices of tests/data: a camera at z = 10 looking along -Z over a
 // 4 x 4 m frame centred on the origin (u = x/4 + 1/2, v = y/4 + 1/2, d = 10 - z).

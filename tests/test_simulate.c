@@ -7,11 +7,17 @@
 #include <string.h>
 
 #include "ensure.h"
-#include "exr_io.h"
-#include "particles.h"
-#include "scene.h"
+#include "io/exr.h"
+#include "sim/particles.h"
+#include "model/scene.h"
 #include "sim_fixture.h"
-#include "simulate.h"
+#include "sim/simulate.h"
+#include "core/limits.h"
+#include "io/scene_xml.h"
+#include "model/image.h"
+#include "pipeline/outputs.h"
+#include "pipeline/pipeline.h"
+#include "pipeline/simulate_phase.h"
 
 // --- helpers ----------------------------------------------------------------------
 
@@ -22,7 +28,7 @@ static wx_camera top_camera(float size, int px)
 
 static wx_sim *start_chunked(fx_scene *f, int threads, int chunk_particles)
 {
-    wx_sim_config cfg = wx_sim_default_config(&f->scene);
+    wx_sim_def cfg = wx_default_sim_def(&f->scene);
     cfg.threads = threads;
     cfg.chunk_particles = chunk_particles;
     cfg.maps = f->maps;
@@ -411,13 +417,13 @@ static bool run_and_hash(int threads, int chunk_particles, uint64_t *files, uint
     if (sim == NULL || !run(sim, 100)) {
         return false;
     }
-    wx_run_options opts;
+    wx_run_def opts;
     memset(&opts, 0, sizeof opts);
     snprintf(opts.out_dir, sizeof opts.out_dir, "%s/t%d_c%d", ensure_tmpdir(), threads,
              chunk_particles);
     wx_error err;
     bool ok = wx_output_prepare(&f.scene, &opts, NULL, &err) == WX_OK &&
-              wx_sim_write_dirt_maps(sim, &opts, &err) == WX_OK;
+              wx_write_dirt_maps(&f.scene, &opts, sim, f.maps, &err) == WX_OK;
     *files = 1469598103934665603ull;
     const char *names[3] = { "front", "side", "top" };
     for (int c = 0; c < 3 && ok; ++c) {
@@ -475,7 +481,7 @@ TEST(recent_hits_are_bounded_and_newest)
 {
     fx_scene f;
     busy_scene(&f);
-    wx_sim_config cfg = wx_sim_default_config(&f.scene);
+    wx_sim_def cfg = wx_default_sim_def(&f.scene);
     cfg.threads = 2;
     cfg.maps = f.maps;
     cfg.hit_capacity = 8;
@@ -615,8 +621,8 @@ TEST(thesis_format_scene_runs_with_defaults)
     }
     ENSURE(r == WX_OK);
     ENSURE(scene.steps == 1000 && scene.time_step == 0.01 && scene.input_count == 2);
-    wx_run_options opts;
-    wx_run_options_default(&scene, &opts);
+    wx_run_def opts;
+    opts = wx_default_run_def(&scene);
     snprintf(opts.out_dir, sizeof opts.out_dir, "%s/out", dir);
     opts.quiet = true;
     opts.threads = 2;

@@ -22,6 +22,8 @@
 #include "../viewer/view.c"
 #include "../viewer/world.c"
 #include "ensure.h"
+#include "model/camera.h"
+#include "sim/simulate.h"
 
 enum { WIDTH = 1024, HEIGHT = 640 }; // the viewer's default window size
 

@@ -1,5 +1,6 @@
 // bake_child.c: `weathering bake` in a child process (bake_child.h).
 #include "bake_child.h"
+#include "core/limits.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -43,14 +44,13 @@ wx_result vw_bake_start(vw_bake_child *child, const char *exe_dir, const char *s
     char program[WX_PATH_MAX + 16];
     int n = snprintf(program, sizeof program, "%s/weathering", exe_dir);
     if (n < 0 || n >= (int)sizeof program || access(program, X_OK) != 0) {
-        return wx_error_set(err, WX_FAIL,
-                            "%s: the scene has maps to bake, and %s is missing; run `weathering "
+        return wx_fail(err, WX_CAUSE_IO, "%s: the scene has maps to bake, and %s is missing; run `weathering "
                             "bake %s --out %s` first",
                             scene_path, program, scene_path, out_dir);
     }
     int fds[2];
     if (pipe(fds) != 0) {
-        return wx_error_set(err, WX_FAIL, "cannot start the bake: %s", strerror(errno));
+        return wx_fail(err, WX_CAUSE_IO, "cannot start the bake: %s", strerror(errno));
     }
     posix_spawn_file_actions_t actions;
     posix_spawn_file_actions_init(&actions);
@@ -64,7 +64,7 @@ wx_result vw_bake_start(vw_bake_child *child, const char *exe_dir, const char *s
     close(fds[1]);
     if (rc != 0) {
         close(fds[0]);
-        return wx_error_set(err, WX_FAIL, "cannot run %s: %s", program, strerror(rc));
+        return wx_fail(err, WX_CAUSE_IO, "cannot run %s: %s", program, strerror(rc));
     }
     fcntl(fds[0], F_SETFL, fcntl(fds[0], F_GETFL) | O_NONBLOCK);
     fcntl(fds[0], F_SETFD, FD_CLOEXEC);

@@ -11,8 +11,9 @@
 #include <stddef.h>
 #include <sys/types.h>
 
-#include "error.h"
-#include "scene.h"
+#include "core/error.h"
+#include "model/scene.h"
+#include "core/limits.h"
 
 typedef struct vw_bake_child {
     pid_t pid;           ///< 0 when no child runs

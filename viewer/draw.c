@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "palette.h"
+#include "sim/simulate.h"
 
 // Static geometry and hit points: position and colour per vertex.
 static const char *const COLOR_VS =
@@ -67,7 +68,7 @@ static wx_result compile(GLenum kind, const char *name, const char *src, GLuint 
         char log[1024] = "";
         glGetShaderInfoLog(shader, sizeof log, NULL, log);
         glDeleteShader(shader);
-        return wx_error_set(err, WX_FAIL, "GL: %s %s shader does not compile: %s", name,
+        return wx_fail(err, WX_CAUSE_RENDERER, "GL: %s %s shader does not compile: %s", name,
                             kind == GL_VERTEX_SHADER ? "vertex" : "fragment", log);
     }
     *out = shader;
@@ -100,7 +101,7 @@ wx_result vw_gl_program(const char *name, const char *vertex_src, const char *fr
         char log[1024] = "";
         glGetProgramInfoLog(p, sizeof log, NULL, log);
         glDeleteProgram(p);
-        return wx_error_set(err, WX_FAIL, "GL: %s program does not link: %s", name, log);
+        return wx_fail(err, WX_CAUSE_RENDERER, "GL: %s program does not link: %s", name, log);
     }
     *program = p;
     return WX_OK;
@@ -159,12 +160,12 @@ wx_result vw_draw_init(vw_draw *draw, int hit_capacity, wx_error *err)
     draw->hit_vertices = malloc((size_t)draw->hit_capacity * sizeof *draw->hit_vertices);
     if (draw->hits == NULL || draw->hit_vertices == NULL) {
         vw_draw_free(draw);
-        return wx_error_set(err, WX_FAIL, "out of memory (hit points)");
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (hit points)");
     }
     GLenum gl_err = glGetError();
     if (gl_err != GL_NO_ERROR) {
         vw_draw_free(draw);
-        return wx_error_set(err, WX_FAIL, "GL error 0x%x while creating buffers", gl_err);
+        return wx_fail(err, WX_CAUSE_RENDERER, "GL error 0x%x while creating buffers", gl_err);
     }
     return WX_OK;
 }
@@ -177,7 +178,7 @@ wx_result vw_draw_set_world(vw_draw *draw, const vw_world *world, wx_error *err)
     int n = world->scene.camera_count;
     bool *cameras = realloc(draw->depth_cameras, (size_t)(n > 0 ? n : 1) * sizeof *cameras);
     if (cameras == NULL) {
-        return wx_error_set(err, WX_FAIL, "out of memory (viewer)");
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (viewer)");
     }
     draw->depth_cameras = cameras;
     draw->camera_count = n;
@@ -241,7 +242,7 @@ static wx_result update_depth_samples(vw_draw *draw, const vw_world *world, cons
     }
     vw_point_filter *f = &draw->filter;
     if (!vw_points_begin(f, mvp, width, height, (size_t)world->point_count)) {
-        return wx_error_set(err, WX_FAIL, "out of memory (depth samples)");
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (depth samples)");
     }
     for (int c = 0; c < world->scene.camera_count; ++c) {
         vw_range r = world->camera_points[c];
@@ -280,7 +281,7 @@ static wx_result update_particles(vw_draw *draw, const vw_world *world, const fl
     }
     vw_point_filter *f = &draw->filter;
     if (!vw_points_begin(f, mvp, width, height, (size_t)view.count)) {
-        return wx_error_set(err, WX_FAIL, "out of memory (%lld particles to draw)",
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (%lld particles to draw)",
                             (long long)view.count);
     }
     for (int64_t i = 0; i < view.count; ++i) {
@@ -319,7 +320,7 @@ wx_result vw_draw_update(vw_draw *draw, const vw_world *world, const vw_show *sh
                          const float mvp[16], int fb_width, int fb_height, wx_error *err)
 {
     if (!reserve_staging(draw, fb_width, fb_height)) {
-        return wx_error_set(err, WX_FAIL, "out of memory (%dx%d window)", fb_width, fb_height);
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (%dx%d window)", fb_width, fb_height);
     }
     wx_result r = WX_OK;
     if (show->depth_samples) {

@@ -11,7 +11,7 @@
 
 #include "gl.h"
 #include "points.h"
-#include "simulate.h"
+#include "sim/simulate.h"
 #include "world.h"
 
 /// What to show.

@@ -7,7 +7,7 @@
 #include <GL/gl.h>
 #include <GL/glext.h>
 
-#include "error.h"
+#include "core/error.h"
 
 /// Compiles and links a vertex and a fragment shader (GLSL source strings).
 /// `name` labels the compiler log in the error message.

@@ -23,6 +23,8 @@
 #include "screenshot.h"
 #include "view.h"
 #include "world.h"
+#include "core/limits.h"
+#include "sim/simulate.h"
 
 #define GLFW_INCLUDE_NONE
 #include <GLFW/glfw3.h>

@@ -11,8 +11,9 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "atomic_file.h"
+#include "core/atomic_file.h"
 #include "gl.h"
+#include "core/limits.h"
 
 typedef struct png_failure {
     jmp_buf jump;
@@ -72,7 +73,7 @@ static wx_result write_png(const char *path, const uint8_t *pixels, int width, i
     w.height = height;
     w.file = fopen(tmp, "wb");
     if (w.file == NULL) {
-        return wx_error_set(err, WX_FAIL, "%s: cannot write (%s)", path, strerror(errno));
+        return wx_fail(err, WX_CAUSE_IO, "%s: cannot write (%s)", path, strerror(errno));
     }
     w.png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &w.failure, on_png_error,
                                     on_png_warning);
@@ -85,12 +86,12 @@ static wx_result write_png(const char *path, const uint8_t *pixels, int width, i
     int closed = fclose(w.file);
     if (!ok) {
         unlink(tmp);
-        return wx_error_set(err, WX_FAIL, "%s: cannot write PNG (%s)", path, w.failure.message);
+        return wx_fail(err, WX_CAUSE_IO, "%s: cannot write PNG (%s)", path, w.failure.message);
     }
     if (closed != 0) {
         int saved = errno;
         unlink(tmp);
-        return wx_error_set(err, WX_FAIL, "%s: cannot write (%s)", path, strerror(saved));
+        return wx_fail(err, WX_CAUSE_IO, "%s: cannot write (%s)", path, strerror(saved));
     }
     return wx_atomic_commit(tmp, path, err);
 }
@@ -98,7 +99,7 @@ static wx_result write_png(const char *path, const uint8_t *pixels, int width, i
 wx_result vw_screenshot_write(const char *path, int width, int height, wx_error *err)
 {
     if (width < 1 || height < 1) {
-        return wx_error_set(err, WX_FAIL, "%s: the window is empty", path);
+        return wx_fail(err, WX_CAUSE_RENDERER, "%s: the window is empty", path);
     }
     size_t row = 3 * (size_t)width;
     uint8_t *bottom_up = malloc(row * (size_t)height);
@@ -106,7 +107,7 @@ wx_result vw_screenshot_write(const char *path, int width, int height, wx_error 
     if (bottom_up == NULL || top_down == NULL) {
         free(bottom_up);
         free(top_down);
-        return wx_error_set(err, WX_FAIL, "%s: out of memory", path);
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "%s: out of memory", path);
     }
     glPixelStorei(GL_PACK_ALIGNMENT, 1);
     glReadBuffer(GL_BACK);

@@ -3,7 +3,7 @@
 #ifndef VW_SCREENSHOT_H
 #define VW_SCREENSHOT_H
 
-#include "error.h"
+#include "core/error.h"
 
 /// Reads the back buffer of the current context (width x height pixels, RGB),
 /// turns glReadPixels' bottom-up rows into top-down ones, and writes `path`.

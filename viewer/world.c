@@ -7,9 +7,17 @@
 #include <string.h>
 #include <sys/stat.h>
 
-#include "camera.h"
-#include "gather.h"
+#include "gather/gather.h"
+#include "io/maps_file.h"
+#include "io/scene_xml.h"
+#include "model/camera.h"
 #include "palette.h"
+#include "pipeline/gather_phase.h"
+#include "pipeline/outputs.h"
+#include "pipeline/simulate_phase.h"
+#include "core/limits.h"
+#include "pipeline/pipeline.h"
+#include "sim/simulate.h"
 
 static const char *const MAP_KINDS[4] = { "depth", "normal", "impact", "dirt" };
 
@@ -22,13 +30,13 @@ wx_result vw_world_parse(vw_world *world, const vw_settings *settings, wx_error 
     if (r != WX_OK) {
         return r;
     }
-    wx_run_options_default(&world->scene, &world->opts);
+    world->opts = wx_default_run_def(&world->scene);
     if (settings->out_dir != NULL) {
         int n = snprintf(world->opts.out_dir, sizeof world->opts.out_dir, "%s",
                          settings->out_dir);
         if (n < 0 || n >= (int)sizeof world->opts.out_dir) {
             wx_scene_free(&world->scene);
-            return wx_error_set(err, WX_BAD_INPUT, "--out %s: path too long", settings->out_dir);
+            return wx_fail(err, WX_CAUSE_PATH_TOO_LONG, "--out %s: path too long", settings->out_dir);
         }
     }
     if (settings->threads > 0) {
@@ -345,7 +353,7 @@ static wx_result build_geometry(vw_world *world, wx_error *err)
     world->camera_lines = calloc((size_t)n, sizeof *world->camera_lines);
     world->camera_points = calloc((size_t)n, sizeof *world->camera_points);
     if (world->camera_lines == NULL || world->camera_points == NULL) {
-        return wx_error_set(err, WX_FAIL, "out of memory (viewer geometry)");
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (viewer geometry)");
     }
     vertex_list lines = { 0 }, points = { 0 };
     for (int a = 0; a < 3; ++a) {
@@ -401,7 +409,7 @@ static wx_result build_geometry(vw_world *world, wx_error *err)
     world->points = points.data;
     world->point_count = points.count;
     if (lines.failed || points.failed) {
-        return wx_error_set(err, WX_FAIL, "out of memory (viewer geometry)");
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (viewer geometry)");
     }
     return WX_OK;
 }
@@ -416,7 +424,7 @@ static wx_result load_maps(vw_world *world, wx_error *err)
     world->camera_maps = calloc((size_t)n, sizeof *world->camera_maps);
     world->input_camera = calloc((size_t)n, sizeof *world->input_camera);
     if (world->maps == NULL || world->camera_maps == NULL || world->input_camera == NULL) {
-        return wx_error_set(err, WX_FAIL, "out of memory (maps)");
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (maps)");
     }
     int inputs = 0;
     for (int c = 0; c < n; ++c) {
@@ -433,8 +441,7 @@ static wx_result load_maps(vw_world *world, wx_error *err)
     for (int c = 0; c < n; ++c) {
         const wx_scene_camera *cam = &scene->cameras[c];
         if (cam->depth_path[0] == '\0') {
-            return wx_error_set(err, WX_BAD_INPUT,
-                                "%s: camera '%s' has no maps; run `weathering bake %s` first",
+            return wx_fail(err, WX_CAUSE_MISSING_PHASE, "%s: camera '%s' has no maps; run `weathering bake %s` first",
                                 scene->path, cam->name, scene->path);
         }
         unsigned which = WX_MAPS_DEPTH | WX_MAPS_NORMAL;
@@ -457,7 +464,7 @@ static wx_result load_maps(vw_world *world, wx_error *err)
 
 static wx_result create_sim(vw_world *world, const vw_settings *settings, wx_error *err)
 {
-    wx_sim_config config = wx_sim_default_config(&world->scene);
+    wx_sim_def config = wx_default_sim_def(&world->scene);
     config.seed = world->opts.seed;
     config.threads = settings->threads;
     config.hit_capacity = settings->hit_capacity;
@@ -511,7 +518,7 @@ wx_result vw_world_gather(vw_world *world, char saved[WX_PATH_MAX], wx_error *er
     snprintf(saved, WX_PATH_MAX, "%s", world->opts.out_dir);
     wx_result r = wx_output_prepare(&world->scene, &world->opts, NULL, err);
     if (r == WX_OK) {
-        r = wx_sim_write_dirt_maps(world->sim, &world->opts, err);
+        r = wx_write_dirt_maps(&world->scene, &world->opts, world->sim, world->maps, err);
     }
     if (r != WX_OK || world->scene.output_index < 0) {
         return r;

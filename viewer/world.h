@@ -13,11 +13,12 @@
 #include <stdbool.h>
 #include <stdint.h>
 
-#include "error.h"
-#include "maps.h"
-#include "pipeline.h"
-#include "scene.h"
-#include "simulate.h"
+#include "core/error.h"
+#include "model/maps.h"
+#include "pipeline/pipeline.h"
+#include "model/scene.h"
+#include "sim/simulate.h"
+#include "core/limits.h"
 
 /// Depth samples drawn over all cameras, at most (thesis 4.8.5: "some samples").
 #define VW_MAX_DEPTH_SAMPLES 250000
@@ -44,7 +45,7 @@ typedef struct vw_settings {
 
 typedef struct vw_world {
     wx_scene scene;
-    wx_run_options opts;
+    wx_run_def opts;
     /// Maps per camera: the scene's input cameras first, in scene order (the
     /// simulation borrows these), then the output camera (depth, normal).
     wx_maps *maps;

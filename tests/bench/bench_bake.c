@@ -13,12 +13,14 @@
 #include <string.h>
 #include <sys/stat.h>
 
-#include "bake.h"
+#include "raster/bake.h"
 #include "bench_report.h"
-#include "camera.h"
-#include "pipeline.h"
-#include "progress.h"
-#include "scene.h"
+#include "model/camera.h"
+#include "pipeline/pipeline.h"
+#include "core/progress.h"
+#include "model/scene.h"
+#include "core/parallel.h"
+#include "pipeline/bake_phase.h"
 
 static const double PI = 3.14159265358979323846;
 
@@ -130,7 +132,7 @@ static bool bake_rows(const char *mesh, const char *out_dir, int px, float dirt,
         m.surface_count = 1;
         s.meshes = &m;
         s.mesh_count = 1;
-        wx_run_options o;
+        wx_run_def o;
         memset(&o, 0, sizeof o);
         snprintf(o.out_dir, sizeof o.out_dir, "%s", out_dir);
         o.threads = wx_cpu_count();

@@ -37,15 +37,20 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "bake.h"
+#include "raster/bake.h"
 #include "bench_report.h"
-#include "collider.h"
-#include "force_field.h"
-#include "maps.h"
-#include "mesh.h"
-#include "particles.h"
-#include "pipeline.h"
-#include "scene.h"
+#include "sim/collider.h"
+#include "sim/force_field.h"
+#include "model/maps.h"
+#include "model/mesh.h"
+#include "sim/particles.h"
+#include "pipeline/pipeline.h"
+#include "model/scene.h"
+#include "io/maps_file.h"
+#include "io/mesh_import.h"
+#include "io/scene_xml.h"
+#include "pipeline/bake_phase.h"
+#include "pipeline/outputs.h"
 
 static const double PI = 3.14159265358979323846;
 enum { THREADS = 2 };
@@ -162,14 +167,14 @@ typedef struct maps_world {
     wx_scene scene;
     bool scene_loaded;
     int count;
-    wx_camera cams[WX_COLLIDER_MAX_CAMERAS];
-    wx_maps maps[WX_COLLIDER_MAX_CAMERAS];
+    wx_camera cams[WX_MAX_INPUT_CAMERAS];
+    wx_maps maps[WX_MAX_INPUT_CAMERAS];
     wx_collider collider;
     bool collider_ready;
     wx_forces forces;
     bool forces_ready;
     float texel_ws; ///< texel size of the first camera
-    int cam_list[WX_COLLIDER_MAX_CAMERAS];
+    int cam_list[WX_MAX_INPUT_CAMERAS];
 } maps_world;
 
 static void maps_world_free(maps_world *w)
@@ -234,8 +239,8 @@ static bool maps_world_load(maps_world *w, const char *scene_path, const char *o
         return false;
     }
     w->scene_loaded = true;
-    wx_run_options opts;
-    wx_run_options_default(&w->scene, &opts);
+    wx_run_def opts;
+    opts = wx_default_run_def(&w->scene);
     snprintf(opts.out_dir, sizeof opts.out_dir, "%s", out_dir);
     opts.threads = THREADS;
     opts.quiet = true;

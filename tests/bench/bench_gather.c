@@ -12,9 +12,9 @@
 #include <string.h>
 
 #include "bench_report.h"
-#include "camera.h"
-#include "gather.h"
-#include "progress.h"
+#include "model/camera.h"
+#include "gather/gather.h"
+#include "core/progress.h"
 
 typedef struct box {
     float lo[3], hi[3];
@@ -173,7 +173,8 @@ int main(int argc, char **argv)
                                           maps[c].dirt };
         }
         wx_gather_def def = wx_default_gather_def();
-        def.output = (wx_gather_view){ &maps[3].cam, n, n, maps[3].depth, maps[3].normal, NULL };
+        def.target = (wx_target){ .kind = WX_TARGET_CAMERA, .camera = &maps[3].cam, .width = n,
+                                 .height = n, .depth = maps[3].depth, .normal = maps[3].normal };
         def.inputs = inputs;
         def.input_count = 3;
         def.radius = 2.0f * 20.0f / (float)n;

@@ -27,9 +27,9 @@
 #include <unistd.h>
 
 #include "bench_report.h"
-#include "particles.h"
+#include "sim/particles.h"
 #include "sim_fixture.h"
-#include "simulate.h"
+#include "sim/simulate.h"
 
 // Independent arithmetic for about 0.2 s: how much faster two threads finish
 // twice the work than one thread finishes it once.
@@ -172,7 +172,7 @@ static void scene_free(bench_scene *b)
 static bool run_config(bench_scene *b, int threads, long particles, long steps, result *out)
 {
     fx_scene *f = &b->f;
-    wx_sim_config cfg = wx_sim_default_config(&f->scene);
+    wx_sim_def cfg = wx_default_sim_def(&f->scene);
     cfg.threads = threads;
     cfg.maps = b->maps;
     wx_sim *sim = NULL;

@@ -8,10 +8,13 @@
 #include <stdint.h>
 #include <string.h>
 
-#include "error.h"
-#include "exr_io.h"
+#include "core/error.h"
+#include "io/exr.h"
 #include "fuzz_workspace.h"
-#include "maps.h"
+#include "model/maps.h"
+#include "core/limits.h"
+#include "io/maps_file.h"
+#include "model/image.h"
 
 int LLVMFuzzerInitialize(int *argc, char ***argv);
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);

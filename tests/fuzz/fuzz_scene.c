@@ -6,10 +6,12 @@
 #include <stdint.h>
 #include <string.h>
 
-#include "error.h"
+#include "core/error.h"
 #include "fuzz_workspace.h"
-#include "pipeline.h"
-#include "scene.h"
+#include "pipeline/pipeline.h"
+#include "model/scene.h"
+#include "io/scene_xml.h"
+#include "pipeline/memory.h"
 
 int LLVMFuzzerInitialize(int *argc, char ***argv);
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);

@@ -11,8 +11,9 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "camera.h"
-#include "exr_io.h"
+#include "model/camera.h"
+#include "io/exr.h"
+#include "model/image.h"
 
 enum { SIZE = 256 };
 

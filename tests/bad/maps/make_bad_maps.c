@@ -10,7 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "exr_io.h"
+#include "io/exr.h"
 
 static const char *dir;
 

@@ -1,0 +1,491 @@
+// cli.c: the `weathering` command line (DESIGN section 6).
+//
+//   weathering COMMAND SCENE.xml [--out DIR] [--seed N] [--threads N] [--stats FILE.json] [-q]
+//
+// Exit status: 0 success, 2 bad usage or bad input (one message naming the file,
+// and the line for XML), 1 any other failure.
+#include <errno.h>
+#include <inttypes.h>
+#include <math.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "core/atomic_file.h"
+#include "core/progress.h"
+#include "io/scene_xml.h"
+#include "io/stats_json.h"
+#include "model/geometry.h"
+#include "model/scene.h"
+#include "pipeline/bake_phase.h"
+#include "pipeline/memory.h"
+#include "pipeline/outputs.h"
+#include "pipeline/pipeline.h"
+#include "pipeline/run.h"
+#include "sim/emitter.h"
+#include "core/limits.h"
+#include "model/camera.h"
+
+#define WX_VERSION "0.1.0"
+
+typedef struct cli_args {
+    const char *command;
+    const char *scene_path;
+    const char *out_dir; // NULL: out/<scene name>/
+    const char *stats_path;
+    uint64_t seed;
+    bool seed_set;
+    int threads; // 0: all cores
+    bool quiet;
+} cli_args;
+
+typedef int (*command_fn)(const cli_args *args);
+
+typedef struct command {
+    const char *name;
+    command_fn run;
+    const char *summary;
+} command;
+
+static int command_info(const cli_args *args);
+static int command_bake(const cli_args *args);
+static int command_simulate(const cli_args *args);
+static int command_gather(const cli_args *args);
+static int command_run(const cli_args *args);
+
+static const command commands[] = {
+    { "run", command_run, "bake what needs baking, simulate, gather: the whole job" },
+    { "bake", command_bake, "render the maps of <View> cameras from the scene's meshes" },
+    { "simulate", command_simulate, "fly the particles; write <camera>_dirt.exr" },
+    { "gather", command_gather, "turn the dirt maps into the output camera's mask" },
+    { "info", command_info, "validate a scene and print what it holds" },
+};
+enum { COMMAND_COUNT = sizeof commands / sizeof commands[0] };
+
+static void print_usage(FILE *out)
+{
+    fprintf(out,
+            "usage: weathering COMMAND SCENE.xml [options]\n"
+            "\n"
+            "Particle-driven weathering masks: dirt-carrying particles collide against\n"
+            "depth maps of a model and leave a dirt mask for compositing.\n"
+            "\n"
+            "commands:\n");
+    for (int i = 0; i < COMMAND_COUNT; ++i) {
+        fprintf(out, "  %-10s %s\n", commands[i].name, commands[i].summary);
+    }
+    fprintf(out,
+            "\n"
+            "options:\n"
+            "  --out DIR          output folder (default: out/<scene name>/)\n"
+            "  --seed N           random seed (default: the scene's Simulation seed)\n"
+            "  --threads N        worker threads (default: all cores)\n"
+            "  --stats FILE.json  write run statistics as JSON\n"
+            "  -q, --quiet        no progress bars or notes on stderr\n"
+            "  -h, --help         this help\n"
+            "  --version          print the version\n"
+            "\n"
+            "exit status: 0 success, 2 bad usage or bad input, 1 other failure\n"
+            "documentation: docs/user-guide.md\n");
+}
+
+static int usage_error(const char *fmt, const char *detail)
+{
+    fprintf(stderr, "weathering: ");
+    fprintf(stderr, fmt, detail);
+    fprintf(stderr, "\nTry 'weathering --help'.\n");
+    return WX_BAD_INPUT;
+}
+
+static bool parse_u64(const char *text, uint64_t *out)
+{
+    if (text[0] < '0' || text[0] > '9') {
+        return false;
+    }
+    errno = 0;
+    char *end = NULL;
+    unsigned long long v = strtoull(text, &end, 10);
+    if (errno != 0 || *end != '\0') {
+        return false;
+    }
+    *out = (uint64_t)v;
+    return true;
+}
+
+// Takes the value of an option given as "--opt VALUE" or "--opt=VALUE".
+static const char *option_value(int argc, char **argv, int *i, const char *name, bool *missing)
+{
+    size_t len = strlen(name);
+    const char *arg = argv[*i];
+    if (arg[len] == '=') {
+        return arg + len + 1;
+    }
+    if (*i + 1 >= argc) {
+        *missing = true;
+        return NULL;
+    }
+    *i += 1;
+    return argv[*i];
+}
+
+static bool is_option(const char *arg, const char *name)
+{
+    size_t len = strlen(name);
+    return strncmp(arg, name, len) == 0 && (arg[len] == '\0' || arg[len] == '=');
+}
+
+// Returns -1 when parsing succeeded and the program should go on, else an exit status.
+static int parse_args(int argc, char **argv, cli_args *args)
+{
+    memset(args, 0, sizeof *args);
+    for (int i = 1; i < argc; ++i) {
+        const char *arg = argv[i];
+        bool missing = false;
+        if (strcmp(arg, "-h") == 0 || strcmp(arg, "--help") == 0) {
+            print_usage(stdout);
+            return 0;
+        }
+        if (strcmp(arg, "--version") == 0) {
+            printf("weathering %s\n", WX_VERSION);
+            return 0;
+        }
+        if (strcmp(arg, "-q") == 0 || strcmp(arg, "--quiet") == 0) {
+            args->quiet = true;
+        } else if (is_option(arg, "--out")) {
+            args->out_dir = option_value(argc, argv, &i, "--out", &missing);
+            if (!missing && args->out_dir[0] == '\0') {
+                return usage_error("%s needs a folder name", "--out");
+            }
+            if (!missing && strlen(args->out_dir) >= WX_PATH_MAX) {
+                return usage_error("--out: a folder name of at most %s characters", "4095");
+            }
+        } else if (is_option(arg, "--stats")) {
+            args->stats_path = option_value(argc, argv, &i, "--stats", &missing);
+            if (!missing && args->stats_path[0] == '\0') {
+                return usage_error("%s needs a file name", "--stats");
+            }
+            if (!missing && strlen(args->stats_path) >= WX_PATH_MAX) {
+                return usage_error("--stats: a file name of at most %s characters", "4095");
+            }
+        } else if (is_option(arg, "--seed")) {
+            const char *v = option_value(argc, argv, &i, "--seed", &missing);
+            if (!missing && !parse_u64(v, &args->seed)) {
+                return usage_error("--seed takes a whole number from 0 to 2^64-1, not '%s'", v);
+            }
+            args->seed_set = true;
+        } else if (is_option(arg, "--threads")) {
+            const char *v = option_value(argc, argv, &i, "--threads", &missing);
+            uint64_t n = 0;
+            if (!missing && (!parse_u64(v, &n) || n < 1 || n > 1024)) {
+                return usage_error("--threads takes a whole number from 1 to 1024, not '%s'", v);
+            }
+            args->threads = (int)n;
+        } else if (arg[0] == '-' && arg[1] != '\0') {
+            return usage_error("unknown option '%s'", arg);
+        } else if (args->command == NULL) {
+            args->command = arg;
+        } else if (args->scene_path == NULL) {
+            args->scene_path = arg;
+        } else {
+            return usage_error("unexpected argument '%s'", arg);
+        }
+        if (missing) {
+            return usage_error("%s needs a value", arg);
+        }
+    }
+    if (args->command == NULL) {
+        print_usage(stderr);
+        return WX_BAD_INPUT;
+    }
+    return -1;
+}
+
+// Loads the scene and fills the run options from it and the command line.
+static int load_scene(const cli_args *args, wx_scene *scene, wx_run_def *opts)
+{
+    wx_error err;
+    wx_result r = wx_scene_load(args->scene_path, scene, &err);
+    if (r != WX_OK) {
+        fprintf(stderr, "weathering: %s\n", err.message);
+        return r;
+    }
+    *opts = wx_default_run_def(scene);
+    if (args->out_dir != NULL) {
+        snprintf(opts->out_dir, sizeof opts->out_dir, "%s", args->out_dir);
+    }
+    if (args->seed_set) {
+        opts->seed = args->seed;
+    }
+    if (args->threads > 0) {
+        opts->threads = args->threads;
+    }
+    opts->quiet = args->quiet;
+    opts->stats_path = args->stats_path;
+    return WX_OK;
+}
+
+// --- info ---------------------------------------------------------------------
+
+static const char *field_name(wx_field_kind kind)
+{
+    switch (kind) {
+    case WX_FIELD_GRAVITY: return "Gravity";
+    case WX_FIELD_WIND: return "Wind";
+    case WX_FIELD_TURBULENCE: return "Turbulence";
+    }
+    return "?";
+}
+
+static void print_camera(const wx_scene_camera *sc)
+{
+    const wx_camera *cam = &sc->camera;
+    float w_ws, h_ws, dir[3], center[3];
+    wx_camera_frame_size(cam, &w_ws, &h_ws);
+    wx_camera_view_dir(cam, dir);
+    const float uvd[3] = { 0.5f, 0.5f, 0.0f };
+    wx_camera_map_to_world(cam, uvd, center);
+    printf("  %-12s %-6s %5d x %-5d  frame %g x %g m, eye-plane centre (%g, %g, %g), "
+           "looking (%.3g, %.3g, %.3g), texel %.4g m%s\n",
+           sc->name, sc->is_output ? "output" : "input", cam->width, cam->height, w_ws, h_ws,
+           center[0], center[1], center[2], dir[0], dir[1], dir[2],
+           cam->width > 0 ? w_ws / (float)cam->width : 0.0f,
+           sc->has_view && sc->depth_path[0] == '\0' ? ", maps baked from geometry" : "");
+    if (sc->is_output) {
+        printf("  %-12s        mask '%s' %d x %d, radius %g m, %s%s\n", "", sc->output_file,
+               sc->output_width, sc->output_height, sc->radius,
+               sc->second_pass == WX_SECOND_PASS_SUM ? "thesis sum" : "weighted mean",
+               sc->normalize ? ", normalised to [0,1]" : "");
+    }
+}
+
+static int command_info(const cli_args *args)
+{
+    wx_scene scene;
+    wx_run_def opts;
+    int status = load_scene(args, &scene, &opts);
+    if (status != WX_OK) {
+        return status;
+    }
+    // The meshes are read as bake reads them, so that info refuses what bake
+    // would, before it prints anything.
+    wx_geometry geometry;
+    memset(&geometry, 0, sizeof geometry);
+    bool imported = wx_scene_needs_bake(&scene) && scene.mesh_count > 0;
+    if (imported) {
+        wx_error err;
+        wx_result r = wx_geometry_load(&scene, args->quiet, &geometry, &err);
+        if (r != WX_OK) {
+            fprintf(stderr, "weathering: %s\n", err.message);
+            wx_scene_free(&scene);
+            return r;
+        }
+    }
+    printf("scene %s\n", scene.path);
+    printf("solver: bounding box %g m centred at (%g, %g, %g); %" PRId64
+           " steps of %g s (%g s simulated); seed %" PRIu64 "\n",
+           scene.bbox_size, scene.bbox_center[0], scene.bbox_center[1], scene.bbox_center[2],
+           scene.steps, scene.time_step, wx_scene_duration(&scene), opts.seed);
+    printf("cameras (%d input, %d output):\n", scene.input_count, scene.output_index >= 0 ? 1 : 0);
+    for (int c = 0; c < scene.camera_count; ++c) {
+        print_camera(&scene.cameras[c]);
+    }
+    printf("emitters (%d):\n", scene.emitter_count);
+    double duration = wx_scene_duration(&scene);
+    for (int e = 0; e < scene.emitter_count; ++e) {
+        const wx_emitter *em = &scene.emitters[e];
+        printf("  %-12s %-10s at (%g, %g, %g)", em->name[0] ? em->name : "(unnamed)",
+               em->kind == WX_EMITTER_POINT ? "point" : "hemisphere", em->center[0],
+               em->center[1], em->center[2]);
+        if (em->kind == WX_EMITTER_HEMISPHERE) {
+            printf(" radius %g", em->radius);
+        }
+        printf(", %g/s from %g to %g s (%lld particles), speed %g, mass %g, dirt %g, "
+               "max collisions %d\n",
+               em->rate, em->start, em->end, (long long)wx_emitter_count_at(em, duration),
+               em->speed,
+               em->mass, em->dirt, em->max_collisions);
+    }
+    printf("force fields (%d):\n", scene.field_count);
+    for (int f = 0; f < scene.field_count; ++f) {
+        const wx_field *fd = &scene.fields[f];
+        printf("  %-12s ", field_name(fd->kind));
+        switch (fd->kind) {
+        case WX_FIELD_GRAVITY: printf("acceleration %g m/s^2 along -Y\n", fd->strength); break;
+        case WX_FIELD_WIND:
+            printf("force %g towards (%g, %g, %g)\n", fd->strength, fd->dir[0], fd->dir[1],
+                   fd->dir[2]);
+            break;
+        case WX_FIELD_TURBULENCE:
+            printf("strength %g, frequency %g, %d octaves\n", fd->strength, fd->frequency,
+                   fd->octaves);
+            break;
+        }
+    }
+    const wx_collider_def *col = &scene.collider;
+    printf("collider: resilience %g, friction %g, adherence %g, deposit %g, erosion %g\n",
+           col->resilience, col->friction, col->adherence, col->deposit, col->erosion);
+    printf("meshes (%d):\n", scene.mesh_count);
+    for (int m = 0; m < scene.mesh_count; ++m) {
+        const wx_mesh *mesh = &scene.meshes[m];
+        printf("  %s:", mesh->path);
+        for (int s = 0; s < mesh->surface_count; ++s) {
+            const wx_surface *sf = &mesh->surfaces[s];
+            printf("%s material '%s' absorption %g bounce %g dirt %g deposit %g erosion %g",
+                   s ? ";" : "", sf->material, sf->absorption, sf->bounce, sf->dirt,
+                   sf->deposit, sf->erosion);
+        }
+        printf("\n");
+        if (imported) {
+            const wx_geometry_mesh *g = &geometry.meshes[m];
+            char shown[WX_ERROR_MAX];
+            printf("    %lld triangles, %lld vertices, bounds (%g, %g, %g) to (%g, %g, %g)\n",
+                   (long long)g->data.triangle_count, (long long)g->data.vertex_count,
+                   g->data.bounds_min[0], g->data.bounds_min[1], g->data.bounds_min[2],
+                   g->data.bounds_max[0], g->data.bounds_max[1], g->data.bounds_max[2]);
+            for (int k = 0; k < g->data.material_count; ++k) {
+                wx_printable(g->data.material_names[k], shown, sizeof shown);
+                printf("    material '%s' -> <Surface material=\"%s\">\n", shown,
+                       mesh->surfaces[g->surface[k]].material);
+            }
+        }
+    }
+    wx_geometry_free(&geometry);
+    wx_memory_need need;
+    wx_memory_estimate(&scene, WX_PHASE_ALL, &need);
+    double available = wx_memory_available();
+    const double mib = 1024.0 * 1024.0;
+    printf("memory: about %.0f MiB at the peak (the %s: program %.0f, bake %.0f with %.0f for "
+           "the meshes, simulation %.0f with %.0f for %lld particles if all were alive at "
+           "once, gather %.0f; MiB)",
+           need.total_bytes / mib, need.phase, need.baseline_bytes / mib, need.bake_bytes / mib,
+           need.mesh_bytes / mib, (need.sim_map_bytes + need.particle_bytes) / mib,
+           need.particle_bytes / mib, (long long)need.particles, need.gather_bytes / mib);
+    if (available >= 0.0) {
+        printf(" of %.0f MiB available%s", available / (1024.0 * 1024.0),
+               need.total_bytes > available ? ": too much, a run would be refused" : "");
+    }
+    printf("\n");
+    printf("output folder: %s\n", opts.out_dir);
+    wx_scene_free(&scene);
+    return 0;
+}
+
+// --- bake, simulate, gather, run ------------------------------------------------
+
+static int report(wx_result r, const wx_error *err)
+{
+    if (r != WX_OK) {
+        fprintf(stderr, "weathering: %s\n", err->message);
+    }
+    return r;
+}
+
+// Runs the phases in `phases` in order, in one process; a phase that is not run
+// reads what an earlier command left in the output folder.
+static int run_phases(const cli_args *args, unsigned phases)
+{
+    double start = wx_now_s();
+    wx_run_report run;
+    memset(&run, 0, sizeof run);
+    wx_scene scene;
+    wx_run_def opts;
+    int status = load_scene(args, &scene, &opts);
+    if (status != WX_OK) {
+        return status;
+    }
+    run.times.load = wx_now_s() - start;
+    wx_error err;
+    wx_result r = WX_OK;
+    if ((phases & WX_PHASE_GATHER) && scene.output_index < 0) {
+        r = wx_fail(&err, WX_CAUSE_BAD_SCENE, "%s: has no output camera (<Ortho out=\"true\">); `%s` needs one",
+                         scene.path, args->command);
+    }
+    if (r == WX_OK) {
+        r = wx_run_phases(&scene, &opts, phases, &run, &err);
+    }
+    run.times.total = wx_now_s() - start;
+    if (r == WX_OK && opts.stats_path != NULL) {
+        r = wx_write_stats(opts.stats_path, &run.stats, &run.times, opts.threads, opts.seed, &err);
+    }
+    if (r == WX_OK && !opts.quiet) {
+        fprintf(stderr, "weathering: %s done in %.2f s; outputs in %s\n", args->command,
+                run.times.total, opts.out_dir);
+    }
+    wx_scene_free(&scene);
+    return report(r, &err);
+}
+
+static int command_bake(const cli_args *args)
+{
+    return run_phases(args, WX_PHASE_BAKE);
+}
+
+static int command_simulate(const cli_args *args)
+{
+    return run_phases(args, WX_PHASE_SIMULATE);
+}
+
+static int command_gather(const cli_args *args)
+{
+    return run_phases(args, WX_PHASE_GATHER);
+}
+
+static int command_run(const cli_args *args)
+{
+    return run_phases(args, WX_PHASE_BAKE | WX_PHASE_SIMULATE | WX_PHASE_GATHER);
+}
+
+// --- interrupts -------------------------------------------------------------------
+
+// SIGINT, SIGTERM, SIGHUP: remove the temporaries still being written and exit
+// with 128 + the signal (130 for Ctrl-C). Finished outputs are already under
+// their final names (atomic rename); no output is ever half there.
+static void on_interrupt(int sig)
+{
+    wx_temp_remove_all();
+    static const char message[] = "\nweathering: interrupted; temporary files removed\n";
+    ssize_t ignored = write(STDERR_FILENO, message, sizeof message - 1);
+    (void)ignored;
+    _exit(128 + sig);
+}
+
+static void install_interrupt_handlers(void)
+{
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_interrupt;
+    sigfillset(&sa.sa_mask); // no second signal inside the handler
+    const int signals[] = { SIGINT, SIGTERM, SIGHUP };
+    for (size_t i = 0; i < sizeof signals / sizeof signals[0]; ++i) {
+        struct sigaction old;
+        // nohup: an ignored SIGHUP stays ignored. SIGINT is caught even when the
+        // shell started us in the background with it ignored: `kill -INT` on a
+        // background run means "stop it".
+        if (signals[i] == SIGHUP && sigaction(SIGHUP, NULL, &old) == 0 &&
+            old.sa_handler == SIG_IGN) {
+            continue;
+        }
+        sigaction(signals[i], &sa, NULL);
+    }
+}
+
+int main(int argc, char **argv)
+{
+    install_interrupt_handlers();
+    cli_args args;
+    int status = parse_args(argc, argv, &args);
+    if (status >= 0) {
+        return status;
+    }
+    for (int i = 0; i < COMMAND_COUNT; ++i) {
+        if (strcmp(args.command, commands[i].name) == 0) {
+            if (args.scene_path == NULL) {
+                return usage_error("%s needs a scene file", args.command);
+            }
+            return commands[i].run(&args);
+        }
+    }
+    return usage_error("unknown command '%s'", args.command);
+}

@@ -1,0 +1,32 @@
+// limits.h: the sizes the program refuses to go beyond, in one place, so that
+// every module checks the same numbers (docs/reliability.md lists them).
+#ifndef WX_LIMITS_H
+#define WX_LIMITS_H
+
+/// Longest path the program handles (a longer --out or scene path is refused).
+#define WX_PATH_MAX 4096
+
+/// Largest map side, reading and writing (<View resolution>, EXR files).
+#define WX_MAP_MAX_SIDE 16384
+/// Largest number of texels in one map: 16384 x 16384 (1 GiB per float channel).
+#define WX_MAP_MAX_TEXELS (16384LL * 16384LL)
+
+/// Most input cameras a scene may have (the collider numbers them in a byte).
+#define WX_MAX_INPUT_CAMERAS 64
+
+/// Channels and header attributes of an image.
+#define WX_IMAGE_MAX_CHANNELS 8
+#define WX_IMAGE_MAX_ATTRS 16
+/// Longest channel or attribute name, and string attribute.
+#define WX_NAME_MAX 64
+#define WX_ATTR_STRING_MAX 1024
+
+/// Longest plain file name the program writes into an output folder.
+#define WX_OUTPUT_NAME_MAX 320
+
+/// Longest material name kept from a mesh file.
+#define WX_MATERIAL_NAME_MAX 128
+/// Most distinct material names one mesh file may use (per-triangle index is 16 bits).
+#define WX_MESH_MAX_MATERIALS 65535
+
+#endif

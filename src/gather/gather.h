@@ -1,0 +1,93 @@
+// gather.h: the output mask (docs/design.md section 5, thesis 4.8.4.4 improved).
+//
+// First pass: every output texel with a surface is turned into its world point,
+// projected into every input camera, and takes that camera's dirt where the
+// camera sees the same point (depth agreement, same side of the surface),
+// converted to dirt per square metre of surface and summed over the cameras.
+// Second pass: a weighted mean over output texels within `radius` world units,
+// weight max(0, Nq.Np) * (1 - r/radius), so it never smooths across creases or
+// depth jumps. docs/mask.md describes the file and every choice made here.
+#ifndef WX_GATHER_H
+#define WX_GATHER_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "core/error.h"
+#include "gather/target.h"
+#include "model/camera.h"
+#include "model/maps.h"
+#include "model/scene.h"
+
+/// |N.view| is clamped to at least this when the footprint of an input texel on
+/// the surface (head-on texel area / |N.view|) is computed. It must equal the
+/// clamp `bake` uses when it stores density x area / |N.view| (bake.c
+/// MIN_COSINE), so that initial dirt density survives the round trip exactly.
+#define WX_GATHER_AREA_MIN_COS 1e-3f
+
+/// Depth tolerance of the visibility test: this many texels of the input camera,
+/// divided by max(|N.view|, WX_GATHER_TOL_MIN_COS) of the input texel.
+#define WX_GATHER_DEPTH_TOL_TEXELS 1.5f
+#define WX_GATHER_TOL_MIN_COS 0.1f
+
+/// How the first pass reads an input camera's dirt.
+typedef enum wx_gather_sampling {
+    WX_GATHER_BILINEAR, ///< the four texels around the point, each tested, renormalised (default)
+    WX_GATHER_NEAREST,  ///< the one texel the point falls in (the thesis)
+} wx_gather_sampling;
+
+/// One camera's maps as the gather reads them: views into memory the caller
+/// owns. Row 0 is the top, texel (i, j) at j*width + i (maps.h).
+typedef struct wx_gather_view {
+    const wx_camera *camera; ///< orthographic matrices (the map size is taken from width/height)
+    int width;
+    int height;
+    const float *depth;  ///< width*height; +inf, NaN, <= 0 or >= 1e30: no surface
+    const float *normal; ///< 3*width*height, interleaved, world-space unit normals
+    const float *dirt;   ///< width*height dirt amounts (input cameras; unused for the output)
+} wx_gather_view;
+
+/// Everything the gather needs, in memory. Zero-initialise or start from
+/// wx_default_gather_def(), then fill the views.
+typedef struct wx_gather_def {
+    wx_target target;             ///< where the mask is evaluated: the output camera's texels
+    const wx_gather_view *inputs; ///< input cameras with their dirt
+    int input_count;
+    float radius;                 ///< second-pass radius in world units; 0 = no second pass
+    wx_second_pass second_pass;   ///< weighted mean (default) or the thesis' weighted sum
+    bool normalize;               ///< divide the final mask by its maximum (when > 0)
+    wx_gather_sampling sampling;
+    int threads;                  ///< worker threads; <= 1 runs on the calling thread only
+    bool quiet;                   ///< no progress bar
+} wx_gather_def;
+
+/// What a gather found.
+typedef struct wx_gather_stats {
+    int64_t surface_texels; ///< output texels with a surface
+    int64_t dirty_texels;   ///< output texels whose final value is > 0
+    double max_value;       ///< largest mask value before normalisation
+    double first_pass_s;    ///< wall-clock seconds of the first pass
+    double second_pass_s;   ///< wall-clock seconds of the second pass
+} wx_gather_stats;
+
+/// Defaults: no cameras, radius 0, weighted mean, bilinear, 1 thread, quiet.
+wx_gather_def wx_default_gather_def(void);
+
+/// A view of a camera and its loaded maps (the dirt plane may be NULL).
+wx_gather_view wx_gather_view_from_maps(const wx_camera *camera, const wx_maps *maps);
+
+/// Computes the mask into mask_out (target width*height floats, row 0 = top; 0
+/// where the target has no surface). stats may be NULL. Fails with
+/// WX_BAD_INPUT on a missing map, a size mismatch, a camera that is not
+/// orthographic or a bad radius; WX_FAIL when out of memory.
+wx_result wx_gather_compute(const wx_gather_def *def, float *mask_out, wx_gather_stats *stats,
+                            wx_error *err);
+
+/// OpenEXR's worldToNDC of a camera: [x y z 1] * M = [u, 1 - v, d, 1].
+void wx_mask_world_to_ndc(const wx_camera *camera, float m[16]);
+
+/// OpenEXR's worldToCamera of a camera: [x y z 1] * M = [(u - 0.5) * width_ws,
+/// (v - 0.5) * height_ws, d, 1] (left-handed, origin at the centre of the eye plane).
+void wx_mask_world_to_camera(const wx_camera *camera, float m[16]);
+
+#endif

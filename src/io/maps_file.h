@@ -1,0 +1,32 @@
+// maps_file.h: the maps of one camera read from their EXR files: depth (R or Z),
+// normal (R G B), impact (R G), dirt (R G B, or the initialDirt channel a
+// simulated dirt map keeps), checked for size agreement and finite values.
+#ifndef WX_MAPS_FILE_H
+#define WX_MAPS_FILE_H
+
+#include "core/error.h"
+#include "model/maps.h"
+
+/// Which maps to load.
+enum {
+    WX_MAPS_DEPTH = 1 << 0,
+    WX_MAPS_NORMAL = 1 << 1,
+    WX_MAPS_IMPACT = 1 << 2,
+    WX_MAPS_DIRT = 1 << 3,
+    WX_MAPS_ALL = 15,
+    /// With WX_MAPS_DIRT: read the dirt plane from channel "initialDirt" when the
+    /// file has it (a dirt map written by `simulate`), else from R.
+    WX_MAPS_INITIAL_DIRT = 1 << 4,
+};
+
+/// Name of the channel in which a simulated dirt map keeps its initial dirt.
+#define WX_INITIAL_DIRT_CHANNEL "initialDirt"
+
+/// Loads the maps selected by `which` from the given paths (NULL or "" for a map
+/// not wanted). Depth reads channel R or Z, normal R G B, impact R G, dirt R G B.
+/// All loaded maps must have the same size; a mismatch names both files.
+wx_result wx_maps_load(wx_maps *maps, unsigned which, const char *depth_path,
+                       const char *normal_path, const char *impact_path,
+                       const char *dirt_path, wx_error *err);
+
+#endif

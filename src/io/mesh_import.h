@@ -1,0 +1,38 @@
+// mesh_import.h: triangle meshes imported with Assimp's C API (OBJ, PLY, glTF,
+// FBX, STL, ...) into a wx_mesh_data (model/mesh.h).
+//
+// The import triangulates, generates smooth normals only where the file has
+// none (smoothing across edges sharper than WX_MESH_SMOOTHING_ANGLE_DEG is not
+// done, so a box keeps flat faces), joins identical vertices and applies the
+// node transforms. The aiScene is released as soon as the arrays are built.
+// Assimp reads through our own file system: regular files only (a FIFO, a
+// device or a folder is refused, never waited on), and besides the mesh file
+// only files inside the mesh's folder (after realpath), so an OBJ's mtllib or a
+// glTF buffer URI cannot reach elsewhere. A referenced file that is not there
+// is no refusal: Assimp does without it, as before (an OBJ without its .mtl).
+// Positions come out in metres where the file states a unit Assimp leaves to
+// us: FBX's UnitScaleFactor (centimetres per file unit). Collada's <unit> and
+// 3DS's master scale are applied by Assimp; glTF is metres; OBJ, PLY and STL
+// have no unit and are taken as metres.
+#ifndef WX_MESH_IMPORT_H
+#define WX_MESH_IMPORT_H
+
+#include "core/error.h"
+#include "model/mesh.h"
+
+/// Largest angle between face normals that generated normals smooth across.
+#define WX_MESH_SMOOTHING_ANGLE_DEG 60.0f
+
+/// Imports a mesh file. WX_BAD_INPUT, with a message naming the file, when it
+/// is missing ("not found"), not a regular file, unreadable or unsupported
+/// (Assimp's reason), when it refers to a file that is not a regular file or
+/// lies outside its folder ("refers to 'x.mtl', which is not a regular file (a
+/// FIFO)", "refers to '../a.bin', outside the mesh's folder"), when a vertex
+/// position, a vertex colour or a normal given in the file is not a finite
+/// number, or when an FBX unit is not positive. Normals Assimp generates for
+/// triangles too large for float stay 0. WX_FAIL when out of memory, inside
+/// Assimp (std::bad_alloc) too. A file without triangles imports with
+/// triangle_count 0. On failure `out` is left empty (safe to free).
+wx_result wx_mesh_import(const char *path, wx_mesh_data *out, wx_error *err);
+
+#endif

@@ -1,0 +1,21 @@
+// png_preview.h: an 8-bit PNG preview of a mask (libpng), scaled to be readable:
+// grey = min(1, value / p99)^(1/2.2), where p99 is the 99th percentile of the
+// mask's positive values; alpha 0 where the camera sees no surface.
+#ifndef WX_PNG_PREVIEW_H
+#define WX_PNG_PREVIEW_H
+
+#include <stddef.h>
+
+#include "core/error.h"
+
+/// The preview's white point: the 99th percentile of the positive finite values
+/// (sorted ascending, element floor(0.99 * (n - 1))), or 0 when there are none.
+/// Returns WX_FAIL when out of memory.
+wx_result wx_preview_scale(const float *mask, size_t count, float *scale, wx_error *err);
+
+/// Writes `path` atomically as 8-bit grey + alpha. `surface` (may be NULL: all
+/// opaque) holds width*height depths; texels without a surface (maps.h) get alpha 0.
+wx_result wx_preview_write_png(const char *path, const float *mask, const float *surface,
+                               int width, int height, wx_error *err);
+
+#endif

@@ -1,0 +1,1758 @@
+// scene.c: loads and validates a scene file (DESIGN section 3) with libxml2.
+//
+// The document is parsed without network access, entity substitution or
+// XInclude; any entity declaration stops the parser at once (so an entity bomb
+// or an external entity never expands), and libxml2 prints nothing: its first
+// error becomes "scene.xml:LINE: message". The tree is then walked element by
+// element. Each element has one table of the attributes it allows (name, type,
+// range, where the value goes) and one table of the children it allows, so an
+// unknown element or attribute is an error that names it. Once the whole file is
+// read, the checks that need the whole picture run (emitter end times, map
+// files and their sizes, names that must be unique). Choices where DESIGN.md is
+// silent are written down in docs/scene-format-notes.md.
+#include "io/scene_xml.h"
+
+#include <errno.h>
+#include <float.h>
+#include <limits.h>
+#include <locale.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <libxml/parser.h>
+#include <libxml/tree.h>
+#include <libxml/xmlerror.h>
+
+#include "core/matrix.h"
+#include "io/exr.h"
+#include "core/input_file.h"
+
+/// Limits that bound memory before anything else is checked.
+#define SCENE_MAX_BYTES (64L * 1024 * 1024)
+#define SCENE_MAX_CAMERAS 256
+#define SCENE_MAX_FIELDS 10000
+#define SCENE_MAX_EMITTERS 10000
+#define SCENE_MAX_MESHES 1000
+#define SCENE_MAX_SURFACES 10000
+#define SCENE_MAX_STEPS 1000000000LL
+#define SCENE_MAX_COLLISIONS 1000000000LL
+
+/// CTWMatrix must be the inverse of WTCMatrix to this relative tolerance
+/// (wx_camera_inverse_error): matrices printed with 4-6 digits pass.
+#define SCENE_INVERSE_TOLERANCE 1e-3f
+
+#define XSI_NAMESPACE "http://www.w3.org/2001/XMLSchema-instance"
+
+enum { MAP_DEPTH, MAP_NORMAL, MAP_IMPACT, MAP_DIRT, MAP_KINDS };
+static const char *const map_elements[MAP_KINDS] = { "DepthMap", "NormalMap", "ImpactMap",
+                                                     "DirtMap" };
+static const char *const map_kinds[MAP_KINDS] = { "depth", "normal", "impact", "dirt" };
+
+// ---------------------------------------------------------------------------
+// Parser state and errors
+
+typedef struct parser {
+    const char *path; ///< the scene file as given, the prefix of every message
+    wx_error *err;
+    wx_scene *scene;
+    int field_cap, emitter_cap, camera_cap, mesh_cap;
+    const xmlNode *collider; ///< <Collider>, once seen
+} parser;
+
+static int line_of(const xmlNode *node)
+{
+    long line = node != NULL ? xmlGetLineNo(node) : 0;
+    return line > 0 && line < INT_MAX ? (int)line : 0;
+}
+
+static const char *name_of(const xmlNode *node)
+{
+    return (const char *)node->name;
+}
+
+static wx_result vfail_line(parser *p, int line, wx_cause cause, const char *fmt, va_list args)
+{
+    char message[WX_ERROR_MAX];
+    vsnprintf(message, sizeof message, fmt, args);
+    return wx_fail(p->err, cause, "%s:%d: %s", p->path, line, message);
+}
+
+/// "path:LINE: message" with the line of `node`; returns the cause's result.
+static wx_result fail(parser *p, const xmlNode *node, wx_cause cause, const char *fmt, ...)
+    __attribute__((format(printf, 4, 5)));
+static wx_result fail(parser *p, const xmlNode *node, wx_cause cause, const char *fmt, ...)
+{
+    va_list args;
+    va_start(args, fmt);
+    wx_result r = vfail_line(p, line_of(node), cause, fmt, args);
+    va_end(args);
+    return r;
+}
+
+static wx_result fail_line(parser *p, int line, wx_cause cause, const char *fmt, ...)
+    __attribute__((format(printf, 4, 5)));
+static wx_result fail_line(parser *p, int line, wx_cause cause, const char *fmt, ...)
+{
+    va_list args;
+    va_start(args, fmt);
+    wx_result r = vfail_line(p, line, cause, fmt, args);
+    va_end(args);
+    return r;
+}
+
+static wx_result out_of_memory(parser *p)
+{
+    return wx_fail(p->err, WX_CAUSE_OUT_OF_MEMORY, "%s: out of memory", p->path);
+}
+
+/// Makes room for one more item of an array that grows by doubling; returns the
+/// (possibly moved) array, or NULL when out of memory (the old one is kept).
+static void *reserve(void *items, int count, int *capacity, size_t item_size)
+{
+    if (count < *capacity) {
+        return items;
+    }
+    int cap = *capacity > 0 ? *capacity * 2 : 4;
+    void *grown = realloc(items, (size_t)cap * item_size);
+    if (grown != NULL) {
+        *capacity = cap;
+    }
+    return grown;
+}
+
+// ---------------------------------------------------------------------------
+// Reading the document: libxml2 quiet, no entities
+
+typedef struct xml_errors {
+    bool set;
+    int line;
+    wx_cause cause;
+    char message[WX_ERROR_MAX];
+} xml_errors;
+
+static void record_xml_error(xml_errors *st, int line, wx_cause cause, const char *message)
+{
+    if (st->set) {
+        return;
+    }
+    st->set = true;
+    st->line = line;
+    st->cause = cause;
+    snprintf(st->message, sizeof st->message, "%s", message != NULL ? message : "parse error");
+    size_t n = strlen(st->message);
+    while (n > 0 && (st->message[n - 1] == '\n' || st->message[n - 1] == ' ')) {
+        st->message[--n] = '\0';
+    }
+    // One line: libxml2 puts the offending bytes on a line of their own
+    // ("...encoding !\nBytes: 0xC8 ...").
+    for (char *c = st->message; *c != '\0'; ++c) {
+        if ((unsigned char)*c < 0x20) {
+            *c = ' ';
+        }
+    }
+}
+
+#if LIBXML_VERSION >= 21200
+static void on_xml_error(void *data, const xmlError *e)
+#else
+static void on_xml_error(void *data, xmlErrorPtr e)
+#endif
+{
+    if (e != NULL && e->level >= XML_ERR_ERROR) {
+        record_xml_error(data, e->line, WX_CAUSE_XML_SYNTAX, e->message);
+    }
+}
+
+// Any entity declaration (general or parameter, internal or external) stops the
+// parser before the entity can be used, so nothing is ever expanded or fetched.
+static void on_entity_decl(void *ctx, const xmlChar *name, int type, const xmlChar *public_id,
+                           const xmlChar *system_id, xmlChar *content)
+{
+    (void)type;
+    (void)public_id;
+    (void)system_id;
+    (void)content;
+    xmlParserCtxtPtr ctxt = ctx;
+    xml_errors *st = ctxt->_private;
+    char message[256];
+    snprintf(message, sizeof message,
+             "entity declarations are not allowed in a scene file (entity '%.100s')",
+             name != NULL ? (const char *)name : "");
+    record_xml_error(st, ctxt->input != NULL ? ctxt->input->line : 0, WX_CAUSE_XML_CONTENT,
+                     message);
+    xmlStopParser(ctxt);
+}
+
+static wx_result read_file(const char *path, char **text, size_t *size, wx_error *err)
+{
+    *text = NULL;
+    *size = 0;
+    char why[WX_INPUT_WHY_MAX];
+    wx_cause cause = WX_CAUSE_NONE;
+    int fd = wx_open_regular(path, why, &cause); // never waits on a FIFO
+    FILE *f = fd >= 0 ? fdopen(fd, "rb") : NULL;
+    if (f == NULL) {
+        if (fd >= 0) {
+            snprintf(why, sizeof why, "cannot open (%s)", strerror(errno));
+            cause = WX_CAUSE_OUT_OF_MEMORY;
+            close(fd);
+        }
+        return wx_fail(err, cause, "%s: %s", path, why);
+    }
+    struct stat st;
+    if (fstat(fileno(f), &st) != 0) {
+        int e = errno;
+        fclose(f);
+        return wx_fail(err, WX_CAUSE_UNREADABLE, "%s: cannot open (%s)", path, strerror(e));
+    }
+    if (st.st_size > SCENE_MAX_BYTES) {
+        fclose(f);
+        return wx_fail(err, WX_CAUSE_TOO_MANY, "%s: scene file too large (over %ld bytes)", path,
+                            SCENE_MAX_BYTES);
+    }
+    char *buf = malloc((size_t)st.st_size + 1);
+    if (buf == NULL) {
+        fclose(f);
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "%s: out of memory", path);
+    }
+    size_t got = fread(buf, 1, (size_t)st.st_size, f);
+    bool failed = ferror(f) != 0;
+    fclose(f);
+    if (failed) {
+        free(buf);
+        return wx_fail(err, WX_CAUSE_IO, "%s: read error", path);
+    }
+    buf[got] = '\0';
+    *text = buf;
+    *size = got;
+    return WX_OK;
+}
+
+static wx_result read_document(const char *path, xmlDocPtr *out, wx_error *err)
+{
+    *out = NULL;
+    char *text;
+    size_t size;
+    wx_result r = read_file(path, &text, &size, err);
+    if (r != WX_OK) {
+        return r;
+    }
+    xmlParserCtxtPtr ctxt = xmlNewParserCtxt();
+    if (ctxt == NULL) {
+        free(text);
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "%s: out of memory", path);
+    }
+    xml_errors st = { 0 };
+    ctxt->_private = &st;
+    ctxt->sax->entityDecl = on_entity_decl;
+    xmlStructuredErrorFunc old_handler = xmlStructuredError;
+    void *old_context = xmlStructuredErrorContext;
+    xmlSetStructuredErrorFunc(&st, on_xml_error);
+    xmlDocPtr doc = xmlCtxtReadMemory(ctxt, text, (int)size, path, NULL,
+                                      XML_PARSE_NONET | XML_PARSE_NOBLANKS | XML_PARSE_BIG_LINES);
+    bool well_formed = ctxt->wellFormed != 0;
+    xmlSetStructuredErrorFunc(old_context, old_handler);
+    xmlFreeParserCtxt(ctxt);
+    free(text);
+    if (st.set || doc == NULL || !well_formed) {
+        xmlFreeDoc(doc);
+        if (st.set) {
+            return wx_fail(err, st.cause, "%s:%d: %s", path, st.line, st.message);
+        }
+        return wx_fail(err, WX_CAUSE_XML_SYNTAX, "%s: not a well-formed XML document", path);
+    }
+    *out = doc;
+    return WX_OK;
+}
+
+// ---------------------------------------------------------------------------
+// Content that is never allowed: text, entity references, processing instructions
+
+static bool is_blank(const xmlChar *s)
+{
+    for (; s != NULL && *s != '\0'; ++s) {
+        if (*s != ' ' && *s != '\t' && *s != '\n' && *s != '\r') {
+            return false;
+        }
+    }
+    return true;
+}
+
+/// Checks the whole subtree of `element`: only elements, comments and
+/// whitespace inside, no entity reference anywhere (also in attribute values).
+static wx_result check_content(parser *p, const xmlNode *element)
+{
+    for (const xmlAttr *a = element->properties; a != NULL; a = a->next) {
+        for (const xmlNode *c = a->children; c != NULL; c = c->next) {
+            if (c->type == XML_ENTITY_REF_NODE) {
+                return fail(p, element, WX_CAUSE_XML_CONTENT, "entity reference '&%s;' in attribute '%s' is not allowed",
+                            name_of(c), (const char *)a->name);
+            }
+        }
+    }
+    for (const xmlNode *n = element->children; n != NULL; n = n->next) {
+        switch (n->type) {
+        case XML_ELEMENT_NODE: {
+            wx_result r = check_content(p, n);
+            if (r != WX_OK) {
+                return r;
+            }
+            break;
+        }
+        case XML_COMMENT_NODE:
+            break;
+        case XML_TEXT_NODE:
+        case XML_CDATA_SECTION_NODE:
+            if (!is_blank(n->content)) {
+                const char *text = (const char *)n->content;
+                while (*text == ' ' || *text == '\t' || *text == '\n' || *text == '\r') {
+                    ++text;
+                }
+                int len = 0;
+                while (len < 30 && text[len] != '\0' && text[len] != '\n' && text[len] != '\r') {
+                    ++len;
+                }
+                // libxml2 gives a text node the line where it ends: count back
+                // to the line of its first non-blank character.
+                int line = line_of(n);
+                for (const char *c = text; *c != '\0' && line > 0; ++c) {
+                    line -= *c == '\n';
+                }
+                return fail_line(p, line > 0 ? line : line_of(element), WX_CAUSE_XML_CONTENT,
+                                 "unexpected text '%.*s' in <%s>", len, text, name_of(element));
+            }
+            break;
+        case XML_ENTITY_REF_NODE:
+            return fail(p, element, WX_CAUSE_XML_CONTENT, "entity reference '&%s;' in <%s> is not allowed", name_of(n),
+                        name_of(element));
+        case XML_PI_NODE:
+            return fail(p, element, WX_CAUSE_XML_CONTENT, "processing instruction '<?%s' in <%s> is not allowed",
+                        name_of(n), name_of(element));
+        default:
+            return fail(p, element, WX_CAUSE_XML_CONTENT, "unexpected content in <%s>", name_of(element));
+        }
+    }
+    return WX_OK;
+}
+
+// ---------------------------------------------------------------------------
+// Attribute values
+
+typedef enum attr_type {
+    T_FLOAT,      ///< float, range by `range`
+    T_DOUBLE,     ///< double, range by `range`
+    T_INT,        ///< int in [lo, hi]
+    T_INT64,      ///< int64_t in [lo, hi]
+    T_UINT64,     ///< uint64_t, any
+    T_BOOL,       ///< "true" or "false"
+    T_VEC3,       ///< float[3], "x y z"
+    T_MATRIX,     ///< float[16]
+    T_RESOLUTION, ///< int[2], "px [py]" in [lo, hi]
+    T_NAME,       ///< plain name: letters digits _ - . , not starting with '.'
+    T_TEXT,       ///< any non-empty text (paths, labels)
+    T_ENUM,       ///< int: index into `choices`
+} attr_type;
+
+typedef enum attr_range {
+    R_FINITE,   ///< any finite number
+    R_POSITIVE, ///< > 0
+    R_NONNEG,   ///< >= 0
+    R_UNIT,     ///< [0, 1]
+} attr_range;
+
+typedef struct attr_spec {
+    const char *name;
+    attr_type type;
+    size_t offset;  ///< where the value goes in the destination struct
+    attr_range range;
+    long long lo, hi;            ///< T_INT, T_INT64, T_RESOLUTION bounds (inclusive)
+    size_t size;                 ///< T_NAME, T_TEXT: buffer size with the NUL
+    const char *const *choices;  ///< T_ENUM: NULL-terminated
+    bool required;
+} attr_spec;
+
+static bool is_space(char c)
+{
+    return c == ' ' || c == '\t' || c == '\n' || c == '\r';
+}
+
+/// Splits a whitespace-separated list of decimal numbers. Stores up to `max`
+/// of them and returns how many there are, or -1 when one is not a number.
+static int parse_numbers(const char *s, double *out, int max)
+{
+    int count = 0;
+    for (;;) {
+        while (is_space(*s)) {
+            ++s;
+        }
+        if (*s == '\0') {
+            return count;
+        }
+        const char *token = s;
+        while (*s != '\0' && !is_space(*s)) {
+            if (*s == 'x' || *s == 'X') {
+                return -1; // no hexadecimal floats
+            }
+            ++s;
+        }
+        char *end;
+        double v = strtod(token, &end);
+        if (end != s || end == token) {
+            return -1;
+        }
+        if (count < max) {
+            out[count] = v;
+        }
+        ++count;
+    }
+}
+
+/// A whole string holding one integer (optional sign, digits), with optional
+/// surrounding whitespace. False when it is not one or overflows.
+static bool parse_integer(const char *s, long long *out)
+{
+    while (is_space(*s)) {
+        ++s;
+    }
+    const char *digits = (*s == '+' || *s == '-') ? s + 1 : s;
+    if (*digits < '0' || *digits > '9') {
+        return false;
+    }
+    errno = 0;
+    char *end;
+    long long v = strtoll(s, &end, 10);
+    if (errno == ERANGE) {
+        return false;
+    }
+    while (is_space(*end)) {
+        ++end;
+    }
+    *out = v;
+    return *end == '\0';
+}
+
+/// A whitespace-separated list of integers in [lo, hi]: stores up to `max` and
+/// returns how many there are, or -1 when one is not such an integer.
+static int parse_integers(const char *s, int *out, int max, long long lo, long long hi)
+{
+    int count = 0;
+    for (;;) {
+        while (is_space(*s)) {
+            ++s;
+        }
+        if (*s == '\0') {
+            return count;
+        }
+        char token[32];
+        size_t len = 0;
+        while (s[len] != '\0' && !is_space(s[len])) {
+            ++len;
+        }
+        long long v;
+        if (len >= sizeof token) {
+            return -1;
+        }
+        memcpy(token, s, len);
+        token[len] = '\0';
+        if (!parse_integer(token, &v) || v < lo || v > hi) {
+            return -1;
+        }
+        if (count < max) {
+            out[count] = (int)v;
+        }
+        ++count;
+        s += len;
+    }
+}
+
+static bool parse_unsigned(const char *s, unsigned long long *out)
+{
+    while (is_space(*s)) {
+        ++s;
+    }
+    const char *digits = *s == '+' ? s + 1 : s;
+    if (*digits < '0' || *digits > '9') {
+        return false;
+    }
+    errno = 0;
+    char *end;
+    unsigned long long v = strtoull(digits, &end, 10);
+    if (errno == ERANGE) {
+        return false;
+    }
+    while (is_space(*end)) {
+        ++end;
+    }
+    *out = v;
+    return *end == '\0';
+}
+
+/// The token of a list, trimmed, for messages: at most 40 characters.
+static void trimmed(const char *s, char out[48])
+{
+    while (is_space(*s)) {
+        ++s;
+    }
+    size_t n = strlen(s);
+    while (n > 0 && is_space(s[n - 1])) {
+        --n;
+    }
+    snprintf(out, 48, "%.*s%s", (int)(n > 40 ? 40 : n), s, n > 40 ? "..." : "");
+}
+
+static wx_result check_range(parser *p, const xmlNode *node, const attr_spec *s, const char *text,
+                             double v)
+{
+    const char *what = NULL;
+    switch (s->range) {
+    case R_FINITE:
+        break;
+    case R_POSITIVE:
+        what = v > 0.0 ? NULL : "> 0";
+        break;
+    case R_NONNEG:
+        what = v >= 0.0 ? NULL : ">= 0";
+        break;
+    case R_UNIT:
+        what = v >= 0.0 && v <= 1.0 ? NULL : "in [0, 1]";
+        break;
+    }
+    if (what != NULL) {
+        char shown[48];
+        trimmed(text, shown);
+        return fail(p, node, WX_CAUSE_BAD_VALUE, "<%s> %s=\"%s\" must be %s", name_of(node), s->name, shown, what);
+    }
+    return WX_OK;
+}
+
+/// Parses numbers for T_FLOAT, T_DOUBLE, T_VEC3, T_MATRIX: exactly `want`
+/// finite numbers (floats when `as_float`).
+static wx_result parse_finite_list(parser *p, const xmlNode *node, const attr_spec *s,
+                                   const char *text, double *values, int want, bool as_float)
+{
+    char shown[48];
+    trimmed(text, shown);
+    int count = parse_numbers(text, values, want);
+    if (count < 0 || (want == 1 && count != 1)) {
+        return fail(p, node, WX_CAUSE_BAD_VALUE, "<%s> %s=\"%s\" is not a number%s", name_of(node), s->name, shown,
+                    want == 1 ? "" : " list");
+    }
+    if (count != want) {
+        return fail(p, node, WX_CAUSE_BAD_VALUE, "<%s> %s has %d numbers, expected %d", name_of(node), s->name, count,
+                    want);
+    }
+    for (int i = 0; i < want; ++i) {
+        if (!isfinite(values[i])) {
+            return fail(p, node, WX_CAUSE_BAD_VALUE, "<%s> %s=\"%s\" is not a finite number", name_of(node), s->name,
+                        shown);
+        }
+        if (as_float) {
+            float f = (float)values[i];
+            if (!isfinite(f)) {
+                return fail(p, node, WX_CAUSE_BAD_VALUE, "<%s> %s=\"%s\" is out of range", name_of(node), s->name,
+                            shown);
+            }
+            values[i] = f;
+        }
+    }
+    return WX_OK;
+}
+
+/// T_FLOAT, T_DOUBLE (with their range), T_VEC3, T_MATRIX.
+static wx_result parse_real_value(parser *p, const xmlNode *node, const attr_spec *s,
+                                  const char *text, void *dst)
+{
+    double values[16];
+    int want = s->type == T_VEC3 ? 3 : s->type == T_MATRIX ? 16 : 1;
+    bool is_float = s->type != T_DOUBLE;
+    wx_result r = parse_finite_list(p, node, s, text, values, want, is_float);
+    if (r != WX_OK) {
+        return r;
+    }
+    if (s->type == T_DOUBLE) {
+        r = check_range(p, node, s, text, values[0]);
+        memcpy(dst, &values[0], sizeof values[0]);
+        return r;
+    }
+    float f[16];
+    for (int i = 0; i < want; ++i) {
+        f[i] = (float)values[i];
+    }
+    if (s->type == T_FLOAT) {
+        r = check_range(p, node, s, text, f[0]);
+    }
+    memcpy(dst, f, sizeof f[0] * (size_t)want);
+    return r;
+}
+
+/// T_INT, T_INT64, T_UINT64, T_RESOLUTION.
+static wx_result parse_integer_value(parser *p, const xmlNode *node, const attr_spec *s,
+                                     const char *text, void *dst)
+{
+    char shown[48];
+    trimmed(text, shown);
+    if (s->type == T_UINT64) {
+        unsigned long long v;
+        if (!parse_unsigned(text, &v)) {
+            return fail(p, node, WX_CAUSE_BAD_VALUE, "<%s> %s=\"%s\" is not an integer in [0, 2^64-1]", name_of(node),
+                        s->name, shown);
+        }
+        uint64_t u = (uint64_t)v;
+        memcpy(dst, &u, sizeof u);
+        return WX_OK;
+    }
+    if (s->type == T_RESOLUTION) {
+        int px[2];
+        int count = parse_integers(text, px, 2, s->lo, s->hi);
+        if (count < 1 || count > 2) {
+            return fail(p, node, WX_CAUSE_BAD_VALUE, "<%s> %s=\"%s\" must be one or two integers in [%lld, %lld]",
+                        name_of(node), s->name, shown, s->lo, s->hi);
+        }
+        if (count == 1) {
+            px[1] = px[0];
+        }
+        memcpy(dst, px, sizeof px);
+        return WX_OK;
+    }
+    long long v;
+    if (!parse_integer(text, &v)) {
+        return fail(p, node, WX_CAUSE_BAD_VALUE, "<%s> %s=\"%s\" is not an integer", name_of(node), s->name, shown);
+    }
+    if (v < s->lo || v > s->hi) {
+        return fail(p, node, WX_CAUSE_BAD_VALUE, "<%s> %s=\"%s\" must be in [%lld, %lld]", name_of(node), s->name,
+                    shown, s->lo, s->hi);
+    }
+    if (s->type == T_INT) {
+        int i = (int)v;
+        memcpy(dst, &i, sizeof i);
+    } else {
+        int64_t i = (int64_t)v;
+        memcpy(dst, &i, sizeof i);
+    }
+    return WX_OK;
+}
+
+/// T_BOOL ("true", "false") and T_ENUM (one of `choices`, stored as its index).
+static wx_result parse_keyword_value(parser *p, const xmlNode *node, const attr_spec *s,
+                                     const char *text, void *dst)
+{
+    char shown[48];
+    trimmed(text, shown);
+    if (s->type == T_BOOL) {
+        bool b = strcmp(shown, "true") == 0;
+        if (!b && strcmp(shown, "false") != 0) {
+            return fail(p, node, WX_CAUSE_BAD_VALUE, "<%s> %s=\"%s\" must be \"true\" or \"false\"", name_of(node),
+                        s->name, shown);
+        }
+        memcpy(dst, &b, sizeof b);
+        return WX_OK;
+    }
+    char list[256] = "";
+    for (int i = 0; s->choices[i] != NULL; ++i) {
+        if (strcmp(shown, s->choices[i]) == 0) {
+            memcpy(dst, &i, sizeof i);
+            return WX_OK;
+        }
+        wx_list_append(list, sizeof list, s->choices[i]);
+    }
+    return fail(p, node, WX_CAUSE_BAD_VALUE, "<%s> %s=\"%s\" must be one of: %s", name_of(node), s->name, shown,
+                list);
+}
+
+static bool is_plain_name(const char *text)
+{
+    if (text[0] == '.') {
+        return false; // no hidden files, no "." or ".."
+    }
+    for (const char *c = text; *c != '\0'; ++c) {
+        bool ok = (*c >= 'a' && *c <= 'z') || (*c >= 'A' && *c <= 'Z') ||
+                  (*c >= '0' && *c <= '9') || *c == '_' || *c == '-' || *c == '.';
+        if (!ok) {
+            return false;
+        }
+    }
+    return true;
+}
+
+/// T_NAME (a plain name) and T_TEXT (any text without control characters).
+static wx_result parse_text_value(parser *p, const xmlNode *node, const attr_spec *s,
+                                  const char *text, void *dst)
+{
+    size_t len = strlen(text);
+    if (len == 0) {
+        return fail(p, node, WX_CAUSE_BAD_VALUE, "<%s> %s is empty", name_of(node), s->name);
+    }
+    if (len >= s->size) {
+        return fail(p, node, WX_CAUSE_BAD_VALUE, "<%s> %s is too long (at most %zu characters)", name_of(node),
+                    s->name, s->size - 1);
+    }
+    if (s->type == T_NAME && !is_plain_name(text)) {
+        char shown[48];
+        trimmed(text, shown);
+        return fail(p, node, WX_CAUSE_BAD_VALUE,
+                    "<%s> %s=\"%s\" must be a plain name (letters, digits, '_', '-', '.', not "
+                    "starting with '.'; no folders)",
+                    name_of(node), s->name, shown);
+    }
+    for (size_t i = 0; i < len; ++i) {
+        if ((unsigned char)text[i] < 0x20) {
+            return fail(p, node, WX_CAUSE_BAD_VALUE, "<%s> %s holds a control character", name_of(node), s->name);
+        }
+    }
+    memcpy(dst, text, len + 1);
+    return WX_OK;
+}
+
+static wx_result parse_value(parser *p, const xmlNode *node, const attr_spec *s, const char *text,
+                             void *dst)
+{
+    switch (s->type) {
+    case T_FLOAT:
+    case T_DOUBLE:
+    case T_VEC3:
+    case T_MATRIX:
+        return parse_real_value(p, node, s, text, dst);
+    case T_INT:
+    case T_INT64:
+    case T_UINT64:
+    case T_RESOLUTION:
+        return parse_integer_value(p, node, s, text, dst);
+    case T_BOOL:
+    case T_ENUM:
+        return parse_keyword_value(p, node, s, text, dst);
+    case T_NAME:
+    case T_TEXT:
+        return parse_text_value(p, node, s, text, dst);
+    }
+    return fail(p, node, WX_CAUSE_BAD_ARGUMENT, "internal error: unknown attribute type");
+}
+
+/// Parses the attributes of `node` by its table into `dst`. An attribute that
+/// is not in the table is an error naming it; `present` (may be NULL) gets bit i
+/// set for each table entry i that the element gives.
+static wx_result parse_attributes(parser *p, const xmlNode *node, const attr_spec *specs,
+                                  int count, void *dst, unsigned *present)
+{
+    unsigned seen = 0;
+    for (const xmlAttr *a = node->properties; a != NULL; a = a->next) {
+        const char *name = (const char *)a->name;
+        if (a->ns != NULL) {
+            // xsi:noNamespaceSchemaLocation and friends, on the root only.
+            bool xsi = a->ns->href != NULL && strcmp((const char *)a->ns->href, XSI_NAMESPACE) == 0;
+            if (xsi && node->parent != NULL && node->parent->type == XML_DOCUMENT_NODE) {
+                continue;
+            }
+            return fail(p, node, WX_CAUSE_UNKNOWN_NAME, "unknown attribute '%s:%s' of <%s>",
+                        a->ns->prefix != NULL ? (const char *)a->ns->prefix : "", name,
+                        name_of(node));
+        }
+        int i = 0;
+        while (i < count && strcmp(specs[i].name, name) != 0) {
+            ++i;
+        }
+        if (i == count) {
+            char allowed[512] = "";
+            for (int k = 0; k < count; ++k) {
+                wx_list_append(allowed, sizeof allowed, specs[k].name);
+            }
+            return fail(p, node, WX_CAUSE_UNKNOWN_NAME, "unknown attribute '%s' of <%s> (allowed: %s)", name,
+                        name_of(node), count > 0 ? allowed : "none");
+        }
+        xmlChar *value = xmlNodeListGetString(node->doc, a->children, 1);
+        wx_result r = parse_value(p, node, &specs[i], value != NULL ? (const char *)value : "",
+                                  (char *)dst + specs[i].offset);
+        xmlFree(value);
+        if (r != WX_OK) {
+            return r;
+        }
+        seen |= 1u << i;
+    }
+    for (int i = 0; i < count; ++i) {
+        if (specs[i].required && !(seen & (1u << i))) {
+            return fail(p, node, WX_CAUSE_MISSING, "<%s> needs attribute '%s'", name_of(node), specs[i].name);
+        }
+    }
+    if (present != NULL) {
+        *present = seen;
+    }
+    return WX_OK;
+}
+
+#define ATTRS(table, dst, present) \
+    parse_attributes(p, node, table, (int)(sizeof table / sizeof table[0]), dst, present)
+#define NO_ATTRS() parse_attributes(p, node, NULL, 0, NULL, NULL)
+
+// ---------------------------------------------------------------------------
+// Child elements
+
+typedef wx_result (*child_fn)(parser *p, const xmlNode *node, void *user);
+
+typedef struct child_spec {
+    const char *name;
+    child_fn parse;
+    bool repeat; ///< may appear more than once
+} child_spec;
+
+enum { MAX_CHILD_KINDS = 16 };
+
+/// Parses the element children of `parent` by its table. `seen` (may be NULL)
+/// gets, per table entry, the first element of that name or NULL.
+static wx_result parse_children(parser *p, const xmlNode *parent, const child_spec *specs,
+                                int count, void *user, const xmlNode **seen)
+{
+    const xmlNode *first[MAX_CHILD_KINDS] = { 0 };
+    for (const xmlNode *n = parent->children; n != NULL; n = n->next) {
+        if (n->type != XML_ELEMENT_NODE) {
+            continue; // comments and whitespace; check_content refused the rest
+        }
+        int i = 0;
+        while (i < count && (n->ns != NULL || strcmp(specs[i].name, name_of(n)) != 0)) {
+            ++i;
+        }
+        if (i == count) {
+            char allowed[512] = "";
+            for (int k = 0; k < count; ++k) {
+                wx_list_append(allowed, sizeof allowed, specs[k].name);
+            }
+            return fail(p, n, WX_CAUSE_UNKNOWN_NAME, "unknown element <%s%s%s> in <%s> (allowed: %s)",
+                        n->ns != NULL && n->ns->prefix != NULL ? (const char *)n->ns->prefix : "",
+                        n->ns != NULL && n->ns->prefix != NULL ? ":" : "", name_of(n),
+                        name_of(parent), count > 0 ? allowed : "none");
+        }
+        if (first[i] != NULL && !specs[i].repeat) {
+            return fail(p, n, WX_CAUSE_DUPLICATE, "<%s> appears twice in <%s> (first at line %d)", name_of(n),
+                        name_of(parent), line_of(first[i]));
+        }
+        if (first[i] == NULL) {
+            first[i] = n;
+        }
+        wx_result r = specs[i].parse(p, n, user);
+        if (r != WX_OK) {
+            return r;
+        }
+    }
+    if (seen != NULL) {
+        memcpy(seen, first, sizeof(first[0]) * (size_t)count);
+    }
+    return WX_OK;
+}
+
+#define CHILDREN(table, user, seen) \
+    parse_children(p, node, table, (int)(sizeof table / sizeof table[0]), user, seen)
+
+// ---------------------------------------------------------------------------
+// Paths
+
+/// Resolves `file` against the scene's folder (absolute paths stay as they are).
+static wx_result resolve_path(parser *p, const xmlNode *node, const char *file,
+                              char out[WX_PATH_MAX])
+{
+    const char *dir = p->scene->dir;
+    int n;
+    if (file[0] == '/' || strcmp(dir, ".") == 0) {
+        n = snprintf(out, WX_PATH_MAX, "%s", file);
+    } else {
+        size_t len = strlen(dir);
+        n = snprintf(out, WX_PATH_MAX, "%s%s%s", dir, len > 0 && dir[len - 1] == '/' ? "" : "/",
+                     file);
+    }
+    if (n < 0 || n >= WX_PATH_MAX) {
+        return fail(p, node, WX_CAUSE_PATH_TOO_LONG, "path '%.200s...' is too long", file);
+    }
+    return WX_OK;
+}
+
+// ---------------------------------------------------------------------------
+// <Solver>
+
+static const attr_spec bbox_attrs[] = {
+    { "size", T_FLOAT, offsetof(wx_scene, bbox_size), .range = R_POSITIVE },
+    { "centerX", T_FLOAT, offsetof(wx_scene, bbox_center[0]), .range = R_FINITE },
+    { "centerY", T_FLOAT, offsetof(wx_scene, bbox_center[1]), .range = R_FINITE },
+    { "centerZ", T_FLOAT, offsetof(wx_scene, bbox_center[2]), .range = R_FINITE },
+};
+
+static const attr_spec simulation_attrs[] = {
+    { "timeStep", T_DOUBLE, offsetof(wx_scene, time_step), .range = R_POSITIVE },
+    { "steps", T_INT64, offsetof(wx_scene, steps), .lo = 1, .hi = SCENE_MAX_STEPS },
+    { "seed", T_UINT64, offsetof(wx_scene, seed), .range = R_FINITE },
+};
+
+static wx_result parse_bounding_box(parser *p, const xmlNode *node, void *user)
+{
+    (void)user;
+    return ATTRS(bbox_attrs, p->scene, NULL);
+}
+
+static wx_result parse_simulation(parser *p, const xmlNode *node, void *user)
+{
+    (void)user;
+    return ATTRS(simulation_attrs, p->scene, NULL);
+}
+
+static const child_spec solver_children[] = {
+    { "BoundingBox", parse_bounding_box, false },
+    { "Simulation", parse_simulation, false },
+};
+
+static wx_result parse_solver(parser *p, const xmlNode *node, void *user)
+{
+    wx_result r = NO_ATTRS();
+    return r != WX_OK ? r : CHILDREN(solver_children, user, NULL);
+}
+
+// ---------------------------------------------------------------------------
+// <ForceFields>
+
+static const attr_spec gravity_attrs[] = {
+    { "acceleration", T_FLOAT, offsetof(wx_field, strength), .range = R_FINITE },
+};
+
+static const attr_spec wind_attrs[] = {
+    { "strength", T_FLOAT, offsetof(wx_field, strength), .range = R_NONNEG },
+    { "dirX", T_FLOAT, offsetof(wx_field, dir[0]), .range = R_FINITE },
+    { "dirY", T_FLOAT, offsetof(wx_field, dir[1]), .range = R_FINITE },
+    { "dirZ", T_FLOAT, offsetof(wx_field, dir[2]), .range = R_FINITE },
+};
+
+static const attr_spec turbulence_attrs[] = {
+    { "strength", T_FLOAT, offsetof(wx_field, strength), .range = R_NONNEG },
+    { "frequency", T_FLOAT, offsetof(wx_field, frequency), .range = R_POSITIVE },
+    { "octaves", T_INT, offsetof(wx_field, octaves), .lo = 1, .hi = 16 },
+};
+
+static wx_result add_field(parser *p, const xmlNode *node, wx_field_kind kind, wx_field **out)
+{
+    wx_scene *s = p->scene;
+    if (s->field_count >= SCENE_MAX_FIELDS) {
+        return fail(p, node, WX_CAUSE_TOO_MANY, "too many force fields (at most %d)", SCENE_MAX_FIELDS);
+    }
+    wx_field *grown = reserve(s->fields, s->field_count, &p->field_cap, sizeof *grown);
+    if (grown == NULL) {
+        return out_of_memory(p);
+    }
+    s->fields = grown;
+    wx_field *f = &grown[s->field_count++];
+    // Defaults (DESIGN section 3; the Wind direction is ours: +X).
+    *f = (wx_field){ .kind = kind, .strength = 0.0f, .frequency = 1.0f, .octaves = 4,
+                     .line = line_of(node) };
+    if (kind == WX_FIELD_GRAVITY) {
+        f->strength = 9.8f;
+        f->dir[1] = -1.0f;
+    } else if (kind == WX_FIELD_WIND) {
+        f->dir[0] = 1.0f;
+    }
+    *out = f;
+    return WX_OK;
+}
+
+static wx_result parse_gravity(parser *p, const xmlNode *node, void *user)
+{
+    (void)user;
+    wx_field *f;
+    wx_result r = add_field(p, node, WX_FIELD_GRAVITY, &f);
+    return r != WX_OK ? r : ATTRS(gravity_attrs, f, NULL);
+}
+
+static wx_result parse_wind(parser *p, const xmlNode *node, void *user)
+{
+    (void)user;
+    wx_field *f;
+    wx_result r = add_field(p, node, WX_FIELD_WIND, &f);
+    if (r != WX_OK || (r = ATTRS(wind_attrs, f, NULL)) != WX_OK) {
+        return r;
+    }
+    double len = sqrt((double)f->dir[0] * f->dir[0] + (double)f->dir[1] * f->dir[1] +
+                      (double)f->dir[2] * f->dir[2]);
+    if (!(len > 0.0) || !isfinite(len)) {
+        return fail(p, node, WX_CAUSE_BAD_VALUE, "<Wind> direction (dirX, dirY, dirZ) must not be zero");
+    }
+    for (int i = 0; i < 3; ++i) {
+        f->dir[i] = (float)(f->dir[i] / len);
+    }
+    return WX_OK;
+}
+
+static wx_result parse_turbulence(parser *p, const xmlNode *node, void *user)
+{
+    (void)user;
+    wx_field *f;
+    wx_result r = add_field(p, node, WX_FIELD_TURBULENCE, &f);
+    return r != WX_OK ? r : ATTRS(turbulence_attrs, f, NULL);
+}
+
+static const child_spec force_field_children[] = {
+    { "Gravity", parse_gravity, true },
+    { "Wind", parse_wind, true },
+    { "Turbulence", parse_turbulence, true },
+};
+
+static wx_result parse_force_fields(parser *p, const xmlNode *node, void *user)
+{
+    wx_result r = NO_ATTRS();
+    return r != WX_OK ? r : CHILDREN(force_field_children, user, NULL);
+}
+
+// ---------------------------------------------------------------------------
+// <Emitters>
+
+#define EMITTER_ATTRS                                                                        \
+    { "name", T_TEXT, offsetof(wx_emitter, name), .size = sizeof(((wx_emitter *)0)->name) }, \
+    { "centerX", T_FLOAT, offsetof(wx_emitter, center[0]), .range = R_FINITE },              \
+    { "centerY", T_FLOAT, offsetof(wx_emitter, center[1]), .range = R_FINITE },              \
+    { "centerZ", T_FLOAT, offsetof(wx_emitter, center[2]), .range = R_FINITE },              \
+    { "rate", T_DOUBLE, offsetof(wx_emitter, rate), .range = R_NONNEG },                     \
+    { "start", T_DOUBLE, offsetof(wx_emitter, start), .range = R_NONNEG },                   \
+    { "end", T_DOUBLE, offsetof(wx_emitter, end), .range = R_NONNEG },                       \
+    { "speed", T_FLOAT, offsetof(wx_emitter, speed), .range = R_NONNEG },                    \
+    { "mass", T_FLOAT, offsetof(wx_emitter, mass), .range = R_POSITIVE },                    \
+    { "dirt", T_FLOAT, offsetof(wx_emitter, dirt), .range = R_NONNEG },                      \
+    { "maxCollisions", T_INT, offsetof(wx_emitter, max_collisions), .lo = 1,                 \
+      .hi = SCENE_MAX_COLLISIONS }
+
+static const attr_spec point_emitter_attrs[] = { EMITTER_ATTRS };
+
+static const attr_spec hemisphere_emitter_attrs[] = {
+    EMITTER_ATTRS,
+    { "radius", T_FLOAT, offsetof(wx_emitter, radius), .range = R_POSITIVE },
+};
+
+static wx_result parse_emitter(parser *p, const xmlNode *node, wx_emitter_kind kind)
+{
+    wx_scene *s = p->scene;
+    if (s->emitter_count >= SCENE_MAX_EMITTERS) {
+        return fail(p, node, WX_CAUSE_TOO_MANY, "too many emitters (at most %d)", SCENE_MAX_EMITTERS);
+    }
+    wx_emitter *grown = reserve(s->emitters, s->emitter_count, &p->emitter_cap, sizeof *grown);
+    if (grown == NULL) {
+        return out_of_memory(p);
+    }
+    s->emitters = grown;
+    wx_emitter *e = &grown[s->emitter_count++];
+    // end = NAN until the simulation's duration is known (finish_emitters).
+    *e = (wx_emitter){ .kind = kind, .radius = kind == WX_EMITTER_HEMISPHERE ? 1.0f : 0.0f,
+                       .rate = 1000.0, .start = 0.0, .end = NAN, .speed = 1.0f, .mass = 1.0f,
+                       .dirt = 1.0f, .max_collisions = 100, .line = line_of(node) };
+    wx_result r = kind == WX_EMITTER_POINT ? ATTRS(point_emitter_attrs, e, NULL)
+                                           : ATTRS(hemisphere_emitter_attrs, e, NULL);
+    if (r != WX_OK) {
+        return r;
+    }
+    for (int i = 0; e->name[0] != '\0' && i < s->emitter_count - 1; ++i) {
+        if (strcmp(s->emitters[i].name, e->name) == 0) {
+            return fail(p, node, WX_CAUSE_DUPLICATE, "emitter name '%s' is used twice (first at line %d)", e->name,
+                        s->emitters[i].line);
+        }
+    }
+    return WX_OK;
+}
+
+static wx_result parse_point_emitter(parser *p, const xmlNode *node, void *user)
+{
+    (void)user;
+    return parse_emitter(p, node, WX_EMITTER_POINT);
+}
+
+static wx_result parse_hemisphere_emitter(parser *p, const xmlNode *node, void *user)
+{
+    (void)user;
+    return parse_emitter(p, node, WX_EMITTER_HEMISPHERE);
+}
+
+static const child_spec emitter_children[] = {
+    { "PointEmitter", parse_point_emitter, true },
+    { "HemisphereEmitter", parse_hemisphere_emitter, true },
+};
+
+static wx_result parse_emitters(parser *p, const xmlNode *node, void *user)
+{
+    wx_result r = NO_ATTRS();
+    return r != WX_OK ? r : CHILDREN(emitter_children, user, NULL);
+}
+
+/// Emitter end times default to the end of the simulation, known only now.
+static wx_result finish_emitters(parser *p)
+{
+    double duration = wx_scene_duration(p->scene);
+    for (int i = 0; i < p->scene->emitter_count; ++i) {
+        wx_emitter *e = &p->scene->emitters[i];
+        if (isnan(e->end)) {
+            e->end = duration;
+        }
+        if (e->start > e->end) {
+            return fail_line(p, e->line, WX_CAUSE_BAD_VALUE, "emitter%s%s%s start=%g is after its end=%g%s",
+                             e->name[0] != '\0' ? " '" : "", e->name,
+                             e->name[0] != '\0' ? "'" : "", e->start, e->end,
+                             e->end == duration ? " (the end of the simulation)" : "");
+        }
+    }
+    return WX_OK;
+}
+
+// ---------------------------------------------------------------------------
+// <Collider>, <ProjectedMaps>, <Ortho>
+
+static const attr_spec collider_attrs[] = {
+    { "resilience", T_FLOAT, offsetof(wx_collider_def, resilience), .range = R_UNIT },
+    { "friction", T_FLOAT, offsetof(wx_collider_def, friction), .range = R_UNIT },
+    { "adherence", T_FLOAT, offsetof(wx_collider_def, adherence), .range = R_NONNEG },
+    { "deposit", T_FLOAT, offsetof(wx_collider_def, deposit), .range = R_NONNEG },
+    { "erosion", T_FLOAT, offsetof(wx_collider_def, erosion), .range = R_NONNEG },
+};
+
+typedef struct ortho_attrs_def {
+    char name[64];
+    bool out;
+} ortho_attrs_def;
+
+static const attr_spec ortho_attrs[] = {
+    { "cameraName", T_NAME, offsetof(ortho_attrs_def, name),
+      .size = sizeof(((ortho_attrs_def *)0)->name), .required = true },
+    { "out", T_BOOL, offsetof(ortho_attrs_def, out), .range = R_FINITE },
+};
+
+typedef struct matrix_def {
+    float m[16];
+} matrix_def;
+
+static const attr_spec matrix_attrs[] = {
+    { "matrix", T_MATRIX, offsetof(matrix_def, m), .required = true },
+};
+
+typedef struct map_def {
+    char file[WX_PATH_MAX];
+} map_def;
+
+static const attr_spec map_attrs[] = {
+    { "file", T_TEXT, offsetof(map_def, file), .size = WX_PATH_MAX, .required = true },
+};
+
+typedef struct output_def {
+    char file[256];
+    int width, height;
+    float radius;
+    int second_pass;
+    bool normalize;
+} output_def;
+
+static const char *const second_pass_names[] = { "mean", "sum", NULL };
+
+enum { OUT_FILE, OUT_WIDTH, OUT_HEIGHT, OUT_RADIUS }; // bits of `present`
+
+static const attr_spec output_attrs[] = {
+    [OUT_FILE] = { "file", T_NAME, offsetof(output_def, file),
+                   .size = sizeof(((output_def *)0)->file) },
+    [OUT_WIDTH] = { "width", T_INT, offsetof(output_def, width), .lo = 1, .hi = WX_MAP_MAX_SIDE },
+    [OUT_HEIGHT] = { "height", T_INT, offsetof(output_def, height), .lo = 1,
+                     .hi = WX_MAP_MAX_SIDE },
+    [OUT_RADIUS] = { "radius", T_FLOAT, offsetof(output_def, radius), .range = R_NONNEG },
+    { "secondPass", T_ENUM, offsetof(output_def, second_pass), .choices = second_pass_names },
+    { "normalize", T_BOOL, offsetof(output_def, normalize) },
+};
+
+typedef struct view_def {
+    float eye[3], target[3], up[3];
+    float width, height;
+    int resolution[2];
+} view_def;
+
+static const attr_spec view_attrs[] = {
+    { "eye", T_VEC3, offsetof(view_def, eye), .required = true },
+    { "target", T_VEC3, offsetof(view_def, target), .required = true },
+    { "up", T_VEC3, offsetof(view_def, up), .range = R_FINITE },
+    { "width", T_FLOAT, offsetof(view_def, width), .range = R_POSITIVE, .required = true },
+    { "height", T_FLOAT, offsetof(view_def, height), .range = R_POSITIVE, .required = true },
+    { "resolution", T_RESOLUTION, offsetof(view_def, resolution), .lo = 1,
+      .hi = WX_MAP_MAX_SIDE, .required = true },
+};
+
+/// What one <Ortho> says, before it is checked as a whole.
+typedef struct ortho_def {
+    wx_scene_camera *cam;
+    const xmlNode *ctw_node, *wtc_node, *view_node, *output_node;
+    float ctw[16], wtc[16];
+    const xmlNode *map_nodes[MAP_KINDS];
+    char map_files[MAP_KINDS][WX_PATH_MAX]; ///< as written in the scene
+    unsigned output_present;
+} ortho_def;
+
+static wx_result parse_matrix(parser *p, const xmlNode *node, void *user)
+{
+    ortho_def *o = user;
+    bool is_ctw = strcmp(name_of(node), "CTWMatrix") == 0;
+    matrix_def m;
+    wx_result r = ATTRS(matrix_attrs, &m, NULL);
+    if (r != WX_OK) {
+        return r;
+    }
+    memcpy(is_ctw ? o->ctw : o->wtc, m.m, sizeof m.m);
+    *(is_ctw ? &o->ctw_node : &o->wtc_node) = node;
+    return WX_OK;
+}
+
+static wx_result parse_map(parser *p, const xmlNode *node, void *user)
+{
+    ortho_def *o = user;
+    int k = 0;
+    while (k < MAP_KINDS && strcmp(map_elements[k], name_of(node)) != 0) {
+        ++k;
+    }
+    map_def *m = malloc(sizeof *m); // 4 KiB: off the stack
+    if (m == NULL) {
+        return out_of_memory(p);
+    }
+    wx_result r = ATTRS(map_attrs, m, NULL);
+    if (r == WX_OK) {
+        memcpy(o->map_files[k], m->file, sizeof m->file);
+        o->map_nodes[k] = node;
+    }
+    free(m);
+    return r;
+}
+
+static wx_result parse_output_map(parser *p, const xmlNode *node, void *user)
+{
+    ortho_def *o = user;
+    wx_scene_camera *cam = o->cam;
+    output_def out = { .second_pass = WX_SECOND_PASS_MEAN };
+    snprintf(out.file, sizeof out.file, "mask.exr");
+    wx_result r = ATTRS(output_attrs, &out, &o->output_present);
+    if (r != WX_OK) {
+        return r;
+    }
+    size_t len = strlen(out.file);
+    if (len < 5 || strcasecmp(out.file + len - 4, ".exr") != 0) {
+        return fail(p, node, WX_CAUSE_BAD_VALUE, "<OutputMap> file=\"%s\" must end in .exr", out.file);
+    }
+    memcpy(cam->output_file, out.file, sizeof out.file);
+    cam->output_width = out.width;
+    cam->output_height = out.height;
+    cam->radius = out.radius;
+    cam->second_pass = out.second_pass == 1 ? WX_SECOND_PASS_SUM : WX_SECOND_PASS_MEAN;
+    cam->normalize = out.normalize;
+    o->output_node = node;
+    return WX_OK;
+}
+
+static wx_result parse_view(parser *p, const xmlNode *node, void *user)
+{
+    ortho_def *o = user;
+    view_def v = { .up = { 0.0f, 1.0f, 0.0f } };
+    wx_result r = ATTRS(view_attrs, &v, NULL);
+    if (r != WX_OK) {
+        return r;
+    }
+    wx_view *view = &o->cam->view;
+    memcpy(view->eye, v.eye, sizeof v.eye);
+    memcpy(view->target, v.target, sizeof v.target);
+    memcpy(view->up, v.up, sizeof v.up);
+    view->width_ws = v.width;
+    view->height_ws = v.height;
+    view->width_px = v.resolution[0];
+    view->height_px = v.resolution[1];
+    o->cam->has_view = true;
+    o->view_node = node;
+    return WX_OK;
+}
+
+static const child_spec ortho_children[] = {
+    { "CTWMatrix", parse_matrix, false }, { "WTCMatrix", parse_matrix, false },
+    { "DepthMap", parse_map, false },     { "NormalMap", parse_map, false },
+    { "ImpactMap", parse_map, false },    { "DirtMap", parse_map, false },
+    { "OutputMap", parse_output_map, false }, { "View", parse_view, false },
+};
+
+/// Every later phase can use the camera's matrices (the collider's and the
+/// gather's tests, made here so that a bad camera is refused at its line).
+static wx_result check_camera(parser *p, const xmlNode *node, const wx_scene_camera *cam)
+{
+    const char *problem = wx_camera_problem(&cam->camera);
+    if (problem != NULL) {
+        return fail(p, node, WX_CAUSE_BAD_CAMERA, "camera '%s': %s", cam->name, problem);
+    }
+    return WX_OK;
+}
+
+/// The matrices of a camera: from its <View>, or both given (and checked), or
+/// one given and the other its inverse.
+static wx_result camera_matrices(parser *p, const xmlNode *node, ortho_def *o)
+{
+    wx_scene_camera *cam = o->cam;
+    if (o->view_node != NULL) {
+        if (o->ctw_node != NULL || o->wtc_node != NULL) {
+            return fail(p, o->view_node, WX_CAUSE_BAD_SCENE,
+                        "camera '%s' has both a <View> and a %s (ambiguous): give one or the other",
+                        cam->name, o->wtc_node != NULL ? "<WTCMatrix>" : "<CTWMatrix>");
+        }
+        wx_error view_err;
+        if (wx_camera_from_view(&cam->view, &cam->camera, &view_err) != WX_OK) {
+            return fail(p, o->view_node, WX_CAUSE_BAD_CAMERA, "camera '%s': %s", cam->name, view_err.message);
+        }
+        return check_camera(p, o->view_node, cam);
+    }
+    if (o->wtc_node == NULL && o->ctw_node == NULL) {
+        return fail(p, node, WX_CAUSE_MISSING, "camera '%s' needs a <WTCMatrix> (and/or <CTWMatrix>) or a <View>",
+                    cam->name);
+    }
+    if (o->wtc_node != NULL && o->ctw_node != NULL) {
+        float error = wx_matrix_inverse_error(o->wtc, o->ctw);
+        if (!(error <= SCENE_INVERSE_TOLERANCE)) {
+            return fail(p, o->ctw_node, WX_CAUSE_BAD_CAMERA,
+                        "<CTWMatrix> of camera '%s' is not the inverse of its <WTCMatrix> "
+                        "(error %.3g, tolerance %g)",
+                        cam->name, (double)error, (double)SCENE_INVERSE_TOLERANCE);
+        }
+        memcpy(cam->camera.wtc, o->wtc, sizeof o->wtc);
+        memcpy(cam->camera.ctw, o->ctw, sizeof o->ctw);
+    } else if (o->wtc_node != NULL) {
+        memcpy(cam->camera.wtc, o->wtc, sizeof o->wtc);
+        if (!wx_matrix_invert(o->wtc, cam->camera.ctw)) {
+            return fail(p, o->wtc_node, WX_CAUSE_BAD_CAMERA, "<WTCMatrix> of camera '%s' is singular", cam->name);
+        }
+    } else {
+        memcpy(cam->camera.ctw, o->ctw, sizeof o->ctw);
+        if (!wx_matrix_invert(o->ctw, cam->camera.wtc)) {
+            return fail(p, o->ctw_node, WX_CAUSE_BAD_CAMERA, "<CTWMatrix> of camera '%s' is singular", cam->name);
+        }
+    }
+    return check_camera(p, o->wtc_node != NULL ? o->wtc_node : o->ctw_node, cam);
+}
+
+/// Which maps a camera must name, the ones it names, and their sizes.
+static wx_result camera_maps(parser *p, const xmlNode *node, ortho_def *o)
+{
+    wx_scene_camera *cam = o->cam;
+    char *paths[MAP_KINDS] = { cam->depth_path, cam->normal_path, cam->impact_path,
+                               cam->dirt_path };
+    int needed = cam->is_output ? 2 : 4; // depth, normal (+ impact, dirt for inputs)
+    int named = 0;
+    for (int k = 0; k < needed; ++k) {
+        named += o->map_nodes[k] != NULL;
+    }
+    if (named < needed && (o->view_node == NULL || named > 0)) {
+        int k = 0;
+        while (o->map_nodes[k] != NULL) {
+            ++k;
+        }
+        if (o->view_node == NULL) {
+            return fail(p, node, WX_CAUSE_MISSING, "camera '%s' needs a <%s> (or a <View> so that bake makes it)",
+                        cam->name, map_elements[k]);
+        }
+        return fail(p, node, WX_CAUSE_MISSING,
+                    "camera '%s' names some of its maps but not <%s>: with a <View>, name all "
+                    "of them or none (bake writes them)",
+                    cam->name, map_elements[k]);
+    }
+    const char *first_file = NULL;
+    for (int k = 0; k < MAP_KINDS; ++k) {
+        const xmlNode *map = o->map_nodes[k];
+        if (map == NULL) {
+            continue;
+        }
+        const char *file = o->map_files[k];
+        wx_result r = resolve_path(p, map, file, paths[k]);
+        if (r != WX_OK) {
+            return r;
+        }
+        char why[WX_INPUT_WHY_MAX];
+        wx_cause cause = WX_CAUSE_NONE;
+        if (!wx_is_regular_file(paths[k], why, &cause)) {
+            return fail(p, map, cause, "map file '%s' %s", file,
+                        cause == WX_CAUSE_FILE_MISSING ? "not found" : why);
+        }
+        wx_image header;
+        wx_error exr_err;
+        memset(&header, 0, sizeof header);
+        r = wx_exr_read_header(paths[k], &header, &exr_err);
+        int w = header.width, h = header.height;
+        wx_image_free(&header);
+        if (r != WX_OK) {
+            return fail(p, map, exr_err.cause, "%s map of camera '%s': %s", map_kinds[k],
+                        cam->name, exr_err.message);
+        }
+        if (o->view_node != NULL) {
+            if (w != cam->view.width_px || h != cam->view.height_px) {
+                return fail(p, map, WX_CAUSE_MAP_SIZE,
+                            "map file '%s' is %dx%d but the <View> resolution of camera '%s' is "
+                            "%dx%d",
+                            file, w, h, cam->name, cam->view.width_px, cam->view.height_px);
+            }
+        } else if (first_file == NULL) {
+            cam->camera.width = w;
+            cam->camera.height = h;
+            first_file = file;
+        } else if (w != cam->camera.width || h != cam->camera.height) {
+            return fail(p, map, WX_CAUSE_MAP_SIZE,
+                        "map file '%s' is %dx%d but '%s' is %dx%d: the maps of camera '%s' "
+                        "must agree in size",
+                        file, w, h, first_file, cam->camera.width, cam->camera.height, cam->name);
+        }
+    }
+    return WX_OK;
+}
+
+/// The <OutputMap> of the output camera, with its defaults.
+static wx_result camera_output(parser *p, const xmlNode *node, ortho_def *o)
+{
+    wx_scene_camera *cam = o->cam;
+    if (!cam->is_output) {
+        if (o->output_node != NULL) {
+            return fail(p, o->output_node, WX_CAUSE_BAD_SCENE,
+                        "<OutputMap> in camera '%s', which is not the output camera (out=\"true\")",
+                        cam->name);
+        }
+        return WX_OK;
+    }
+    if (o->output_node == NULL) {
+        if (o->view_node == NULL) {
+            return fail(p, node, WX_CAUSE_MISSING, "output camera '%s' needs an <OutputMap>", cam->name);
+        }
+        snprintf(cam->output_file, sizeof cam->output_file, "mask.exr");
+        cam->second_pass = WX_SECOND_PASS_MEAN;
+    }
+    unsigned given = o->output_present;
+    int w = cam->camera.width, h = cam->camera.height;
+    if (!(given & (1u << OUT_WIDTH))) {
+        cam->output_width = w;
+    }
+    if (!(given & (1u << OUT_HEIGHT))) {
+        cam->output_height = h;
+    }
+    if (cam->output_width != w || cam->output_height != h) {
+        return fail(p, o->output_node, WX_CAUSE_MAP_SIZE,
+                    "<OutputMap> size %dx%d differs from the %dx%d maps of output camera '%s'",
+                    cam->output_width, cam->output_height, w, h, cam->name);
+    }
+    if (!(given & (1u << OUT_RADIUS))) {
+        float frame_w, frame_h;
+        wx_camera_frame_size(&cam->camera, &frame_w, &frame_h);
+        cam->radius = 2.0f * frame_w / (float)cam->output_width; // 2 output texels
+    }
+    return WX_OK;
+}
+
+static wx_result parse_ortho(parser *p, const xmlNode *node, void *user)
+{
+    (void)user;
+    wx_scene *s = p->scene;
+    ortho_attrs_def attrs = { .out = false };
+    wx_result r = ATTRS(ortho_attrs, &attrs, NULL);
+    if (r != WX_OK) {
+        return r;
+    }
+    for (int i = 0; i < s->camera_count; ++i) {
+        if (strcmp(s->cameras[i].name, attrs.name) == 0) {
+            return fail(p, node, WX_CAUSE_DUPLICATE, "camera name '%s' is used twice (first at line %d)", attrs.name,
+                        s->cameras[i].line);
+        }
+    }
+    if (attrs.out && s->output_index >= 0) {
+        const wx_scene_camera *first = &s->cameras[s->output_index];
+        return fail(p, node, WX_CAUSE_DUPLICATE,
+                    "camera '%s' is a second output camera (the first is '%s' at line %d); a scene "
+                    "has at most one",
+                    attrs.name, first->name, first->line);
+    }
+    if (s->camera_count >= SCENE_MAX_CAMERAS) {
+        return fail(p, node, WX_CAUSE_TOO_MANY, "too many cameras (at most %d)", SCENE_MAX_CAMERAS);
+    }
+    if (!attrs.out && s->input_count >= WX_MAX_INPUT_CAMERAS) {
+        return fail(p, node, WX_CAUSE_TOO_MANY, "too many input cameras (the collider takes at most %d)",
+                    WX_MAX_INPUT_CAMERAS);
+    }
+    wx_scene_camera *grown = reserve(s->cameras, s->camera_count, &p->camera_cap, sizeof *grown);
+    if (grown == NULL) {
+        return out_of_memory(p);
+    }
+    s->cameras = grown;
+    wx_scene_camera *cam = &grown[s->camera_count];
+    memset(cam, 0, sizeof *cam);
+    memcpy(cam->name, attrs.name, sizeof attrs.name);
+    cam->is_output = attrs.out;
+    cam->line = line_of(node);
+    if (attrs.out) {
+        s->output_index = s->camera_count;
+    } else {
+        s->input_count++;
+    }
+    s->camera_count++;
+
+    ortho_def *o = calloc(1, sizeof *o); // 16 KiB of file names: off the stack
+    if (o == NULL) {
+        return out_of_memory(p);
+    }
+    o->cam = cam;
+    if ((r = CHILDREN(ortho_children, o, NULL)) == WX_OK &&
+        (r = camera_matrices(p, node, o)) == WX_OK && (r = camera_maps(p, node, o)) == WX_OK) {
+        r = camera_output(p, node, o);
+    }
+    free(o);
+    return r;
+}
+
+static const child_spec projected_maps_children[] = {
+    { "Ortho", parse_ortho, true },
+};
+
+static wx_result parse_projected_maps(parser *p, const xmlNode *node, void *user)
+{
+    wx_result r = NO_ATTRS();
+    if (r != WX_OK || (r = CHILDREN(projected_maps_children, user, NULL)) != WX_OK) {
+        return r;
+    }
+    if (p->scene->input_count == 0) {
+        return fail(p, node, WX_CAUSE_MISSING, "no input camera: at least one <Ortho> must not be out=\"true\"");
+    }
+    return WX_OK;
+}
+
+static const child_spec collider_children[] = {
+    { "ProjectedMaps", parse_projected_maps, false },
+};
+
+static wx_result parse_collider(parser *p, const xmlNode *node, void *user)
+{
+    p->collider = node;
+    const xmlNode *seen[1];
+    wx_result r = ATTRS(collider_attrs, &p->scene->collider, NULL);
+    if (r != WX_OK || (r = CHILDREN(collider_children, user, seen)) != WX_OK) {
+        return r;
+    }
+    if (seen[0] == NULL) {
+        return fail(p, node, WX_CAUSE_MISSING, "<Collider> needs a <ProjectedMaps> with the cameras");
+    }
+    return WX_OK;
+}
+
+// ---------------------------------------------------------------------------
+// <Geometry>
+
+static const char *const color_use_names[] = { "none", "impact", "dirt", NULL };
+
+typedef struct surface_def {
+    char material[128];
+    float absorption, bounce, dirt, deposit, erosion;
+    int colors;
+} surface_def;
+
+static const attr_spec surface_attrs[] = {
+    { "material", T_TEXT, offsetof(surface_def, material),
+      .size = sizeof(((surface_def *)0)->material), .required = true },
+    { "absorption", T_FLOAT, offsetof(surface_def, absorption), .range = R_UNIT },
+    { "bounce", T_FLOAT, offsetof(surface_def, bounce), .range = R_UNIT },
+    { "dirt", T_FLOAT, offsetof(surface_def, dirt), .range = R_NONNEG },
+    { "deposit", T_FLOAT, offsetof(surface_def, deposit), .range = R_UNIT },
+    { "erosion", T_FLOAT, offsetof(surface_def, erosion), .range = R_UNIT },
+    { "vertexColors", T_ENUM, offsetof(surface_def, colors), .choices = color_use_names },
+};
+
+typedef struct mesh_state {
+    wx_mesh *mesh;
+    int surface_cap;
+} mesh_state;
+
+static wx_result parse_surface(parser *p, const xmlNode *node, void *user)
+{
+    mesh_state *m = user;
+    wx_mesh *mesh = m->mesh;
+    surface_def d = { .colors = 0 };
+    wx_result r = ATTRS(surface_attrs, &d, NULL);
+    if (r != WX_OK) {
+        return r;
+    }
+    for (int i = 0; i < mesh->surface_count; ++i) {
+        if (strcmp(mesh->surfaces[i].material, d.material) == 0) {
+            return fail(p, node, WX_CAUSE_DUPLICATE, "material '%s' appears twice in this <Mesh> (first at line %d)",
+                        d.material, mesh->surfaces[i].line);
+        }
+    }
+    if (mesh->surface_count >= SCENE_MAX_SURFACES) {
+        return fail(p, node, WX_CAUSE_TOO_MANY, "too many surfaces (at most %d)", SCENE_MAX_SURFACES);
+    }
+    wx_surface *grown = reserve(mesh->surfaces, mesh->surface_count, &m->surface_cap,
+                                sizeof *grown);
+    if (grown == NULL) {
+        return out_of_memory(p);
+    }
+    mesh->surfaces = grown;
+    static const wx_color_use colors[] = { WX_COLOR_NONE, WX_COLOR_IMPACT, WX_COLOR_DIRT };
+    wx_surface *sf = &grown[mesh->surface_count++];
+    *sf = (wx_surface){ .absorption = d.absorption, .bounce = d.bounce, .dirt = d.dirt,
+                        .deposit = d.deposit, .erosion = d.erosion, .colors = colors[d.colors],
+                        .line = line_of(node) };
+    memcpy(sf->material, d.material, sizeof d.material);
+    return WX_OK;
+}
+
+static const attr_spec mesh_attrs[] = {
+    { "file", T_TEXT, offsetof(map_def, file), .size = WX_PATH_MAX, .required = true },
+};
+
+static const child_spec mesh_children[] = {
+    { "Surface", parse_surface, true },
+};
+
+static wx_result parse_mesh(parser *p, const xmlNode *node, void *user)
+{
+    (void)user;
+    wx_scene *s = p->scene;
+    if (s->mesh_count >= SCENE_MAX_MESHES) {
+        return fail(p, node, WX_CAUSE_TOO_MANY, "too many meshes (at most %d)", SCENE_MAX_MESHES);
+    }
+    wx_mesh *grown = reserve(s->meshes, s->mesh_count, &p->mesh_cap, sizeof *grown);
+    if (grown == NULL) {
+        return out_of_memory(p);
+    }
+    s->meshes = grown;
+    wx_mesh *mesh = &grown[s->mesh_count++];
+    memset(mesh, 0, sizeof *mesh);
+    mesh->line = line_of(node);
+    map_def *file = malloc(sizeof *file);
+    if (file == NULL) {
+        return out_of_memory(p);
+    }
+    wx_result r = ATTRS(mesh_attrs, file, NULL);
+    char why[WX_INPUT_WHY_MAX];
+    wx_cause cause = WX_CAUSE_NONE;
+    if (r == WX_OK && (r = resolve_path(p, node, file->file, mesh->path)) == WX_OK &&
+        !wx_is_regular_file(mesh->path, why, &cause)) {
+        r = fail(p, node, cause, "mesh file '%s' %s", file->file,
+                 cause == WX_CAUSE_FILE_MISSING ? "not found" : why);
+    }
+    free(file);
+    mesh_state m = { .mesh = mesh };
+    return r != WX_OK ? r : CHILDREN(mesh_children, &m, NULL);
+}
+
+static const child_spec geometry_children[] = {
+    { "Mesh", parse_mesh, true },
+};
+
+static wx_result parse_geometry(parser *p, const xmlNode *node, void *user)
+{
+    wx_result r = NO_ATTRS();
+    return r != WX_OK ? r : CHILDREN(geometry_children, user, NULL);
+}
+
+// ---------------------------------------------------------------------------
+// <Weathering> and the checks that need the whole scene
+
+static const child_spec root_children[] = {
+    { "Solver", parse_solver, false },         { "ForceFields", parse_force_fields, false },
+    { "Emitters", parse_emitters, false },     { "Collider", parse_collider, false },
+    { "Geometry", parse_geometry, false },
+};
+
+/// The mask must not take the name of a map that bake or simulate writes.
+static wx_result check_output_name(parser *p)
+{
+    const wx_scene *s = p->scene;
+    if (s->output_index < 0) {
+        return WX_OK;
+    }
+    const wx_scene_camera *out = &s->cameras[s->output_index];
+    for (int c = 0; c < s->camera_count; ++c) {
+        for (int k = 0; k < MAP_KINDS; ++k) {
+            char name[128];
+            snprintf(name, sizeof name, "%s_%s.exr", s->cameras[c].name, map_kinds[k]);
+            if (strcmp(name, out->output_file) == 0) {
+                return fail_line(p, out->line, WX_CAUSE_BAD_SCENE,
+                                 "<OutputMap> file=\"%s\" is the name of camera '%s''s %s map in "
+                                 "the output folder; choose another",
+                                 out->output_file, s->cameras[c].name, map_kinds[k]);
+            }
+        }
+    }
+    return WX_OK;
+}
+
+static wx_result parse_root(parser *p, const xmlNode *node)
+{
+    if (node == NULL) {
+        return wx_fail(p->err, WX_CAUSE_XML_SYNTAX, "%s: no root element", p->path);
+    }
+    if (node->ns != NULL || strcmp(name_of(node), "Weathering") != 0) {
+        return fail(p, node, WX_CAUSE_UNKNOWN_NAME, "the root element is <%s>, expected <Weathering>", name_of(node));
+    }
+    wx_result r = check_content(p, node);
+    if (r != WX_OK || (r = NO_ATTRS()) != WX_OK ||
+        (r = CHILDREN(root_children, NULL, NULL)) != WX_OK) {
+        return r;
+    }
+    if (p->collider == NULL) {
+        return fail(p, node, WX_CAUSE_MISSING, "<Weathering> needs a <Collider> with the cameras");
+    }
+    if ((r = finish_emitters(p)) != WX_OK) {
+        return r;
+    }
+    return check_output_name(p);
+}
+
+// ---------------------------------------------------------------------------
+// Public API
+
+/// path, dir and name of the scene, and the defaults of everything else.
+static wx_result scene_init(wx_scene *s, const char *path, wx_error *err)
+{
+    if (strlen(path) >= WX_PATH_MAX) {
+        return wx_fail(err, WX_CAUSE_PATH_TOO_LONG, "%.200s...: path too long", path);
+    }
+    snprintf(s->path, sizeof s->path, "%s", path);
+    const char *slash = strrchr(path, '/');
+    if (slash == NULL) {
+        snprintf(s->dir, sizeof s->dir, ".");
+    } else if (slash == path) {
+        snprintf(s->dir, sizeof s->dir, "/");
+    } else {
+        snprintf(s->dir, sizeof s->dir, "%.*s", (int)(slash - path), path);
+    }
+    const char *base = slash != NULL ? slash + 1 : path;
+    const char *dot = strrchr(base, '.');
+    size_t len = dot != NULL && dot != base ? (size_t)(dot - base) : strlen(base);
+    if (len >= sizeof s->name) {
+        len = sizeof s->name - 1;
+    }
+    memcpy(s->name, base, len);
+    s->name[len] = '\0';
+
+    s->bbox_size = 100.0f;
+    s->time_step = 0.01;
+    s->steps = 1000;
+    s->seed = 1;
+    s->collider = wx_default_collider_def();
+    s->output_index = -1;
+    return WX_OK;
+}
+
+wx_result wx_scene_load(const char *path, wx_scene *out, wx_error *err)
+{
+    memset(out, 0, sizeof *out);
+    wx_result r = scene_init(out, path, err);
+    xmlDocPtr doc = NULL;
+    if (r == WX_OK) {
+        r = read_document(path, &doc, err);
+    }
+    if (r == WX_OK) {
+        // Numbers are read with '.' as the decimal point whatever the locale.
+        locale_t c_locale = newlocale(LC_NUMERIC_MASK, "C", (locale_t)0);
+        locale_t previous = c_locale != (locale_t)0 ? uselocale(c_locale) : (locale_t)0;
+        parser p = { .path = path, .err = err, .scene = out };
+        r = parse_root(&p, xmlDocGetRootElement(doc));
+        if (c_locale != (locale_t)0) {
+            uselocale(previous);
+            freelocale(c_locale);
+        }
+    }
+    xmlFreeDoc(doc);
+    if (r != WX_OK) {
+        wx_scene_free(out);
+    }
+    return r;
+}

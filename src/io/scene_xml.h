@@ -1,0 +1,17 @@
+// scene_xml.h: the scene file (docs/design.md section 3) read with libxml2 into
+// a wx_scene. Everything is checked on loading (numbers finite and in range,
+// matrices of 16 numbers that invert one another, unique camera names, map
+// files that exist and agree in size, no unknown elements or attributes), so
+// later phases can trust a wx_scene. Every error reads "scene.xml:LINE: what is
+// wrong". The only module that includes libxml2.
+#ifndef WX_SCENE_XML_H
+#define WX_SCENE_XML_H
+
+#include "core/error.h"
+#include "model/scene.h"
+
+/// Parses and validates a scene file. On failure the scene is left empty (safe
+/// to free) and err holds "path:LINE: message" (WX_BAD_INPUT) or an I/O error.
+wx_result wx_scene_load(const char *path, wx_scene *out, wx_error *err);
+
+#endif

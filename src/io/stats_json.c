@@ -1,0 +1,50 @@
+// stats_json.c: the --stats file (stats_json.h).
+#include "io/stats_json.h"
+
+#include <stdio.h>
+
+#include "core/atomic_file.h"
+
+wx_result wx_write_stats(const char *path, const wx_sim_stats *stats, const wx_phase_times *times,
+                         int threads, uint64_t seed, wx_error *err)
+{
+    char json[4096];
+    int n = snprintf(
+        json, sizeof json,
+        "{\n"
+        "  \"particles_emitted\": %lld,\n"
+        "  \"particle_steps\": %lld,\n"
+        "  \"collisions\": %lld,\n"
+        "  \"absorbed\": %lld,\n"
+        "  \"settled\": %lld,\n"
+        "  \"escaped\": %lld,\n"
+        "  \"alive\": %lld,\n"
+        "  \"dirt\": {\n"
+        "    \"initial_surface\": %.17g,\n"
+        "    \"emitted\": %.17g,\n"
+        "    \"final_surface\": %.17g,\n"
+        "    \"in_flight\": %.17g,\n"
+        "    \"escaped\": %.17g\n"
+        "  },\n"
+        "  \"seconds\": {\n"
+        "    \"load\": %.6f,\n"
+        "    \"bake\": %.6f,\n"
+        "    \"simulate\": %.6f,\n"
+        "    \"gather\": %.6f,\n"
+        "    \"total\": %.6f\n"
+        "  },\n"
+        "  \"threads\": %d,\n"
+        "  \"seed\": %llu\n"
+        "}\n",
+        (long long)stats->particles_emitted, (long long)stats->particle_steps,
+        (long long)stats->collisions, (long long)stats->absorbed, (long long)stats->settled,
+        (long long)stats->escaped, (long long)stats->alive, stats->dirt_initial_surface,
+        stats->dirt_emitted, stats->dirt_final_surface, stats->dirt_in_flight,
+        stats->dirt_escaped, times->load, times->bake, times->simulate, times->gather,
+        times->total, threads, (unsigned long long)seed);
+    if (n < 0 || n >= (int)sizeof json) {
+        return wx_fail(err, WX_CAUSE_INTERNAL, "%s: statistics too long", path);
+    }
+    return wx_write_file_atomic(path, json, (size_t)n, err);
+}
+

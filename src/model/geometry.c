@@ -1,0 +1,66 @@
+// geometry.c: the scene's meshes matched to their <Surface>s (geometry.h).
+#include "model/geometry.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+
+static const char *color_use_name(wx_color_use use)
+{
+    return use == WX_COLOR_IMPACT ? "impact" : "dirt";
+}
+
+wx_result wx_geometry_match(const wx_scene *scene, int mesh_index, wx_geometry_mesh *g,
+                            bool *has_dirt, wx_error *err)
+{
+    const wx_mesh *mesh = &scene->meshes[mesh_index];
+    const wx_mesh_data *data = &g->data;
+    for (int m = 0; m < data->material_count; ++m) {
+        const char *name = data->material_names[m];
+        int match = -1, any = -1;
+        for (int s = 0; s < mesh->surface_count; ++s) {
+            const wx_surface *surf = &mesh->surfaces[s];
+            if (strcmp(surf->material, name) == 0 && match < 0) {
+                match = s;
+            } else if (strcmp(surf->material, "*") == 0 && any < 0) {
+                any = s;
+            }
+        }
+        match = match >= 0 ? match : any;
+        if (match < 0) {
+            char list[512] = "";
+            for (int k = 0; k < data->material_count; ++k) {
+                wx_list_append(list, sizeof list, data->material_names[k]);
+            }
+            return wx_fail(err, WX_CAUSE_UNMATCHED_MATERIAL, "%s:%d: mesh '%s' has material '%s' that no <Surface> matches "
+                                "(materials in the file: %s)",
+                                scene->path, mesh->line, wx_mesh_display_name(scene, mesh), name,
+                                list);
+        }
+        const wx_surface *surf = &mesh->surfaces[match];
+        if (surf->colors != WX_COLOR_NONE && !data->material_colored[m]) {
+            return wx_fail(err, WX_CAUSE_UNMATCHED_MATERIAL, "%s:%d: <Surface material=\"%s\"> takes its %s values from vertex "
+                                "colours, but mesh '%s' has none for material '%s'",
+                                scene->path, surf->line, surf->material,
+                                color_use_name(surf->colors), wx_mesh_display_name(scene, mesh),
+                                name);
+        }
+        if (surf->dirt > 0.0f || surf->colors == WX_COLOR_DIRT) {
+            *has_dirt = true;
+        }
+        g->surface[m] = match;
+    }
+    return WX_OK;
+}
+
+void wx_geometry_free(wx_geometry *geometry)
+{
+    for (int i = 0; i < geometry->count; ++i) {
+        wx_mesh_data_free(&geometry->meshes[i].data);
+        free(geometry->meshes[i].surface);
+    }
+    free(geometry->meshes);
+    memset(geometry, 0, sizeof *geometry);
+}

@@ -1,0 +1,152 @@
+// scene.h: the scene as data (docs/design.md section 3): solver, force fields,
+// emitters, collider, cameras with their maps and outputs, meshes with their
+// surfaces. Plain structures with their defaults; io/scene_xml.c fills them
+// from a scene file and checks everything, so later phases can trust them.
+#ifndef WX_SCENE_H
+#define WX_SCENE_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "core/error.h"
+#include "core/limits.h"
+#include "model/camera.h"
+
+typedef enum wx_field_kind {
+    WX_FIELD_GRAVITY,    ///< acceleration along -Y
+    WX_FIELD_WIND,       ///< force = strength * unit(dir)
+    WX_FIELD_TURBULENCE, ///< force from Perlin turbulence of (position, time)
+} wx_field_kind;
+
+typedef struct wx_field {
+    wx_field_kind kind;
+    float strength;  ///< Gravity: acceleration (m/s^2); Wind, Turbulence: force
+    float dir[3];    ///< Wind: unit direction (normalised on loading)
+    float frequency; ///< Turbulence: spatial frequency of the first octave (1/m)
+    int octaves;     ///< Turbulence: number of octaves, 1..16
+    int line;        ///< line in the scene file
+} wx_field;
+
+typedef enum wx_emitter_kind {
+    WX_EMITTER_POINT,
+    WX_EMITTER_HEMISPHERE,
+} wx_emitter_kind;
+
+typedef struct wx_emitter {
+    wx_emitter_kind kind;
+    char name[64];       ///< "" when not given
+    float center[3];
+    float radius;        ///< hemisphere radius (default 1); 0 for a point emitter
+    double rate;         ///< particles per simulated second (default 1000)
+    double start;        ///< seconds (default 0)
+    double end;          ///< seconds (default: end of the simulation, steps*timeStep)
+    float speed;         ///< m/s (default 1)
+    float mass;          ///< default 1, > 0
+    float dirt;          ///< load per particle (default 1)
+    int max_collisions;  ///< default 100, >= 1
+    int line;
+} wx_emitter;
+
+typedef struct wx_collider_def {
+    float resilience; ///< R, default 0.5
+    float friction;   ///< F, default 0.8
+    float adherence;  ///< A, default 1
+    float deposit;    ///< D, default 1
+    float erosion;    ///< E, default 1
+} wx_collider_def;
+
+typedef enum wx_second_pass {
+    WX_SECOND_PASS_MEAN, ///< weighted mean (DESIGN section 5), the default
+    WX_SECOND_PASS_SUM,  ///< the thesis' unnormalised weighted sum
+} wx_second_pass;
+
+/// An <Ortho> camera with its maps.
+typedef struct wx_scene_camera {
+    char name[64];     ///< cameraName: letters, digits, '_', '-', '.'
+    bool is_output;    ///< out="true"
+    wx_camera camera;  ///< matrices, and map size (from the maps or the View)
+    bool has_view;     ///< given by <View> rather than (only) by matrices
+    wx_view view;
+    /// Map files resolved against the scene's folder; "" where the scene names
+    /// none (a <View> camera whose maps `bake` will write).
+    char depth_path[WX_PATH_MAX];
+    char normal_path[WX_PATH_MAX];
+    char impact_path[WX_PATH_MAX];
+    char dirt_path[WX_PATH_MAX];
+    /// The map paths point at maps this program wrote into the output folder
+    /// (`bake`), not at files the scene names: later phases may replace them.
+    bool maps_in_output;
+    /// Output camera only (<OutputMap>).
+    char output_file[256];   ///< base name in the output folder, default "mask.exr"
+    int output_width;
+    int output_height;
+    float radius;            ///< second-pass radius, world units; default 2 output texels
+    wx_second_pass second_pass;
+    bool normalize;          ///< scale the final mask to [0,1]
+    int line;
+} wx_scene_camera;
+
+typedef enum wx_color_use {
+    WX_COLOR_NONE,   ///< ignore vertex colours (default)
+    WX_COLOR_IMPACT, ///< impact R,G from the vertex colour's R,G
+    WX_COLOR_DIRT,   ///< dirt density, deposit, erosion from R,G,B
+} wx_color_use;
+
+/// Weathering properties of one material name ("*" matches every other).
+typedef struct wx_surface {
+    char material[128];
+    float absorption; ///< impact R
+    float bounce;     ///< impact G
+    float dirt;       ///< initial dirt per square metre
+    float deposit;    ///< dirt G
+    float erosion;    ///< dirt B
+    wx_color_use colors; ///< vertexColors="none|impact|dirt"
+    int line;
+} wx_surface;
+
+typedef struct wx_mesh {
+    char path[WX_PATH_MAX]; ///< resolved against the scene's folder
+    wx_surface *surfaces;
+    int surface_count;
+    int line;
+} wx_mesh;
+
+typedef struct wx_scene {
+    char path[WX_PATH_MAX]; ///< the scene file as given
+    char dir[WX_PATH_MAX];  ///< its folder (relative paths resolve here)
+    char name[256];         ///< file name without folder and extension
+
+    float bbox_size;        ///< BoundingBox cube side, default 100
+    float bbox_center[3];
+    double time_step;       ///< seconds, default 0.01
+    int64_t steps;          ///< default 1000
+    uint64_t seed;          ///< default 1
+
+    wx_field *fields;
+    int field_count;
+    wx_emitter *emitters;
+    int emitter_count;
+    wx_collider_def collider;
+
+    wx_scene_camera *cameras; ///< input and output cameras in file order
+    int camera_count;
+    int input_count;
+    int output_index;         ///< index into cameras, or -1
+
+    wx_mesh *meshes;
+    int mesh_count;
+} wx_scene;
+
+/// Default collider parameters (DESIGN section 3).
+wx_collider_def wx_default_collider_def(void);
+
+/// The mesh path as the scene file wrote it (relative to the scene's folder).
+const char *wx_mesh_display_name(const wx_scene *scene, const wx_mesh *mesh);
+
+/// Frees everything the scene owns; the struct is zeroed.
+void wx_scene_free(wx_scene *scene);
+
+/// Total simulated time, steps * time_step.
+double wx_scene_duration(const wx_scene *scene);
+
+#endif

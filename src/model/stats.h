@@ -1,0 +1,34 @@
+// stats.h: what a run counts and measures: the simulation's counters and dirt
+// ledger, and the seconds of each phase (the pinned keys of --stats,
+// docs/design.md section 6).
+#ifndef WX_STATS_H
+#define WX_STATS_H
+
+#include <stdint.h>
+
+/// Counters of a simulation (the pinned keys of --stats).
+typedef struct wx_sim_stats {
+    int64_t particles_emitted;
+    int64_t particle_steps;
+    int64_t collisions;
+    int64_t absorbed;
+    int64_t settled;
+    int64_t escaped;
+    int64_t alive;
+    double dirt_initial_surface;
+    double dirt_emitted;
+    double dirt_final_surface;
+    double dirt_in_flight;
+    double dirt_escaped;
+} wx_sim_stats;
+
+/// Wall-clock seconds per phase.
+typedef struct wx_phase_times {
+    double load;
+    double bake;
+    double simulate;
+    double gather;
+    double total;
+} wx_phase_times;
+
+#endif

@@ -1,0 +1,212 @@
+// bake_phase.c: the `bake` phase on files (bake_phase.h): the depth maps the
+// visibility test needs read, the cameras rendered in memory (raster/bake.c),
+// each camera's maps written as they come.
+#include "pipeline/bake_phase.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "core/parallel.h"
+#include "io/exr.h"
+#include "core/progress.h"
+#include "io/maps_file.h"
+#include "io/mesh_import.h"
+#include "pipeline/load.h"
+#include "pipeline/outputs.h"
+
+// One map file of a baked camera.
+typedef struct map_file {
+    const wx_image *image;
+    char path[WX_PATH_MAX];
+    wx_result result;
+    wx_error err;
+} map_file;
+
+typedef struct bake_writer {
+    wx_scene *scene;
+    const wx_run_def *opts;
+    bool prepared; ///< the output folder exists (made with the first camera's maps)
+    map_file files[4];
+} bake_writer;
+
+// Writes files [begin, end) of the camera in hand (one per worker).
+static void write_files(int64_t begin, int64_t end, int worker, void *context)
+{
+    (void)worker;
+    bake_writer *w = context;
+    for (int64_t k = begin; k < end; ++k) {
+        map_file *f = &w->files[k];
+        f->result = wx_exr_write(f->path, f->image, &f->err);
+    }
+}
+
+// wx_bake_maps_fn: names the camera's files, stamps the headers, writes them in
+// parallel, and points the camera at them.
+static wx_result write_maps(int camera, wx_image *maps, int count, void *user, wx_error *err)
+{
+    static const char *const kinds[4] = { "depth", "normal", "impact", "dirt" };
+    bake_writer *w = user;
+    wx_scene_camera *sc = &w->scene->cameras[camera];
+    if (!w->prepared) {
+        wx_result r = wx_output_prepare(w->scene, w->opts, NULL, err);
+        if (r != WX_OK) {
+            return r;
+        }
+        w->prepared = true;
+    }
+    for (int k = 0; k < count; ++k) {
+        map_file *f = &w->files[k];
+        char name[sizeof sc->name + 32];
+        snprintf(name, sizeof name, "%s_%s.exr", sc->name, kinds[k]);
+        wx_result r = wx_output_path(w->scene, w->opts, name, f->path, err);
+        if (r != WX_OK) {
+            wx_error_prefix(err, "bake camera '%s'", sc->name);
+            return r;
+        }
+        wx_image_set_m44f(&maps[k], "WTCMatrix", sc->camera.wtc);
+        wx_image_set_m44f(&maps[k], "CTWMatrix", sc->camera.ctw);
+        wx_image_set_string(&maps[k], "cameraName", sc->name);
+        f->image = &maps[k];
+        f->result = WX_OK;
+    }
+    wx_parallel_for(w->opts->threads, count, 1, write_files, w);
+    for (int k = 0; k < count; ++k) {
+        if (w->files[k].result != WX_OK) {
+            *err = w->files[k].err;
+            wx_error_prefix(err, "bake camera '%s'", sc->name);
+            return w->files[k].result;
+        }
+    }
+    char *dest[4] = { sc->depth_path, sc->normal_path, sc->impact_path, sc->dirt_path };
+    for (int k = 0; k < count; ++k) {
+        memcpy(dest[k], w->files[k].path, WX_PATH_MAX);
+    }
+    sc->maps_in_output = true; // ours: later phases may replace them
+    return WX_OK;
+}
+
+// The depth maps of the input cameras the scene gives as files, when the
+// initial-dirt visibility test needs them (some surface starts with dirt and
+// there is more than one input camera); *given stays NULL otherwise.
+static wx_result read_given_depths(const wx_scene *scene, const wx_geometry *geometry,
+                                   wx_maps **given, wx_error *err)
+{
+    *given = NULL;
+    if (!geometry->has_dirt || scene->input_count < 2) {
+        return WX_OK;
+    }
+    wx_maps *maps = calloc((size_t)scene->camera_count, sizeof *maps);
+    if (maps == NULL) {
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "bake: out of memory");
+    }
+    *given = maps;
+    for (int c = 0; c < scene->camera_count; ++c) {
+        const wx_scene_camera *sc = &scene->cameras[c];
+        if (sc->is_output || (sc->has_view && sc->depth_path[0] == '\0')) {
+            continue; // the output camera has no dirt; a baked camera renders its own
+        }
+        wx_result r = wx_maps_load(&maps[c], WX_MAPS_DEPTH, sc->depth_path, NULL, NULL, NULL,
+                                   err);
+        if (r != WX_OK) {
+            return r;
+        }
+    }
+    return WX_OK;
+}
+
+wx_result wx_geometry_load(const wx_scene *scene, bool quiet, wx_geometry *out, wx_error *err)
+{
+    memset(out, 0, sizeof *out);
+    out->meshes = calloc(scene->mesh_count > 0 ? (size_t)scene->mesh_count : 1,
+                         sizeof *out->meshes);
+    if (out->meshes == NULL) {
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (meshes)");
+    }
+    wx_result r = WX_OK;
+    double t0 = wx_now_s();
+    for (int i = 0; i < scene->mesh_count && r == WX_OK; ++i) {
+        const wx_mesh *mesh = &scene->meshes[i];
+        wx_geometry_mesh *g = &out->meshes[i];
+        out->count = i + 1;
+        struct stat st;
+        if (stat(mesh->path, &st) == 0) {
+            out->file_bytes += (int64_t)st.st_size;
+        }
+        r = wx_mesh_import(mesh->path, &g->data, err);
+        if (r != WX_OK) {
+            wx_error_prefix(err, "%s:%d", scene->path, mesh->line);
+            break;
+        }
+        if (g->data.triangle_count == 0) {
+            wx_warn(quiet, "%s:%d: mesh '%s' has no triangles", scene->path, mesh->line,
+                    wx_mesh_display_name(scene, mesh));
+        }
+        int materials = g->data.material_count;
+        g->surface = calloc(materials > 0 ? (size_t)materials : 1, sizeof *g->surface);
+        if (g->surface == NULL) {
+            r = wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (meshes)");
+            break;
+        }
+        r = wx_geometry_match(scene, i, g, &out->has_dirt, err);
+        out->triangles += g->data.triangle_count;
+        out->vertices += g->data.vertex_count;
+    }
+    out->import_s = wx_now_s() - t0;
+    if (r != WX_OK) {
+        wx_geometry_free(out);
+    }
+    return r;
+}
+
+wx_result wx_bake_geometry(wx_scene *scene, const wx_run_def *opts, wx_geometry *geometry,
+                           wx_bake_stats *stats, wx_error *err)
+{
+    wx_maps *given = NULL;
+    bake_writer *writer = calloc(1, sizeof *writer); // four paths: off the stack
+    wx_result r = writer != NULL ? WX_OK : wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "bake: out of memory");
+    if (r == WX_OK && wx_scene_needs_bake(scene)) {
+        r = read_given_depths(scene, geometry, &given, err);
+    }
+    if (r == WX_OK) {
+        writer->scene = scene;
+        writer->opts = opts;
+        wx_bake_def def = wx_default_bake_def();
+        def.scene = scene;
+        def.geometry = geometry;
+        def.given_depth = given;
+        def.threads = opts->threads;
+        def.quiet = opts->quiet;
+        def.on_maps = write_maps;
+        def.user = writer;
+        r = wx_bake_render(&def, stats, err);
+    }
+    for (int c = 0; given != NULL && c < scene->camera_count; ++c) {
+        wx_maps_free(&given[c]);
+    }
+    free(given);
+    free(writer);
+    return r;
+}
+
+wx_result wx_bake_scene_stats(wx_scene *scene, const wx_run_def *opts, wx_bake_stats *stats,
+                              wx_error *err)
+{
+    wx_geometry geometry;
+    memset(&geometry, 0, sizeof geometry);
+    wx_result r = WX_OK;
+    if (wx_scene_needs_bake(scene) && scene->mesh_count > 0) {
+        r = wx_geometry_load(scene, opts->quiet, &geometry, err);
+    }
+    if (r == WX_OK) {
+        r = wx_bake_geometry(scene, opts, &geometry, stats, err);
+    }
+    wx_geometry_free(&geometry);
+    return r;
+}
+
+wx_result wx_bake_scene(wx_scene *scene, const wx_run_def *opts, wx_error *err)
+{
+    return wx_bake_scene_stats(scene, opts, NULL, err);
+}

@@ -1,0 +1,36 @@
+// bake_phase.h: the `bake` phase: the scene's meshes imported and matched, the
+// <View> cameras without map files rendered (raster/bake.c), and their maps
+// written into the output folder: <camera>_depth.exr, <camera>_normal.exr and,
+// for input cameras, <camera>_impact.exr and <camera>_dirt.exr, each with the
+// camera's "WTCMatrix", "CTWMatrix" (m44f, row-major) and "cameraName" in its
+// header. The cameras' map paths then point at those files.
+#ifndef WX_BAKE_PHASE_H
+#define WX_BAKE_PHASE_H
+
+#include "core/error.h"
+#include "model/geometry.h"
+#include "model/scene.h"
+#include "pipeline/pipeline.h"
+#include "raster/bake.h"
+
+/// Imports every mesh of `scene` and matches each of its materials to a
+/// <Surface> (the one naming it, else "*"). WX_BAD_INPUT "scene:LINE: ..." for
+/// a mesh that cannot be imported, a material no <Surface> matches, or a
+/// <Surface vertexColors> on a material without colours; a mesh without
+/// triangles is a warning (unless quiet). On failure `out` is left empty.
+wx_result wx_geometry_load(const wx_scene *scene, bool quiet, wx_geometry *out, wx_error *err);
+
+/// Bakes with the geometry already imported (wx_geometry_load);
+/// its mesh arrays are released as they are uploaded. `stats` may be NULL.
+wx_result wx_bake_geometry(wx_scene *scene, const wx_run_def *opts, wx_geometry *geometry,
+                           wx_bake_stats *stats, wx_error *err);
+
+/// The whole phase: imports the geometry when some camera is baked, then
+/// wx_bake_geometry. `stats` may be NULL.
+wx_result wx_bake_scene_stats(wx_scene *scene, const wx_run_def *opts, wx_bake_stats *stats,
+                              wx_error *err);
+
+/// wx_bake_scene_stats without the statistics.
+wx_result wx_bake_scene(wx_scene *scene, const wx_run_def *opts, wx_error *err);
+
+#endif

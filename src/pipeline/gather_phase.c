@@ -1,0 +1,119 @@
+// gather_phase.c: the `gather` phase on files (gather_phase.h): the maps in, the
+// gather (gather/gather.c) on them, the mask and its preview out.
+#include "pipeline/gather_phase.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "gather/gather.h"
+#include "io/exr.h"
+#include "io/maps_file.h"
+#include "io/png_preview.h"
+#include "pipeline/load.h"
+#include "pipeline/outputs.h"
+
+wx_result wx_gather_scene(const wx_scene *scene, const wx_run_def *opts, wx_error *err)
+{
+    int input_count = scene->input_count;
+    wx_maps *in_maps = calloc((size_t)input_count + 1, sizeof *in_maps);
+    if (in_maps == NULL) {
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "gather: out of memory");
+    }
+    wx_result result = wx_load_gather_maps(scene, opts, in_maps, err);
+    if (result == WX_OK) {
+        result = wx_gather_maps(scene, opts, in_maps, err);
+    }
+    for (int c = 0; c < input_count; ++c) {
+        wx_maps_free(&in_maps[c]);
+    }
+    free(in_maps);
+    return result;
+}
+
+wx_result wx_gather_maps(const wx_scene *scene, const wx_run_def *opts, const wx_maps *in_maps,
+                         wx_error *err)
+{
+    if (scene->output_index < 0 || scene->output_index >= scene->camera_count) {
+        return wx_fail(err, WX_CAUSE_BAD_SCENE, "%s: no output camera (an <Ortho out=\"true\">); gather needs one",
+                            scene->path);
+    }
+    const wx_scene_camera *out = &scene->cameras[scene->output_index];
+    char mask_path[WX_PATH_MAX], png_path[WX_PATH_MAX], png_name[WX_OUTPUT_NAME_MAX];
+    wx_preview_name(out->output_file, png_name, sizeof png_name);
+    wx_result result = wx_output_path(scene, opts, out->output_file, mask_path, err);
+    if (result == WX_OK) {
+        result = wx_output_path(scene, opts, png_name, png_path, err);
+    }
+    if (result != WX_OK) {
+        return result;
+    }
+
+    int input_count = scene->input_count;
+    wx_maps out_maps;
+    memset(&out_maps, 0, sizeof out_maps);
+    wx_gather_view *views = calloc((size_t)input_count + 1, sizeof *views);
+    wx_image *image = calloc(1, sizeof *image);
+    if (views == NULL || image == NULL) {
+        free(views);
+        free(image);
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "gather: out of memory");
+    }
+
+    result = wx_maps_load(&out_maps, WX_MAPS_DEPTH | WX_MAPS_NORMAL, out->depth_path,
+                          out->normal_path, NULL, NULL, err);
+    if (result != WX_OK) {
+        wx_error_prefix(err, "output camera '%s'", out->name);
+    } else if (out_maps.width != out->output_width || out_maps.height != out->output_height) {
+        result = wx_fail(err, WX_CAUSE_MAP_SIZE, "%s: output camera '%s': its maps are %d x %d but <OutputMap> "
+                              "asks for %d x %d",
+                              scene->path, out->name, out_maps.width, out_maps.height,
+                              out->output_width, out->output_height);
+    }
+    int k = 0;
+    for (int c = 0; c < scene->camera_count && result == WX_OK; ++c) {
+        const wx_scene_camera *cam = &scene->cameras[c];
+        if (!cam->is_output) {
+            views[k] = wx_gather_view_from_maps(&cam->camera, &in_maps[k]);
+            k++;
+        }
+    }
+    if (result == WX_OK) {
+        static const char *const names[] = { "Y" };
+        result = wx_image_alloc(image, out_maps.width, out_maps.height, 1, names, err);
+    }
+    if (result == WX_OK) {
+        wx_gather_def def = wx_default_gather_def();
+        def.target = wx_target_from_camera(&out->camera, &out_maps);
+        def.inputs = views;
+        def.input_count = k;
+        def.radius = out->radius;
+        def.second_pass = out->second_pass;
+        def.normalize = out->normalize;
+        def.threads = opts->threads;
+        def.quiet = opts->quiet;
+        result = wx_gather_compute(&def, image->channels[0], NULL, err);
+    }
+    if (result == WX_OK) {
+        float m[16];
+        wx_mask_world_to_camera(&out->camera, m);
+        wx_image_set_m44f(image, "worldToCamera", m);
+        wx_mask_world_to_ndc(&out->camera, m);
+        wx_image_set_m44f(image, "worldToNDC", m);
+        wx_image_set_m44f(image, "WTCMatrix", out->camera.wtc);
+        wx_image_set_m44f(image, "CTWMatrix", out->camera.ctw);
+        wx_image_set_string(image, "cameraName", out->name);
+        image->threads = opts->threads; // compresses chunks in parallel: same bytes
+        result = wx_exr_write(mask_path, image, err);
+    }
+    if (result == WX_OK) {
+        result = wx_preview_write_png(png_path, image->channels[0], out_maps.depth,
+                                      out_maps.width, out_maps.height, err);
+    }
+
+    wx_image_free(image);
+    free(image);
+    free(views);
+    wx_maps_free(&out_maps);
+    return result;
+}

@@ -1,0 +1,26 @@
+// gather_phase.h: the `gather` phase: the input cameras' maps and dirt read (or
+// given in memory by a simulation that just ran), the output camera's maps
+// read, the mask computed (gather/gather.c) and written with its preview.
+#ifndef WX_GATHER_PHASE_H
+#define WX_GATHER_PHASE_H
+
+#include "core/error.h"
+#include "model/maps.h"
+#include "model/scene.h"
+#include "pipeline/pipeline.h"
+
+/// The `gather` phase: loads the output camera's depth and normal maps and, for
+/// every input camera, its depth and normal maps and the dirt map `simulate`
+/// left in opts->out_dir (<camera>_dirt.exr; when there is none, the camera's
+/// dirt map from the scene, with a note on stderr unless quiet), computes the
+/// mask and writes opts->out_dir/<output_file> (EXR, channel Y, with the camera
+/// in its header) and the PNG preview beside it (extension replaced by .png).
+wx_result wx_gather_scene(const wx_scene *scene, const wx_run_def *opts, wx_error *err);
+
+/// The `gather` phase with the input cameras' maps already in memory (one per
+/// input camera in scene order: depth, normal and the dirt to gather): reads
+/// the output camera's maps, computes and writes the mask and its preview.
+wx_result wx_gather_maps(const wx_scene *scene, const wx_run_def *opts, const wx_maps *in_maps,
+                         wx_error *err);
+
+#endif

@@ -1,0 +1,104 @@
+// load.c: what the simulation and the gather read before they compute (load.h):
+// the input cameras' maps.
+#include "pipeline/load.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "core/progress.h"
+#include "io/exr.h"
+#include "io/maps_file.h"
+
+wx_result wx_load_simulation_maps(const wx_scene *scene, wx_maps *maps, wx_error *err)
+{
+    int k = 0;
+    for (int c = 0; c < scene->camera_count; ++c) {
+        const wx_scene_camera *cam = &scene->cameras[c];
+        if (cam->is_output) {
+            continue;
+        }
+        if (cam->depth_path[0] == '\0') {
+            return wx_fail(err, WX_CAUSE_MISSING_PHASE, "%s: camera '%s' has no maps yet; run `weathering bake` first",
+                                scene->path, cam->name);
+        }
+        unsigned which = WX_MAPS_DEPTH | WX_MAPS_NORMAL | WX_MAPS_IMPACT;
+        if (cam->dirt_path[0] != '\0') {
+            // A dirt map that an earlier `simulate` wrote starts from the dirt it
+            // started from (channel initialDirt), so running again is repeatable.
+            which |= WX_MAPS_DIRT | WX_MAPS_INITIAL_DIRT;
+        }
+        wx_result r = wx_maps_load(&maps[k], which, cam->depth_path, cam->normal_path,
+                                   cam->impact_path, cam->dirt_path, err);
+        if (r != WX_OK) {
+            wx_error_prefix(err, "camera '%s'", cam->name);
+            return r;
+        }
+        k++;
+    }
+    return WX_OK;
+}
+
+// True when the EXR at `path` has a channel named `name` (header only).
+static bool has_channel(const char *path, const char *name)
+{
+    wx_image *header = calloc(1, sizeof *header); // attributes inline: off the stack
+    bool found = false;
+    if (header != NULL && wx_exr_read_header(path, header, NULL) == WX_OK) {
+        for (int c = 0; c < header->channel_count && !found; ++c) {
+            found = strcmp(header->channel_names[c], name) == 0;
+        }
+    }
+    free(header);
+    return found;
+}
+
+wx_result wx_load_gather_maps(const wx_scene *scene, const wx_run_def *opts, wx_maps *maps,
+                              wx_error *err)
+{
+    int k = 0;
+    for (int c = 0; c < scene->camera_count; ++c) {
+        const wx_scene_camera *cam = &scene->cameras[c];
+        if (cam->is_output) {
+            continue;
+        }
+        char simulated[WX_PATH_MAX];
+        int n = snprintf(simulated, sizeof simulated, "%s/%s_dirt.exr", opts->out_dir, cam->name);
+        if (n < 0 || n >= (int)sizeof simulated) {
+            return wx_fail(err, WX_CAUSE_PATH_TOO_LONG, "%s: output path too long", opts->out_dir);
+        }
+        const char *dirt_path = simulated;
+        if (access(simulated, R_OK) != 0) {
+            if (cam->dirt_path[0] == '\0') {
+                return wx_fail(err, WX_CAUSE_MISSING_PHASE,
+                                    "%s: camera '%s' has no dirt map (no %s); run `weathering "
+                                    "simulate %s --out %s` first",
+                                    scene->path, cam->name, simulated, scene->path,
+                                    opts->out_dir);
+            }
+            dirt_path = cam->dirt_path;
+            wx_note(opts->quiet,
+                    "gather: no simulated dirt map %s; camera '%s' uses its scene dirt map %s",
+                    simulated, cam->name, dirt_path);
+        } else if (!has_channel(simulated, WX_INITIAL_DIRT_CHANNEL)) {
+            wx_note(opts->quiet,
+                    "gather: %s was never simulated (it holds the initial dirt bake wrote); run "
+                    "`weathering simulate` first for the particles' dirt",
+                    simulated);
+        }
+        wx_result r = wx_maps_load(&maps[k], WX_MAPS_DEPTH | WX_MAPS_NORMAL | WX_MAPS_DIRT,
+                                   cam->depth_path, cam->normal_path, NULL, dirt_path, err);
+        if (r != WX_OK) {
+            wx_error_prefix(err, "camera '%s'", cam->name);
+            return r;
+        }
+        // Only the dirt plane is read: release deposit and erosion now.
+        free(maps[k].deposit);
+        free(maps[k].erosion);
+        maps[k].deposit = maps[k].erosion = NULL;
+        k++;
+    }
+    return WX_OK;
+}

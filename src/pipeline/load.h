@@ -1,0 +1,26 @@
+// load.h: what the simulation and the gather read from files before they
+// compute: the input cameras' maps.
+#ifndef WX_LOAD_H
+#define WX_LOAD_H
+
+#include "core/error.h"
+#include "model/maps.h"
+#include "model/scene.h"
+#include "pipeline/pipeline.h"
+
+/// Loads the maps of every input camera (scene order; `maps` has
+/// scene->input_count entries) as the simulation reads them: depth, normal,
+/// impact and, when the camera has one, its dirt map (from the channel
+/// initialDirt when an earlier `simulate` wrote it, so a second run starts
+/// where the first started). Errors name the camera and the file.
+wx_result wx_load_simulation_maps(const wx_scene *scene, wx_maps *maps, wx_error *err);
+
+/// Loads the maps of every input camera as the gather reads them: depth,
+/// normal, and the dirt `simulate` left in the output folder
+/// (<camera>_dirt.exr); without it the camera's scene dirt map, with a note.
+/// A dirt map that holds only the baked initial dirt (never simulated) is used
+/// with a note too.
+wx_result wx_load_gather_maps(const wx_scene *scene, const wx_run_def *opts, wx_maps *maps,
+                              wx_error *err);
+
+#endif

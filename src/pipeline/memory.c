@@ -1,0 +1,206 @@
+// memory.c: the memory a run needs, what is available, and the refusal of a run
+// that would not fit (memory.h, docs/reliability.md).
+#include "pipeline/memory.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "pipeline/outputs.h"
+#include "sim/emitter.h"
+
+void wx_memory_estimate(const wx_scene *scene, unsigned phases, wx_memory_need *need)
+{
+    memset(need, 0, sizeof *need);
+    need->baseline_bytes = WX_MEMORY_BASELINE;
+    need->camera_line = scene->path[0] != '\0' ? 1 : 0;
+    double largest = -1.0, input_texels = 0.0, largest_input = 0.0, output_texels = 0.0;
+    double framebuffer = 0.0, images = 0.0, baked_inputs = 0.0;
+    bool bake = (phases & WX_PHASE_BAKE) && wx_scene_needs_bake(scene);
+    for (int c = 0; c < scene->camera_count; ++c) {
+        const wx_scene_camera *sc = &scene->cameras[c];
+        double texels = (double)sc->camera.width * (double)sc->camera.height;
+        if (sc->is_output) {
+            output_texels = texels;
+        } else {
+            input_texels += texels;
+            largest_input = fmax(largest_input, texels);
+        }
+        if (texels > largest) {
+            largest = texels;
+            need->camera_line = sc->line;
+        }
+        if (bake && sc->has_view && sc->depth_path[0] == '\0') {
+            framebuffer = fmax(framebuffer, WX_BAKE_FRAMEBUFFER_BYTES_PER_TEXEL * texels);
+            images = fmax(images, texels * (sc->is_output ? WX_BAKE_OUTPUT_IMAGE_BYTES_PER_TEXEL
+                                                          : WX_BAKE_INPUT_IMAGE_BYTES_PER_TEXEL));
+            baked_inputs += sc->is_output ? 0.0 : texels;
+        }
+    }
+    if (bake) {
+        double largest_file = -1.0;
+        for (int m = 0; m < scene->mesh_count; ++m) {
+            struct stat st;
+            double bytes = stat(scene->meshes[m].path, &st) == 0 ? (double)st.st_size : 0.0;
+            need->mesh_bytes += WX_MESH_BYTES_PER_FILE_BYTE * bytes;
+            if (bytes > largest_file) {
+                largest_file = bytes;
+                need->mesh_line = scene->meshes[m].line;
+            }
+        }
+        // Two cameras' images at once, the visibility test's depth planes, the
+        // readback strip (1 Mi floats), and the meshes as imported and uploaded.
+        need->bake_bytes = WX_BAKE_CONTEXT_BYTES + framebuffer + 2.0 * images +
+                           4.0 * (input_texels > baked_inputs ? input_texels : baked_inputs) +
+                           4.0 * 1024.0 * 1024.0 + need->mesh_bytes;
+    }
+    if (phases & WX_PHASE_SIMULATE) {
+        need->sim_map_bytes = WX_SIM_BYTES_PER_INPUT_TEXEL * input_texels +
+                              WX_SIM_WRITE_BYTES_PER_TEXEL * largest_input;
+        largest = -1.0;
+        double duration = wx_scene_duration(scene);
+        for (int e = 0; e < scene->emitter_count; ++e) {
+            double n = (double)wx_emitter_count_at(&scene->emitters[e], duration);
+            need->particles += n;
+            if (n > largest) {
+                largest = n;
+                need->emitter_line = scene->emitters[e].line;
+            }
+        }
+        need->particle_bytes = need->particles * WX_BYTES_PER_PARTICLE;
+    }
+    if (phases & WX_PHASE_GATHER) {
+        need->gather_bytes = WX_GATHER_BYTES_PER_INPUT_TEXEL * input_texels +
+                             WX_GATHER_BYTES_PER_OUTPUT_TEXEL * output_texels;
+    }
+    double sim = need->sim_map_bytes + need->particle_bytes;
+    double peak = need->bake_bytes;
+    need->phase = "bake";
+    if (sim > peak) {
+        peak = sim;
+        need->phase = "simulate";
+    }
+    if (need->gather_bytes > peak) {
+        peak = need->gather_bytes;
+        need->phase = "gather";
+    }
+    need->total_bytes = need->baseline_bytes + WX_MEMORY_MARGIN * peak;
+}
+
+// A "Key:   1234 kB" line of /proc/meminfo, in bytes; < 0 when absent.
+static double meminfo_bytes(const char *key)
+{
+    FILE *f = fopen("/proc/meminfo", "r");
+    if (f == NULL) {
+        return -1.0;
+    }
+    char line[256];
+    double bytes = -1.0;
+    size_t key_len = strlen(key);
+    while (fgets(line, sizeof line, f) != NULL) {
+        if (strncmp(line, key, key_len) == 0 && line[key_len] == ':') {
+            bytes = 1024.0 * strtod(line + key_len + 1, NULL);
+            break;
+        }
+    }
+    fclose(f);
+    return bytes;
+}
+
+// A cgroup v2 number file ("max" or bytes); < 0 when absent or "max".
+static double cgroup_number(const char *path)
+{
+    FILE *f = fopen(path, "r");
+    if (f == NULL) {
+        return -1.0;
+    }
+    char text[64] = "";
+    double value = -1.0;
+    if (fgets(text, sizeof text, f) != NULL && text[0] >= '0' && text[0] <= '9') {
+        value = strtod(text, NULL);
+    }
+    fclose(f);
+    return value;
+}
+
+static void take_min(double *least, double value)
+{
+    if (value >= 0.0 && (*least < 0.0 || value < *least)) {
+        *least = value;
+    }
+}
+
+double wx_memory_available(void)
+{
+    const char *override = getenv("WX_MEMORY_AVAILABLE_MB");
+    if (override != NULL && override[0] != '\0') {
+        char *end = NULL;
+        double mb = strtod(override, &end);
+        if (end != override && *end == '\0' && mb >= 0.0) {
+            return mb * 1024.0 * 1024.0;
+        }
+    }
+    double least = meminfo_bytes("MemAvailable");
+    if (least < 0.0) {
+        long pages = sysconf(_SC_AVPHYS_PAGES);
+        long page = sysconf(_SC_PAGESIZE);
+        if (pages > 0 && page > 0) {
+            least = (double)pages * (double)page;
+        }
+    }
+    double cg_max = cgroup_number("/sys/fs/cgroup/memory.max");
+    double cg_now = cgroup_number("/sys/fs/cgroup/memory.current");
+    if (cg_max >= 0.0) {
+        take_min(&least, cg_now >= 0.0 && cg_now < cg_max ? cg_max - cg_now : 0.0);
+    }
+    struct rlimit rl;
+    if (getrlimit(RLIMIT_AS, &rl) == 0 && rl.rlim_cur != RLIM_INFINITY) {
+        take_min(&least, (double)rl.rlim_cur);
+    }
+    if (getrlimit(RLIMIT_DATA, &rl) == 0 && rl.rlim_cur != RLIM_INFINITY) {
+        take_min(&least, (double)rl.rlim_cur);
+    }
+    return least;
+}
+
+static double gib(double bytes)
+{
+    return bytes / (1024.0 * 1024.0 * 1024.0);
+}
+
+wx_result wx_memory_check(const wx_scene *scene, unsigned phases, wx_error *err)
+{
+    wx_memory_need need;
+    wx_memory_estimate(scene, phases, &need);
+    double available = wx_memory_available();
+    if (available < 0.0 || need.total_bytes <= available) {
+        return WX_OK;
+    }
+    if (strcmp(need.phase, "simulate") == 0 && need.particle_bytes > need.sim_map_bytes) {
+        return wx_fail(err, WX_CAUSE_MEMORY_LIMIT, "%s:%d: the emitters would emit %.4g particles: with the maps that "
+                            "needs about %.3g GiB (%.0f bytes per particle, %.3g GiB of maps), "
+                            "but only %.3g GiB of memory is available; lower the rate or the "
+                            "duration (see docs/reliability.md)",
+                            scene->path, need.emitter_line, need.particles, gib(need.total_bytes),
+                            WX_BYTES_PER_PARTICLE, gib(need.sim_map_bytes), gib(available));
+    }
+    if (strcmp(need.phase, "bake") == 0 && need.mesh_bytes > need.bake_bytes - need.mesh_bytes) {
+        return wx_fail(err, WX_CAUSE_MEMORY_LIMIT,
+                            "%s:%d: importing and baking the meshes needs about %.3g GiB (%.3g "
+                            "GiB to import %.0f MiB of mesh files), but only %.3g GiB of memory "
+                            "is available (see docs/reliability.md)",
+                            scene->path, need.mesh_line, gib(need.total_bytes),
+                            gib(need.mesh_bytes),
+                            need.mesh_bytes / WX_MESH_BYTES_PER_FILE_BYTE / (1024.0 * 1024.0),
+                            gib(available));
+    }
+    return wx_fail(err, WX_CAUSE_MEMORY_LIMIT, "%s:%d: the maps need about %.3g GiB at the peak (the %s), but only %.3g "
+                        "GiB of memory is available; use smaller maps (see docs/reliability.md)",
+                        scene->path, need.camera_line, gib(need.total_bytes), need.phase,
+                        gib(available));
+}
+

@@ -1,0 +1,74 @@
+// memory.h: the memory a run needs at its peak, estimated from the scene before
+// any work, the memory the process may still use, and the check that refuses a
+// run that would not fit (docs/reliability.md).
+#ifndef WX_MEMORY_H
+#define WX_MEMORY_H
+
+#include <stdbool.h>
+
+#include "core/error.h"
+#include "model/scene.h"
+
+/// Memory a run needs at its peak, estimated before work starts from the scene
+/// alone (docs/reliability.md): the program itself, plus the largest of its
+/// phases (they run one after the other; each frees what the next does not use).
+typedef struct wx_memory_need {
+    double baseline_bytes; ///< the program and its libraries (WX_MEMORY_BASELINE)
+    double mesh_bytes;     ///< importing the meshes: WX_MESH_BYTES_PER_FILE_BYTE x their files
+    double bake_bytes;     ///< the bake: GL context, framebuffer, images being written, meshes
+    double sim_map_bytes;  ///< the simulation's maps, collider and dirt (without particles)
+    double particles;      ///< particles the emitters emit over the simulation
+    double particle_bytes; ///< as if every particle emitted were alive at once
+    double gather_bytes;   ///< the gather: the maps it reads, its planes, the files it writes
+    double total_bytes;    ///< baseline + the largest phase
+    const char *phase;     ///< the largest phase: "bake", "simulate" or "gather"
+    int camera_line;       ///< scene line of the camera with the largest maps
+    int emitter_line;      ///< scene line of the emitter with the most particles
+    int mesh_line;         ///< scene line of the largest mesh file
+} wx_memory_need;
+
+/// The program's own memory before any scene data (code, libraries, heaps).
+#define WX_MEMORY_BASELINE (64.0 * 1024.0 * 1024.0)
+/// The GL context and llvmpipe's own buffers in the bake.
+#define WX_BAKE_CONTEXT_BYTES (40.0 * 1024.0 * 1024.0)
+/// Bytes per byte of mesh file while Assimp imports it (measured: about 18 for
+/// OBJ; binary formats hold fewer bytes per triangle).
+#define WX_MESH_BYTES_PER_FILE_BYTE 32.0
+/// Bytes per texel of the bake's float framebuffer (RGBA32F x 2, R32F, depth).
+#define WX_BAKE_FRAMEBUFFER_BYTES_PER_TEXEL 40.0
+/// Bytes per texel of the images of one baked camera (depth 1, normal 3, impact
+/// 3, dirt 3 floats; an output camera only depth and normal). Two cameras' sets
+/// are alive while one is written and the next rendered.
+#define WX_BAKE_INPUT_IMAGE_BYTES_PER_TEXEL 40.0
+#define WX_BAKE_OUTPUT_IMAGE_BYTES_PER_TEXEL 16.0
+/// Bytes per input texel in the simulation: the maps (depth, normal, impact,
+/// dirt: 9 floats), the collider's depth and pyramid (5), the dirt in double (16).
+#define WX_SIM_BYTES_PER_INPUT_TEXEL 57.0
+/// Bytes per texel of the dirt map being written (4 floats).
+#define WX_SIM_WRITE_BYTES_PER_TEXEL 16.0
+/// Bytes per particle: WX_PARTICLE_BYTES with room for the arrays to double as
+/// they grow, plus the per-step events and candidates of the workers.
+#define WX_BYTES_PER_PARTICLE 192.0
+/// Bytes per input texel in the gather (depth, normal, dirt) and per output
+/// texel (its depth and normal, the mask, the second pass's 5 planes, the
+/// preview's sorted values).
+#define WX_GATHER_BYTES_PER_INPUT_TEXEL 20.0
+#define WX_GATHER_BYTES_PER_OUTPUT_TEXEL 48.0
+/// Margin over the measured sizes (allocator rounding, small buffers).
+#define WX_MEMORY_MARGIN 1.15
+
+/// Estimates the peak memory of running `phases` (WX_PHASE_*) of the scene: the
+/// bake counts when `phases` has it and some camera is baked, the particles when
+/// it has the simulation.
+void wx_memory_estimate(const wx_scene *scene, unsigned phases, wx_memory_need *need);
+
+/// Bytes this process can still use: the least of MemAvailable, the cgroup's
+/// memory.max minus memory.current and RLIMIT_AS / RLIMIT_DATA; < 0 when
+/// unknown. $WX_MEMORY_AVAILABLE_MB overrides it (tests, or to insist).
+double wx_memory_available(void);
+
+/// Refuses (WX_BAD_INPUT, "scene:LINE: ...") a run whose estimate exceeds the
+/// memory available, naming the numbers, before any work starts.
+wx_result wx_memory_check(const wx_scene *scene, unsigned phases, wx_error *err);
+
+#endif

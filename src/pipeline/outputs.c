@@ -1,0 +1,437 @@
+// outputs.c: the output folder and what goes into it (outputs.h, docs/design.md
+// section 6): the names a run writes, the checks made before any work, the
+// folder's preparation and its removal after a failure.
+#define _XOPEN_SOURCE 700 // realpath
+#include "pipeline/outputs.h"
+
+#include <errno.h>
+#include <limits.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "core/atomic_file.h"
+
+void wx_preview_name(const char *mask_name, char *out, size_t cap)
+{
+    const char *dot = strrchr(mask_name, '.');
+    int stem = dot != NULL && dot != mask_name ? (int)(dot - mask_name) : (int)strlen(mask_name);
+    bool is_png = dot != NULL && dot != mask_name && strcmp(dot, ".png") == 0;
+    snprintf(out, cap, "%.*s%s", stem, mask_name, is_png ? ".preview.png" : ".png");
+}
+
+// A <View> camera whose maps `bake` writes into the output folder.
+static bool baked_camera(const wx_scene_camera *cam)
+{
+    return cam->has_view && (cam->depth_path[0] == '\0' || cam->maps_in_output);
+}
+
+static wx_result add_name(wx_output_names *list, int *capacity, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+
+static wx_result add_name(wx_output_names *list, int *capacity, const char *fmt, ...)
+{
+    if (list->count == *capacity) {
+        int grown_capacity = *capacity > 0 ? 2 * *capacity : 16;
+        void *grown = realloc(list->names, (size_t)grown_capacity * sizeof *list->names);
+        if (grown == NULL) {
+            return WX_FAIL;
+        }
+        list->names = grown;
+        *capacity = grown_capacity;
+    }
+    va_list args;
+    va_start(args, fmt);
+    vsnprintf(list->names[list->count], WX_OUTPUT_NAME_MAX, fmt, args);
+    va_end(args);
+    for (int k = 0; k < list->count; ++k) {
+        if (strcmp(list->names[k], list->names[list->count]) == 0) {
+            return WX_OK; // bake and simulate both write <camera>_dirt.exr
+        }
+    }
+    list->count++;
+    return WX_OK;
+}
+
+wx_result wx_output_names_list(const wx_scene *scene, unsigned phases, wx_output_names *out,
+                               wx_error *err)
+{
+    static const char *const kinds[4] = { "depth", "normal", "impact", "dirt" };
+    memset(out, 0, sizeof *out);
+    int capacity = 0;
+    wx_result r = WX_OK;
+    for (int c = 0; c < scene->camera_count && r == WX_OK; ++c) {
+        const wx_scene_camera *cam = &scene->cameras[c];
+        int baked = (phases & WX_PHASE_BAKE) && baked_camera(cam) ? (cam->is_output ? 2 : 4) : 0;
+        for (int k = 0; k < baked && r == WX_OK; ++k) {
+            r = add_name(out, &capacity, "%s_%s.exr", cam->name, kinds[k]);
+        }
+        if (r == WX_OK && (phases & WX_PHASE_SIMULATE) && !cam->is_output) {
+            r = add_name(out, &capacity, "%s_dirt.exr", cam->name);
+        }
+    }
+    if (r == WX_OK && (phases & WX_PHASE_GATHER) && scene->output_index >= 0) {
+        const wx_scene_camera *cam = &scene->cameras[scene->output_index];
+        char png[WX_OUTPUT_NAME_MAX];
+        wx_preview_name(cam->output_file, png, sizeof png);
+        r = add_name(out, &capacity, "%s", cam->output_file);
+        if (r == WX_OK) {
+            r = add_name(out, &capacity, "%s", png);
+        }
+    }
+    if (r != WX_OK) {
+        wx_output_names_free(out);
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (output names)");
+    }
+    return WX_OK;
+}
+
+void wx_output_names_free(wx_output_names *names)
+{
+    free(names->names);
+    memset(names, 0, sizeof *names);
+}
+
+// mkdir -p: creates every missing folder of `path`; `created` gets the first one made.
+static wx_result make_folders(const char *path, char created[WX_PATH_MAX], wx_error *err)
+{
+    char partial[WX_PATH_MAX];
+    size_t len = strlen(path);
+    created[0] = '\0';
+    if (len == 0 || len >= sizeof partial) {
+        return wx_fail(err, WX_CAUSE_PATH_TOO_LONG, "output folder name is empty or too long");
+    }
+    memcpy(partial, path, len + 1);
+    for (size_t i = 1; i <= len; ++i) {
+        if (partial[i] != '/' && partial[i] != '\0') {
+            continue;
+        }
+        char saved = partial[i];
+        partial[i] = '\0';
+        if (mkdir(partial, 0777) == 0) {
+            if (created[0] == '\0') {
+                memcpy(created, partial, i + 1);
+            }
+        } else if (errno != EEXIST) {
+            return wx_fail(err, WX_CAUSE_IO, "%s: cannot create folder (%s)", partial,
+                                strerror(errno));
+        }
+        partial[i] = saved;
+    }
+    struct stat st;
+    if (stat(path, &st) != 0 || !S_ISDIR(st.st_mode)) {
+        return wx_fail(err, WX_CAUSE_OUTPUT_CONFLICT, "%s: exists and is not a folder", path);
+    }
+    return WX_OK;
+}
+
+// Whether a file name in the output folder is the temporary of one of ours.
+typedef struct temp_owner {
+    const wx_output_names *names;
+    const char *stats_name; ///< --stats file's name when it lies in the folder, else NULL
+} temp_owner;
+
+static bool is_our_output(const char *name, void *context)
+{
+    const temp_owner *owner = context;
+    if (owner->stats_name != NULL && strcmp(name, owner->stats_name) == 0) {
+        return true;
+    }
+    for (int k = 0; k < owner->names->count; ++k) {
+        if (strcmp(name, owner->names->names[k]) == 0) {
+            return true;
+        }
+    }
+    return false;
+}
+
+static bool canonical_path(const char *path, char out[WX_PATH_MAX]);
+
+wx_result wx_output_prepare(const wx_scene *scene, const wx_run_def *opts,
+                            char created[WX_PATH_MAX], wx_error *err)
+{
+    char made[WX_PATH_MAX];
+    wx_result r = make_folders(opts->out_dir, made, err);
+    if (created != NULL) {
+        memcpy(created, made, sizeof made);
+    }
+    if (r != WX_OK) {
+        wx_output_remove_empty(opts->out_dir, made);
+        return r;
+    }
+    // Temporaries of an earlier run that was killed (SIGKILL, power loss): only
+    // those of the files this program writes there.
+    wx_output_names names;
+    r = wx_output_names_list(scene, WX_PHASE_ALL, &names, err);
+    if (r != WX_OK) {
+        return r;
+    }
+    temp_owner owner = { .names = &names };
+    char folder[WX_PATH_MAX], stats_folder[WX_PATH_MAX];
+    if (opts->stats_path != NULL) {
+        const char *slash = strrchr(opts->stats_path, '/');
+        int n = slash != NULL ? (int)(slash - opts->stats_path) : 1;
+        snprintf(stats_folder, sizeof stats_folder, "%.*s", n,
+                 slash != NULL ? opts->stats_path : ".");
+        if (canonical_path(opts->out_dir, folder) && canonical_path(stats_folder, stats_folder) &&
+            strcmp(folder, stats_folder) == 0) {
+            owner.stats_name = slash != NULL ? slash + 1 : opts->stats_path;
+        }
+    }
+    wx_temp_remove_stale(opts->out_dir, is_our_output, &owner);
+    wx_output_names_free(&names);
+    return WX_OK;
+}
+
+void wx_output_remove_empty(const char *out_dir, const char *created)
+{
+    if (created == NULL || created[0] == '\0') {
+        return;
+    }
+    char folder[WX_PATH_MAX];
+    snprintf(folder, sizeof folder, "%s", out_dir);
+    size_t stop = strlen(created);
+    for (;;) {
+        size_t len = strlen(folder);
+        while (len > 1 && folder[len - 1] == '/') {
+            folder[--len] = '\0';
+        }
+        if (len < stop || rmdir(folder) != 0) {
+            return; // not empty (or not ours): keep it and its parents
+        }
+        char *slash = strrchr(folder, '/');
+        if (len == stop || slash == NULL) {
+            return;
+        }
+        *slash = '\0';
+    }
+}
+
+static bool same_file(const struct stat *a, const char *path)
+{
+    struct stat b;
+    return path[0] != '\0' && stat(path, &b) == 0 && a->st_dev == b.st_dev &&
+           a->st_ino == b.st_ino;
+}
+
+// True when the file `st` describes is the scene or a map or mesh it names.
+// Maps this program baked into the output folder (maps_in_output) are not inputs.
+static bool is_scene_input(const wx_scene *scene, const struct stat *st)
+{
+    if (same_file(st, scene->path)) {
+        return true;
+    }
+    for (int c = 0; c < scene->camera_count; ++c) {
+        const wx_scene_camera *cam = &scene->cameras[c];
+        if (cam->maps_in_output) {
+            continue; // baked by us: a later phase may write the next stage over them
+        }
+        if (same_file(st, cam->depth_path) || same_file(st, cam->normal_path) ||
+            same_file(st, cam->impact_path) || same_file(st, cam->dirt_path)) {
+            return true;
+        }
+    }
+    for (int m = 0; m < scene->mesh_count; ++m) {
+        if (same_file(st, scene->meshes[m].path)) {
+            return true;
+        }
+    }
+    return false;
+}
+
+wx_result wx_output_path(const wx_scene *scene, const wx_run_def *opts, const char *name,
+                         char path[WX_PATH_MAX], wx_error *err)
+{
+    if (name[0] == '\0' || strchr(name, '/') != NULL || strcmp(name, ".") == 0 ||
+        strcmp(name, "..") == 0) {
+        return wx_fail(err, WX_CAUSE_BAD_VALUE, "'%s' is not a plain file name", name);
+    }
+    int n = snprintf(path, WX_PATH_MAX, "%s/%s", opts->out_dir, name);
+    if (n < 0 || n >= WX_PATH_MAX) {
+        return wx_fail(err, WX_CAUSE_PATH_TOO_LONG, "%s/%s: path too long", opts->out_dir, name);
+    }
+    struct stat st;
+    if (stat(path, &st) == 0 && is_scene_input(scene, &st)) {
+        return wx_fail(err, WX_CAUSE_OUTPUT_CONFLICT, "%s: is an input of scene %s and would be overwritten; choose "
+                            "another --out folder",
+                            path, scene->path);
+    }
+    return WX_OK;
+}
+
+// What a path that is not a regular file is, for messages (lstat: a link is a link).
+static const char *file_kind(mode_t mode)
+{
+    return S_ISLNK(mode)    ? "a symbolic link"
+           : S_ISDIR(mode)  ? "a folder"
+           : S_ISFIFO(mode) ? "a FIFO"
+           : S_ISCHR(mode) || S_ISBLK(mode) ? "a device"
+                                             : "not a regular file";
+}
+
+// Removes "." and resolves ".." in the part of a path that does not exist yet.
+static void append_lexical(char out[WX_PATH_MAX], const char *rest)
+{
+    char copy[WX_PATH_MAX];
+    snprintf(copy, sizeof copy, "%s", rest);
+    char *save = NULL;
+    for (char *part = strtok_r(copy, "/", &save); part != NULL; part = strtok_r(NULL, "/", &save)) {
+        if (strcmp(part, ".") == 0) {
+            continue;
+        }
+        size_t len = strlen(out);
+        if (strcmp(part, "..") == 0) {
+            char *slash = strrchr(out, '/');
+            if (slash != NULL) {
+                *(slash == out ? slash + 1 : slash) = '\0';
+            }
+            continue;
+        }
+        snprintf(out + len, WX_PATH_MAX - len, "%s%s", len > 0 && out[len - 1] == '/' ? "" : "/",
+                 part);
+    }
+}
+
+// The absolute path of `path` with its symbolic links resolved as far as it
+// exists (realpath of its longest existing prefix, then the rest as written).
+static bool canonical_path(const char *path, char out[WX_PATH_MAX])
+{
+    char prefix[WX_PATH_MAX];
+    if (snprintf(prefix, sizeof prefix, "%s", path) >= (int)sizeof prefix) {
+        return false;
+    }
+    char resolved[PATH_MAX];
+    for (;;) {
+        const char *start = prefix[0] != '\0' ? prefix : ".";
+        if (realpath(start, resolved) != NULL) {
+            break;
+        }
+        char *slash = strrchr(prefix, '/');
+        if (slash == NULL) {
+            prefix[0] = '\0';
+        } else if (slash == prefix) {
+            prefix[1] = '\0'; // "/" exists
+        } else {
+            *slash = '\0';
+        }
+    }
+    if (snprintf(out, WX_PATH_MAX, "%s", resolved) >= WX_PATH_MAX) {
+        return false;
+    }
+    size_t used = strlen(prefix);
+    if (strcmp(prefix, path) != 0) {
+        append_lexical(out, path + used);
+    }
+    return true;
+}
+
+// The --stats file (DESIGN section 6): never an input, an output of the run or an
+// existing non-regular file; its folder exists or is the output folder.
+static wx_result check_stats_path(const wx_scene *scene, const wx_run_def *opts,
+                                  const wx_output_names *outputs, wx_error *err)
+{
+    const char *path = opts->stats_path;
+    struct stat st;
+    if (lstat(path, &st) == 0) {
+        if (!S_ISREG(st.st_mode)) {
+            return wx_fail(err, WX_CAUSE_OUTPUT_CONFLICT, "--stats %s: exists and is %s; the statistics are written only "
+                                "to a new or a regular file",
+                                path, file_kind(st.st_mode));
+        }
+        if (is_scene_input(scene, &st)) {
+            return wx_fail(err, WX_CAUSE_OUTPUT_CONFLICT, "--stats %s: is an input of scene %s and would be overwritten",
+                                path, scene->path);
+        }
+    }
+    char stats[WX_PATH_MAX], out_dir[WX_PATH_MAX], output[WX_PATH_MAX];
+    if (!canonical_path(path, stats) || !canonical_path(opts->out_dir, out_dir)) {
+        return wx_fail(err, WX_CAUSE_PATH_TOO_LONG, "--stats %s: path too long", path);
+    }
+    for (int k = 0; k < outputs->count; ++k) {
+        int n = snprintf(output, sizeof output, "%s/%s", out_dir, outputs->names[k]);
+        if (n > 0 && n < (int)sizeof output && strcmp(output, stats) == 0) {
+            return wx_fail(err, WX_CAUSE_OUTPUT_CONFLICT, "--stats %s: is the run's output %s; choose another file name",
+                                path, outputs->names[k]);
+        }
+    }
+    char folder[WX_PATH_MAX];
+    snprintf(folder, sizeof folder, "%s", stats);
+    *strrchr(folder, '/') = '\0';
+    struct stat dir;
+    bool exists = stat(folder[0] != '\0' ? folder : "/", &dir) == 0 && S_ISDIR(dir.st_mode);
+    if (!exists && strcmp(folder, out_dir) != 0) {
+        return wx_fail(err, WX_CAUSE_FILE_MISSING, "--stats %s: folder %s does not exist (only the output folder is "
+                            "made by the run)",
+                            path, folder);
+    }
+    return WX_OK;
+}
+
+wx_result wx_check_outputs(const wx_scene *scene, const wx_run_def *opts, unsigned phases,
+                           wx_error *err)
+{
+    wx_output_names names;
+    wx_result r = wx_output_names_list(scene, phases, &names, err);
+    for (int k = 0; k < names.count && r == WX_OK; ++k) {
+        char path[WX_PATH_MAX];
+        r = wx_output_path(scene, opts, names.names[k], path, err);
+        struct stat st;
+        if (r == WX_OK && lstat(path, &st) == 0 && !S_ISREG(st.st_mode)) {
+            r = wx_fail(err, WX_CAUSE_OUTPUT_CONFLICT, "%s: exists and is %s, where the run writes its output %s; remove "
+                             "it or choose another --out folder",
+                             path, file_kind(st.st_mode), names.names[k]);
+        }
+    }
+    if (r == WX_OK && opts->stats_path != NULL) {
+        wx_output_names all;
+        r = wx_output_names_list(scene, WX_PHASE_ALL, &all, err);
+        if (r == WX_OK) {
+            r = check_stats_path(scene, opts, &all, err);
+        }
+        wx_output_names_free(&all);
+    }
+    wx_output_names_free(&names);
+    return r;
+}
+
+bool wx_scene_needs_bake(const wx_scene *scene)
+{
+    for (int c = 0; c < scene->camera_count; ++c) {
+        if (scene->cameras[c].has_view && scene->cameras[c].depth_path[0] == '\0') {
+            return true;
+        }
+    }
+    return false;
+}
+
+wx_result wx_use_baked_maps(wx_scene *scene, const wx_run_def *opts, wx_error *err)
+{
+    static const char *const kinds[4] = { "depth", "normal", "impact", "dirt" };
+    for (int c = 0; c < scene->camera_count; ++c) {
+        wx_scene_camera *cam = &scene->cameras[c];
+        if (!cam->has_view || cam->depth_path[0] != '\0') {
+            continue;
+        }
+        cam->maps_in_output = true;
+        char *paths[4] = { cam->depth_path, cam->normal_path, cam->impact_path, cam->dirt_path };
+        int count = cam->is_output ? 2 : 4;
+        for (int k = 0; k < count; ++k) {
+            int n = snprintf(paths[k], WX_PATH_MAX, "%s/%s_%s.exr", opts->out_dir, cam->name,
+                             kinds[k]);
+            if (n < 0 || n >= WX_PATH_MAX) {
+                return wx_fail(err, WX_CAUSE_PATH_TOO_LONG, "%s: output path too long", opts->out_dir);
+            }
+            if (access(paths[k], R_OK) != 0) {
+                return wx_fail(err, WX_CAUSE_MISSING_PHASE, "%s: camera '%s' has no baked %s map in %s; run `weathering "
+                                    "bake %s --out %s` first",
+                                    scene->path, cam->name, kinds[k], opts->out_dir, scene->path,
+                                    opts->out_dir);
+            }
+        }
+    }
+    return WX_OK;
+}
+

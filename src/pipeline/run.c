@@ -1,0 +1,107 @@
+// run.c: the phases of a run in one process (run.h): the checks first, then
+// bake, simulate and gather, each input file read once.
+#include "pipeline/run.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/progress.h"
+#include "model/geometry.h"
+#include "pipeline/bake_phase.h"
+#include "pipeline/gather_phase.h"
+#include "pipeline/load.h"
+#include "pipeline/memory.h"
+#include "pipeline/outputs.h"
+#include "pipeline/simulate_phase.h"
+
+// Marks the maps of the cameras bake renders as the output folder's own (bake
+// is about to write them there); true when there is any.
+static bool mark_baked_cameras(wx_scene *scene)
+{
+    bool any = wx_scene_needs_bake(scene);
+    for (int c = 0; c < scene->camera_count; ++c) {
+        wx_scene_camera *cam = &scene->cameras[c];
+        cam->maps_in_output = cam->maps_in_output || (cam->has_view && cam->depth_path[0] == '\0');
+    }
+    return any;
+}
+
+static void free_maps(wx_maps *maps, int count)
+{
+    if (maps != NULL) {
+        for (int c = 0; c < count; ++c) {
+            wx_maps_free(&maps[c]);
+        }
+        free(maps);
+    }
+}
+
+wx_result wx_run_phases(wx_scene *scene, const wx_run_def *opts, unsigned phases,
+                        wx_run_report *report, wx_error *err)
+{
+    double start = wx_now_s();
+    wx_geometry geometry;
+    memset(&geometry, 0, sizeof geometry);
+    wx_maps *maps = NULL;
+    char created[WX_PATH_MAX] = "";
+    wx_result r = WX_OK;
+    bool bake = (phases & WX_PHASE_BAKE) && mark_baked_cameras(scene);
+    if (!(phases & WX_PHASE_BAKE)) {
+        r = wx_use_baked_maps(scene, opts, err);
+    }
+    // Everything that can be refused, before any folder or file is made.
+    if (r == WX_OK && bake && scene->mesh_count > 0) {
+        r = wx_geometry_load(scene, opts->quiet, &geometry, err);
+    }
+    if (r == WX_OK) {
+        r = wx_memory_check(scene, phases, err);
+    }
+    if (r == WX_OK) {
+        r = wx_check_outputs(scene, opts, phases, err);
+    }
+    if (r == WX_OK) {
+        r = wx_output_prepare(scene, opts, created, err);
+    }
+    report->times.load += wx_now_s() - start;
+
+    if (r == WX_OK && (phases & WX_PHASE_BAKE)) {
+        double t0 = wx_now_s();
+        if (bake) {
+            r = wx_bake_geometry(scene, opts, &geometry, NULL, err);
+        } else if (phases == WX_PHASE_BAKE) {
+            wx_note(opts->quiet, "%s: every camera has its maps; nothing to bake", scene->path);
+        }
+        report->times.bake = wx_now_s() - t0;
+    }
+    wx_geometry_free(&geometry);
+    if (r == WX_OK && (phases & WX_PHASE_SIMULATE)) {
+        double t0 = wx_now_s();
+        maps = calloc((size_t)scene->input_count + 1, sizeof *maps);
+        r = maps != NULL ? wx_load_simulation_maps(scene, maps, err)
+                         : wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (maps)");
+        if (r == WX_OK) {
+            r = wx_simulate_maps(scene, opts, maps, &report->stats, err);
+        }
+        const wx_sim_stats *st = &report->stats;
+        if (r == WX_OK && scene->emitter_count > 0 && st->collisions == 0) {
+            wx_warn(opts->quiet,
+                    "%s: no particle hit a surface (%lld emitted, %lld escaped the bounding "
+                    "box, %lld still flying): the dirt maps and the mask hold only the "
+                    "initial dirt; see \"Fitting a scene to a model\" in docs/user-guide.md",
+                    scene->path, (long long)st->particles_emitted, (long long)st->escaped,
+                    (long long)st->alive);
+        }
+        report->times.simulate = wx_now_s() - t0;
+    }
+    if (r == WX_OK && (phases & WX_PHASE_GATHER)) {
+        double t0 = wx_now_s();
+        r = maps != NULL ? wx_gather_maps(scene, opts, maps, err) : wx_gather_scene(scene, opts, err);
+        report->times.gather = wx_now_s() - t0;
+    }
+    free_maps(maps, scene->input_count);
+    if (r != WX_OK) {
+        wx_output_remove_empty(opts->out_dir, created); // a failed run leaves no empty folder
+    }
+    return r;
+}

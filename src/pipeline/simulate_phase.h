@@ -1,0 +1,36 @@
+// simulate_phase.h: the `simulate` phase: every input camera's maps read once,
+// the simulation run on them for the scene's steps, and a dirt map per input
+// camera written into the output folder (<camera>_dirt.exr).
+#ifndef WX_SIMULATE_PHASE_H
+#define WX_SIMULATE_PHASE_H
+
+#include "core/error.h"
+#include "model/maps.h"
+#include "model/scene.h"
+#include "model/stats.h"
+#include "pipeline/pipeline.h"
+#include "sim/simulate.h"
+
+/// Writes <camera>_dirt.exr for every input camera into the output folder: R
+/// the simulated dirt, G deposit and B erosion as in the input dirt map (the
+/// camera's `maps`, those the simulation ran on), initialDirt the dirt it
+/// started from, and that map's header attributes (WTCMatrix, CTWMatrix and
+/// cameraName set from the camera when it has none).
+wx_result wx_write_dirt_maps(const wx_scene *scene, const wx_run_def *opts, const wx_sim *sim,
+                             const wx_maps *maps, wx_error *err);
+
+/// The `simulate` phase on maps already in memory (one per input camera, scene
+/// order, as wx_load_simulation_maps reads them): runs scene->steps steps,
+/// writes opts->out_dir/<camera>_dirt.exr for each input camera, fills
+/// `stats`, and leaves in each maps[c].dirt the simulated dirt as written
+/// (impact, deposit and erosion released): what the gather reads next.
+wx_result wx_simulate_maps(const wx_scene *scene, const wx_run_def *opts, wx_maps *maps,
+                           wx_sim_stats *stats, wx_error *err);
+
+/// The `simulate` phase: loads every input camera's maps from the scene's
+/// paths, runs scene->steps steps (progress bar unless opts->quiet), writes
+/// opts->out_dir/<camera>_dirt.exr for each input camera and fills `stats`.
+wx_result wx_simulate_scene(const wx_scene *scene, const wx_run_def *opts,
+                            wx_sim_stats *stats, wx_error *err);
+
+#endif

@@ -1,0 +1,997 @@
+// bake.c: meshes and orthographic cameras to depth, normal, impact and dirt
+// EXR maps, rendered offscreen with OSMesa (thesis 4.9.2, DESIGN sections 1-3).
+//
+// One GL 4.5 core context renders into a float framebuffer with three colour
+// targets in one pass (shaders/bake_*.glsl). Each mesh is imported, mapped onto
+// the scene's <Surface>s, uploaded once (its CPU arrays freed on the way) and
+// drawn for every camera. The projection is the camera's WTCMatrix itself: clip
+// x, y = 2u-1, 2v-1, and clip z maps d over the depth range of the geometry,
+// clipped at the eye plane (d = 0). The stored d is computed per fragment from
+// the interpolated position, not from the depth buffer. glReadPixels returns
+// rows bottom-up; read_target() flips them, the only place that does. Initial
+// dirt is given to the input camera that sees each patch most head-on
+// (compute_initial_dirt). The EXR files of one camera are written by worker
+// threads while the next camera renders. docs/cameras.md describes the choices.
+#define GL_GLEXT_PROTOTYPES 1
+#include <GL/osmesa.h>
+#include <GL/gl.h>
+#include <GL/glext.h>
+
+#include "raster/bake.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "model/maps.h"
+#include "model/geometry.h"
+#include "model/mesh.h"
+#include "core/progress.h"
+#include "shaders.h"
+
+enum {
+    TARGET_DEPTH_NORMAL, // RGBA32F: d, normal
+    TARGET_IMPACT_DIRT,  // RGBA32F: absorption, bounce, deposit, erosion
+    TARGET_DENSITY,      // R32F: initial dirt per square metre
+    TARGET_COUNT,
+};
+
+/// Smallest |N.view| used when dividing by it (a surface seen edge-on).
+#define MIN_COSINE 1e-3f
+/// Cameras whose |N.view| differ by less than this are tied (first listed wins).
+#define TIE_COSINE 1e-4f
+
+typedef struct gpu_mesh {
+    GLuint vao;
+    GLuint positions, normals, colors, materials, indices; // vertex and index buffers
+    GLuint material_props; // behind props_texture
+    GLuint props_texture;
+    GLsizei index_count;
+    double origin[3];
+} gpu_mesh;
+
+// What the bake knows of one scene camera.
+typedef struct cam_state {
+    bool bake;         // rendered here
+    double d_min;      // depth range of all vertices
+    double d_max;
+    float *depth;      // depth plane kept for the initial-dirt visibility test, or NULL
+    int depth_width;
+    int depth_height;
+} cam_state;
+
+// The images of the camera being baked (reused while the size stays).
+typedef struct map_set {
+    int count; // 4 for an input camera, 2 (depth, normal) for the output camera
+    wx_image maps[4];
+} map_set;
+
+typedef struct baker {
+    const wx_scene *scene;
+    const wx_bake_def *def;
+    wx_bake_stats *stats;
+    OSMesaContext context;
+    bool current;    // the context is current: GL objects may be deleted
+    unsigned char context_buffer[16 * 16 * 4];
+    GLuint program;
+    GLint loc_wtc, loc_depth_range, loc_depth_row, loc_view_dir;
+    GLuint fbo;
+    GLuint renderbuffers[TARGET_COUNT + 1]; // colour targets, then depth
+    int fb_width, fb_height;
+    GLint max_side;
+    GLint max_texture_buffer;
+    gpu_mesh *meshes;
+    int mesh_count;
+    cam_state *cams; // one per scene camera
+    bool has_dirt;   // some surface starts with dirt
+    float *strip;    // readback buffer
+    size_t strip_floats;
+    map_set set;
+} baker;
+
+// ---------------------------------------------------------------------------
+// Messages.
+
+#define warn(b, ...) wx_warn((b)->def->quiet, __VA_ARGS__)
+
+static wx_result gl_check(const char *what, wx_error *err)
+{
+    GLenum e = glGetError();
+    if (e == GL_NO_ERROR) {
+        return WX_OK;
+    }
+    while (glGetError() != GL_NO_ERROR) {
+    }
+    const char *name = e == GL_OUT_OF_MEMORY          ? "out of memory"
+                       : e == GL_INVALID_VALUE         ? "invalid value"
+                       : e == GL_INVALID_OPERATION     ? "invalid operation"
+                       : e == GL_INVALID_ENUM          ? "invalid enum"
+                       : e == GL_INVALID_FRAMEBUFFER_OPERATION ? "invalid framebuffer operation"
+                                                               : "error";
+    return wx_fail(err, WX_CAUSE_RENDERER, "bake: OpenGL %s (0x%04x) while %s", name, (unsigned)e,
+                        what);
+}
+
+// ---------------------------------------------------------------------------
+// GL context, program, framebuffer.
+
+static wx_result compile_shader(GLenum kind, const char *source, const char *name, GLuint *out,
+                                wx_error *err)
+{
+    GLuint shader = glCreateShader(kind);
+    glShaderSource(shader, 1, &source, NULL);
+    glCompileShader(shader);
+    GLint ok = GL_FALSE;
+    glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
+    if (ok != GL_TRUE) {
+        char log[768] = "";
+        glGetShaderInfoLog(shader, sizeof log, NULL, log);
+        glDeleteShader(shader);
+        return wx_fail(err, WX_CAUSE_RENDERER, "bake: shader %s does not compile: %s", name, log);
+    }
+    *out = shader;
+    return WX_OK;
+}
+
+static wx_result create_program(baker *b, wx_error *err)
+{
+    GLuint vs = 0, fs = 0;
+    wx_result r = compile_shader(GL_VERTEX_SHADER, wx_shader_bake_vert, "bake_vert.glsl", &vs, err);
+    if (r == WX_OK) {
+        r = compile_shader(GL_FRAGMENT_SHADER, wx_shader_bake_frag, "bake_frag.glsl", &fs, err);
+    }
+    if (r != WX_OK) {
+        glDeleteShader(vs);
+        return r;
+    }
+    b->program = glCreateProgram();
+    glAttachShader(b->program, vs);
+    glAttachShader(b->program, fs);
+    glLinkProgram(b->program);
+    glDeleteShader(vs);
+    glDeleteShader(fs);
+    GLint ok = GL_FALSE;
+    glGetProgramiv(b->program, GL_LINK_STATUS, &ok);
+    if (ok != GL_TRUE) {
+        char log[768] = "";
+        glGetProgramInfoLog(b->program, sizeof log, NULL, log);
+        return wx_fail(err, WX_CAUSE_RENDERER, "bake: shaders do not link: %s", log);
+    }
+    b->loc_wtc = glGetUniformLocation(b->program, "u_wtc");
+    b->loc_depth_range = glGetUniformLocation(b->program, "u_depth_range");
+    b->loc_depth_row = glGetUniformLocation(b->program, "u_depth_row");
+    b->loc_view_dir = glGetUniformLocation(b->program, "u_view_dir");
+    glUseProgram(b->program);
+    glUniform1i(glGetUniformLocation(b->program, "u_material_props"), 0);
+    return gl_check("setting up the bake shaders", err);
+}
+
+static wx_result create_context(baker *b, wx_error *err)
+{
+    // llvmpipe takes its thread count from the environment when it starts.
+    if (b->def->threads > 0 && getenv("LP_NUM_THREADS") == NULL) {
+        char n[16];
+        snprintf(n, sizeof n, "%d", b->def->threads);
+        setenv("LP_NUM_THREADS", n, 0);
+    }
+    const int attribs[] = { OSMESA_FORMAT,
+                            OSMESA_RGBA,
+                            OSMESA_DEPTH_BITS,
+                            0,
+                            OSMESA_STENCIL_BITS,
+                            0,
+                            OSMESA_ACCUM_BITS,
+                            0,
+                            OSMESA_PROFILE,
+                            OSMESA_CORE_PROFILE,
+                            OSMESA_CONTEXT_MAJOR_VERSION,
+                            4,
+                            OSMESA_CONTEXT_MINOR_VERSION,
+                            5,
+                            0 };
+    b->context = OSMesaCreateContextAttribs(attribs, NULL);
+    if (b->context == NULL) {
+        return wx_fail(err, WX_CAUSE_RENDERER, "bake: cannot create an OSMesa OpenGL 4.5 core context (is Mesa's "
+                            "llvmpipe available? try GALLIUM_DRIVER=llvmpipe)");
+    }
+    if (!OSMesaMakeCurrent(b->context, b->context_buffer, GL_UNSIGNED_BYTE, 16, 16)) {
+        return wx_fail(err, WX_CAUSE_RENDERER, "bake: cannot make the OSMesa context current");
+    }
+    b->current = true;
+    GLint rb = 0, tex = 0, vp[2] = { 0, 0 };
+    glGetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &rb);
+    glGetIntegerv(GL_MAX_TEXTURE_SIZE, &tex);
+    glGetIntegerv(GL_MAX_VIEWPORT_DIMS, vp);
+    glGetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &b->max_texture_buffer);
+    GLint side = rb;
+    side = tex < side ? tex : side;
+    side = vp[0] < side ? vp[0] : side;
+    side = vp[1] < side ? vp[1] : side;
+    b->max_side = side < WX_MAP_MAX_SIDE ? side : WX_MAP_MAX_SIDE;
+    GLint draw_buffers = 0;
+    glGetIntegerv(GL_MAX_DRAW_BUFFERS, &draw_buffers);
+    if (draw_buffers < TARGET_COUNT) {
+        return wx_fail(err, WX_CAUSE_RENDERER, "bake: the GL driver has %d draw buffers, %d needed",
+                            (int)draw_buffers, TARGET_COUNT);
+    }
+    wx_result r = create_program(b, err);
+    if (r != WX_OK) {
+        return r;
+    }
+    glGenFramebuffers(1, &b->fbo);
+    glGenRenderbuffers(TARGET_COUNT + 1, b->renderbuffers);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glDisable(GL_CULL_FACE);
+    glDisable(GL_BLEND);
+    glDisable(GL_DITHER);
+    glVertexAttrib4f(2, 0.0f, 0.0f, 0.0f, 1.0f); // colour of meshes without colours
+    glPixelStorei(GL_PACK_ALIGNMENT, 4);
+    return gl_check("creating the GL context", err);
+}
+
+static wx_result ensure_framebuffer(baker *b, int width, int height, wx_error *err)
+{
+    if (b->fb_width == width && b->fb_height == height) {
+        return WX_OK;
+    }
+    static const GLenum formats[TARGET_COUNT + 1] = { GL_RGBA32F, GL_RGBA32F, GL_R32F,
+                                                      GL_DEPTH_COMPONENT32F };
+    glBindFramebuffer(GL_FRAMEBUFFER, b->fbo);
+    for (int t = 0; t <= TARGET_COUNT; ++t) {
+        glBindRenderbuffer(GL_RENDERBUFFER, b->renderbuffers[t]);
+        glRenderbufferStorage(GL_RENDERBUFFER, formats[t], width, height);
+        GLenum attachment = t < TARGET_COUNT ? (GLenum)(GL_COLOR_ATTACHMENT0 + t)
+                                             : GL_DEPTH_ATTACHMENT;
+        glFramebufferRenderbuffer(GL_FRAMEBUFFER, attachment, GL_RENDERBUFFER,
+                                  b->renderbuffers[t]);
+    }
+    wx_result r = gl_check("allocating the float framebuffer", err);
+    if (r != WX_OK) {
+        wx_error_prefix(err, "%d x %d maps", width, height);
+        b->fb_width = b->fb_height = 0;
+        return r;
+    }
+    GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+    if (status != GL_FRAMEBUFFER_COMPLETE) {
+        // llvmpipe reports a storage it could not allocate as an incomplete
+        // attachment, not as GL_OUT_OF_MEMORY: every format here is renderable.
+        b->fb_width = b->fb_height = 0;
+        double mib = (double)width * (double)height * 40.0 / (1024.0 * 1024.0);
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "bake: out of memory for the %d x %d float framebuffer (about %.0f "
+                            "MiB; OpenGL status 0x%04x)",
+                            width, height, mib, (unsigned)status);
+    }
+    b->fb_width = width;
+    b->fb_height = height;
+    return WX_OK;
+}
+
+// ---------------------------------------------------------------------------
+// Meshes.
+
+static void delete_gpu_mesh(gpu_mesh *m)
+{
+    GLuint buffers[6] = { m->positions, m->normals, m->colors,
+                          m->materials, m->indices, m->material_props };
+    glDeleteBuffers(6, buffers);
+    glDeleteTextures(1, &m->props_texture);
+    glDeleteVertexArrays(1, &m->vao);
+    memset(m, 0, sizeof *m);
+}
+
+static GLuint upload_buffer(GLenum target, size_t bytes, const void *data)
+{
+    GLuint buffer = 0;
+    glGenBuffers(1, &buffer);
+    glBindBuffer(target, buffer);
+    glBufferData(target, (GLsizeiptr)bytes, data, GL_STATIC_DRAW);
+    return buffer;
+}
+
+// Moves one CPU array into a new GL buffer: the copy is freed as soon as GL
+// holds its own, so that a mesh exists about once in memory.
+static GLuint upload_and_free(GLenum target, size_t bytes, void *data)
+{
+    GLuint buffer = upload_buffer(target, bytes, data);
+    free(data);
+    return buffer;
+}
+
+// Uploads the mesh (freeing its arrays on the way) and its per-material
+// properties (2 RGBA texels per material). The per-triangle material becomes a
+// per-vertex attribute: every vertex belongs to triangles of one material
+// (mesh.h).
+static wx_result upload_mesh(baker *b, wx_mesh_data *mesh, const float *props, gpu_mesh *g,
+                             wx_error *err)
+{
+    size_t nv = (size_t)mesh->vertex_count, nt = (size_t)mesh->triangle_count;
+    if (nt * 3 > (size_t)INT32_MAX) {
+        return wx_fail(err, WX_CAUSE_BAD_MESH, "%lld triangles are more than one draw takes (%d); split the mesh",
+                            (long long)nt, INT32_MAX / 3);
+    }
+    if ((size_t)mesh->material_count * 2 > (size_t)b->max_texture_buffer) {
+        return wx_fail(err, WX_CAUSE_BAD_MESH, "%d materials are more than the renderer takes",
+                            mesh->material_count);
+    }
+    uint16_t *vertex_material = malloc((nv > 0 ? nv : 1) * sizeof *vertex_material);
+    if (vertex_material == NULL) {
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "bake: out of memory");
+    }
+    for (size_t t = 0; t < nt; ++t) {
+        for (int k = 0; k < 3; ++k) {
+            vertex_material[mesh->indices[3 * t + (size_t)k]] = mesh->materials[t];
+        }
+    }
+    free(mesh->materials);
+    mesh->materials = NULL;
+    memcpy(g->origin, mesh->origin, sizeof g->origin);
+    glGenVertexArrays(1, &g->vao);
+    glBindVertexArray(g->vao);
+    g->positions = upload_and_free(GL_ARRAY_BUFFER, nv * 3 * sizeof(float), mesh->positions);
+    mesh->positions = NULL;
+    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 0, NULL);
+    glEnableVertexAttribArray(0);
+    g->normals = upload_and_free(GL_ARRAY_BUFFER, nv * 3 * sizeof(float), mesh->normals);
+    mesh->normals = NULL;
+    glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, 0, NULL);
+    glEnableVertexAttribArray(1);
+    if (mesh->colors != NULL) {
+        g->colors = upload_and_free(GL_ARRAY_BUFFER, nv * 4 * sizeof(float), mesh->colors);
+        mesh->colors = NULL;
+        glVertexAttribPointer(2, 4, GL_FLOAT, GL_FALSE, 0, NULL);
+        glEnableVertexAttribArray(2);
+    }
+    g->materials = upload_and_free(GL_ARRAY_BUFFER, nv * sizeof(uint16_t), vertex_material);
+    glVertexAttribIPointer(3, 1, GL_UNSIGNED_SHORT, 0, NULL);
+    glEnableVertexAttribArray(3);
+    g->indices = upload_and_free(GL_ELEMENT_ARRAY_BUFFER, nt * 3 * sizeof(uint32_t),
+                                 mesh->indices);
+    mesh->indices = NULL;
+    g->index_count = (GLsizei)(nt * 3);
+    glBindVertexArray(0);
+
+    g->material_props = upload_buffer(GL_TEXTURE_BUFFER,
+                                      (size_t)mesh->material_count * 8 * sizeof(float), props);
+    glGenTextures(1, &g->props_texture);
+    glBindTexture(GL_TEXTURE_BUFFER, g->props_texture);
+    glTexBuffer(GL_TEXTURE_BUFFER, GL_RGBA32F, g->material_props);
+    glBindTexture(GL_TEXTURE_BUFFER, 0);
+    glBindBuffer(GL_TEXTURE_BUFFER, 0);
+    glBindBuffer(GL_ARRAY_BUFFER, 0);
+    return gl_check("uploading the mesh", err);
+}
+
+// The camera's WTCMatrix with the mesh origin folded into its translation row,
+// so that [p - origin, 1] * m = [p, 1] * wtc (computed in double).
+static void local_matrix(const float wtc[16], const double origin[3], float out[16])
+{
+    for (int k = 0; k < 16; ++k) {
+        out[k] = wtc[k];
+    }
+    for (int col = 0; col < 4; ++col) {
+        double t = wtc[12 + col];
+        for (int j = 0; j < 3; ++j) {
+            t += origin[j] * (double)wtc[4 * j + col];
+        }
+        out[12 + col] = (float)t;
+    }
+}
+
+// Fills 2 RGBA texels per material of a mesh from its matched <Surface>:
+// (absorption, bounce, dirt, deposit), (erosion, colour use, 0, 0).
+static void material_props(const wx_mesh *mesh, const wx_geometry_mesh *g, float *props)
+{
+    for (int m = 0; m < g->data.material_count; ++m) {
+        const wx_surface *match = &mesh->surfaces[g->surface[m]];
+        float *p = &props[8 * m];
+        p[0] = match->absorption;
+        p[1] = match->bounce;
+        p[2] = match->dirt;
+        p[3] = match->deposit;
+        p[4] = match->erosion;
+        p[5] = (float)match->colors; // 0 none, 1 impact, 2 dirt (bake_frag.glsl)
+        p[6] = p[7] = 0.0f;
+    }
+}
+
+// Projects every vertex into every camera to bake: depth range, and warnings for
+// vertices outside the frame or behind the eye.
+static void survey_vertices(baker *b, const wx_mesh *mesh, const wx_mesh_data *data)
+{
+    const wx_scene *scene = b->scene;
+    for (int c = 0; c < scene->camera_count; ++c) {
+        cam_state *cs = &b->cams[c];
+        if (!cs->bake) {
+            continue;
+        }
+        const wx_scene_camera *sc = &scene->cameras[c];
+        double m[16];
+        for (int k = 0; k < 16; ++k) {
+            m[k] = sc->camera.wtc[k];
+        }
+        for (int col = 0; col < 3; ++col) {
+            for (int j = 0; j < 3; ++j) {
+                m[12 + col] += data->origin[j] * m[4 * j + col];
+            }
+        }
+        int64_t outside = 0, behind = 0;
+        double d_min = cs->d_min, d_max = cs->d_max;
+        const float *p = data->positions;
+        for (int64_t v = 0; v < data->vertex_count; ++v, p += 3) {
+            double u = p[0] * m[0] + p[1] * m[4] + p[2] * m[8] + m[12];
+            double w = p[0] * m[1] + p[1] * m[5] + p[2] * m[9] + m[13];
+            double d = p[0] * m[2] + p[1] * m[6] + p[2] * m[10] + m[14];
+            outside += u < 0.0 || u > 1.0 || w < 0.0 || w > 1.0;
+            behind += d < 0.0;
+            d_min = d < d_min ? d : d_min;
+            d_max = d > d_max ? d : d_max;
+        }
+        cs->d_min = d_min;
+        cs->d_max = d_max;
+        if (outside > 0) {
+            warn(b, "%s: camera '%s': %lld of %lld vertices of mesh '%s' fall outside its frame",
+                 scene->path, sc->name, (long long)outside, (long long)data->vertex_count,
+                 wx_mesh_display_name(scene, mesh));
+        }
+        if (behind > 0) {
+            warn(b,
+                 "%s: camera '%s': %lld of %lld vertices of mesh '%s' lie behind its eye (d < 0) "
+                 "and are not seen",
+                 scene->path, sc->name, (long long)behind, (long long)data->vertex_count,
+                 wx_mesh_display_name(scene, mesh));
+        }
+    }
+}
+
+// Uploads every mesh of the geometry (its arrays are released on the way).
+static wx_result load_meshes(baker *b, wx_geometry *geometry, wx_error *err)
+{
+    const wx_scene *scene = b->scene;
+    b->meshes = calloc(scene->mesh_count > 0 ? (size_t)scene->mesh_count : 1, sizeof *b->meshes);
+    if (b->meshes == NULL) {
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "bake: out of memory");
+    }
+    b->stats->import_s += geometry->import_s;
+    for (int i = 0; i < geometry->count; ++i) {
+        const wx_mesh *mesh = &scene->meshes[i];
+        wx_geometry_mesh *g = &geometry->meshes[i];
+        wx_mesh_data *data = &g->data;
+        if (data->triangle_count == 0) {
+            continue;
+        }
+        double t1 = wx_now_s();
+        float *props = malloc((size_t)data->material_count * 8 * sizeof(float));
+        wx_result r = WX_OK;
+        if (props == NULL) {
+            r = wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "bake: out of memory");
+        } else {
+            material_props(mesh, g, props);
+            survey_vertices(b, mesh, data);
+            r = upload_mesh(b, data, props, &b->meshes[b->mesh_count], err);
+            b->mesh_count++; // counted even when incomplete, so that it is deleted
+            if (r != WX_OK) {
+                wx_error_prefix(err, "%s:%d: mesh '%s'", scene->path, mesh->line,
+                                wx_mesh_display_name(scene, mesh));
+            }
+        }
+        b->stats->triangles += data->triangle_count;
+        b->stats->vertices += data->vertex_count;
+        free(props);
+        wx_mesh_data_release_arrays(data);
+        b->stats->setup_s += wx_now_s() - t1;
+        if (r != WX_OK) {
+            return r;
+        }
+    }
+    if (b->stats->triangles == 0) {
+        return wx_fail(err, WX_CAUSE_BAD_MESH, "%s: the meshes of <Geometry> hold no triangles to bake the cameras "
+                            "given by <View> from",
+                            scene->path);
+    }
+    b->has_dirt = geometry->has_dirt;
+    return WX_OK;
+}
+
+// ---------------------------------------------------------------------------
+// Rendering and readback.
+
+static wx_result draw_camera(baker *b, int c, int targets, wx_error *err)
+{
+    const wx_scene_camera *sc = &b->scene->cameras[c];
+    const cam_state *cs = &b->cams[c];
+    int width = sc->camera.width, height = sc->camera.height;
+    wx_result r = ensure_framebuffer(b, width, height, err);
+    if (r != WX_OK) {
+        return r;
+    }
+    // Depth range: every vertex, with a margin, clipped at the eye plane.
+    double d_min = cs->d_min, d_max = cs->d_max;
+    double margin = 1e-3 * (d_max - d_min) + 1e-5 * (fabs(d_min) + fabs(d_max)) + 1e-6;
+    double near = d_min - margin > 0.0 ? d_min - margin : 0.0;
+    double far = d_max + margin;
+    if (!(far > near + 1e-6 * (fabs(near) + 1.0))) {
+        far = near + 1.0; // nothing in front of the eye
+    }
+
+    glBindFramebuffer(GL_FRAMEBUFFER, b->fbo);
+    static const GLenum all[TARGET_COUNT] = { GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1,
+                                              GL_COLOR_ATTACHMENT2 };
+    glDrawBuffers(TARGET_COUNT, all);
+    glViewport(0, 0, width, height);
+    const float background[4] = { INFINITY, 0.0f, 0.0f, 0.0f };
+    const float zero[4] = { 0.0f, 0.0f, 0.0f, 0.0f };
+    glClearBufferfv(GL_COLOR, 0, background);
+    glClearBufferfv(GL_COLOR, 1, zero);
+    glClearBufferfv(GL_COLOR, 2, zero);
+    const float far_depth = 1.0f;
+    glClearBufferfv(GL_DEPTH, 0, &far_depth);
+    glDrawBuffers(targets, all);
+
+    glUseProgram(b->program);
+    float view[3];
+    wx_camera_view_dir(&sc->camera, view);
+    glUniform3f(b->loc_view_dir, view[0], view[1], view[2]);
+    glUniform2f(b->loc_depth_range, (float)near, (float)far);
+    for (int i = 0; i < b->mesh_count; ++i) {
+        const gpu_mesh *g = &b->meshes[i];
+        float m[16];
+        local_matrix(sc->camera.wtc, g->origin, m);
+        glUniformMatrix4fv(b->loc_wtc, 1, GL_FALSE, m);
+        glUniform4f(b->loc_depth_row, m[2], m[6], m[10], m[14]);
+        glActiveTexture(GL_TEXTURE0);
+        glBindTexture(GL_TEXTURE_BUFFER, g->props_texture);
+        glBindVertexArray(g->vao);
+        glDrawElements(GL_TRIANGLES, g->index_count, GL_UNSIGNED_INT, NULL);
+    }
+    glBindVertexArray(0);
+    return gl_check("drawing", err);
+}
+
+// Destination of one channel of a colour target: a plane in EXR row order.
+typedef struct plane_out {
+    float *plane; // NULL: channel not wanted
+} plane_out;
+
+// Reads colour target `target` (`channels` floats per texel) in strips and
+// scatters its channels into planes, flipping rows: GL row y is EXR row H-1-y.
+static wx_result read_target(baker *b, int target, int channels, const plane_out *out,
+                             wx_error *err)
+{
+    int width = b->fb_width, height = b->fb_height;
+    size_t row_floats = (size_t)width * (size_t)channels;
+    int rows = (int)((size_t)(1 << 20) / row_floats);
+    rows = rows < 1 ? 1 : rows > height ? height : rows;
+    size_t need = row_floats * (size_t)rows;
+    if (b->strip_floats < need) {
+        free(b->strip);
+        b->strip = malloc(need * sizeof(float));
+        b->strip_floats = b->strip != NULL ? need : 0;
+        if (b->strip == NULL) {
+            return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "bake: out of memory for the readback");
+        }
+    }
+    glReadBuffer((GLenum)(GL_COLOR_ATTACHMENT0 + target));
+    GLenum format = channels == 4 ? GL_RGBA : GL_RED;
+    for (int y0 = 0; y0 < height; y0 += rows) {
+        int n = height - y0 < rows ? height - y0 : rows;
+        glReadPixels(0, y0, width, n, format, GL_FLOAT, b->strip);
+        for (int k = 0; k < n; ++k) {
+            const float *src = b->strip + (size_t)k * row_floats;
+            size_t row = (size_t)(height - 1 - (y0 + k)) * (size_t)width;
+            for (int c = 0; c < channels; ++c) {
+                float *dst = out[c].plane;
+                if (dst == NULL) {
+                    continue;
+                }
+                dst += row;
+                for (int i = 0; i < width; ++i) {
+                    dst[i] = src[(size_t)i * (size_t)channels + (size_t)c];
+                }
+            }
+        }
+    }
+    return gl_check("reading the maps back", err);
+}
+
+// ---------------------------------------------------------------------------
+// Initial dirt (DESIGN section 3): stored once, in the input camera that sees the
+// patch most head-on.
+
+// The depth map of an input camera that the scene gives as files (read by the
+// caller), for the visibility test: copied, "no surface" as +inf.
+static wx_result take_given_depth(baker *b, int c, wx_error *err)
+{
+    const wx_maps *given = b->def->given_depth != NULL ? &b->def->given_depth[c] : NULL;
+    if (given == NULL || given->depth == NULL) {
+        return wx_fail(err, WX_CAUSE_BAD_ARGUMENT, "bake: no depth map given for camera '%s'",
+                       b->scene->cameras[c].name);
+    }
+    cam_state *cs = &b->cams[c];
+    size_t n = (size_t)given->width * (size_t)given->height;
+    cs->depth = malloc((n > 0 ? n : 1) * sizeof *cs->depth);
+    if (cs->depth == NULL) {
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "bake: out of memory");
+    }
+    cs->depth_width = given->width;
+    cs->depth_height = given->height;
+    for (size_t k = 0; k < n; ++k) {
+        cs->depth[k] = wx_depth_is_empty(given->depth[k]) ? INFINITY : given->depth[k];
+    }
+    return WX_OK;
+}
+
+typedef struct other_view {
+    int index;         // scene camera index (its order in the file)
+    const wx_camera *cam;
+    const float *depth;
+    int width, height;
+    float view[3];
+    float texel_ws;    // larger side of one texel, world units
+} other_view;
+
+static void map_to_world(const float ctw[16], double u, double v, double d, double p[3])
+{
+    for (int k = 0; k < 3; ++k) {
+        p[k] = u * ctw[k] + v * ctw[4 + k] + d * ctw[8 + k] + ctw[12 + k];
+    }
+}
+
+// True when camera k sees world point p (on a surface with unit normal n) and
+// sees it more head-on than camera c (|n.view_c| = cos_c), ties going to the
+// camera listed first. Visibility: p projects into k's frame onto a texel whose
+// depth agrees with p's within 1.5 texels' worth of the surface's depth slope
+// in k (plus 0.1 texel and float rounding).
+static bool other_owns(const other_view *k, int c, const double p[3], const float n[3],
+                       float cos_c)
+{
+    float cos_k = fabsf(n[0] * k->view[0] + n[1] * k->view[1] + n[2] * k->view[2]);
+    bool better = cos_k > cos_c + TIE_COSINE || (cos_k >= cos_c - TIE_COSINE && k->index < c);
+    if (!better) {
+        return false;
+    }
+    const float *m = k->cam->wtc;
+    double uvd[3];
+    for (int col = 0; col < 3; ++col) {
+        uvd[col] = p[0] * m[col] + p[1] * m[4 + col] + p[2] * m[8 + col] + m[12 + col];
+    }
+    int i, j;
+    if (!wx_map_texel(k->width, k->height, (float)uvd[0], (float)uvd[1], &i, &j)) {
+        return false;
+    }
+    float stored = k->depth[(size_t)j * (size_t)k->width + (size_t)i];
+    if (!isfinite(stored)) {
+        return false;
+    }
+    float ck = cos_k > MIN_COSINE ? cos_k : MIN_COSINE;
+    float slope = sqrtf(fmaxf(0.0f, 1.0f - ck * ck)) / ck;
+    double tol = k->texel_ws * (1.5 * fmin(slope, 1e3) + 0.1) +
+                 4e-6 * (fabs(uvd[2]) + fabs(stored));
+    return fabs(uvd[2] - stored) <= tol;
+}
+
+// Turns the density plane of camera c into dirt amounts: density x texel area /
+// |N.view| where c owns the patch, 0 elsewhere.
+static wx_result compute_initial_dirt(baker *b, int c, const float *depth,
+                                      const wx_image *normal, float *dirt, wx_error *err)
+{
+    const wx_scene *scene = b->scene;
+    const wx_scene_camera *sc = &scene->cameras[c];
+    int width = sc->camera.width, height = sc->camera.height;
+    float view[3], frame_w, frame_h;
+    wx_camera_view_dir(&sc->camera, view);
+    wx_camera_frame_size(&sc->camera, &frame_w, &frame_h);
+    float texel_area = (frame_w / (float)width) * (frame_h / (float)height);
+
+    other_view *others = malloc((size_t)scene->camera_count * sizeof *others);
+    if (others == NULL) {
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "bake: out of memory");
+    }
+    int other_count = 0;
+    for (int k = 0; k < scene->camera_count; ++k) {
+        const cam_state *ks = &b->cams[k];
+        if (k == c || scene->cameras[k].is_output || ks->depth == NULL) {
+            continue;
+        }
+        other_view *o = &others[other_count++];
+        o->index = k;
+        o->cam = &scene->cameras[k].camera;
+        o->depth = ks->depth;
+        o->width = ks->depth_width;
+        o->height = ks->depth_height;
+        wx_camera_view_dir(o->cam, o->view);
+        float fw, fh;
+        wx_camera_frame_size(o->cam, &fw, &fh);
+        o->texel_ws = fmaxf(fw / (float)o->width, fh / (float)o->height);
+    }
+
+    for (int j = 0; j < height; ++j) {
+        for (int i = 0; i < width; ++i) {
+            size_t t = (size_t)j * (size_t)width + (size_t)i;
+            float density = dirt[t];
+            float d = depth[t];
+            if (density == 0.0f || !isfinite(d)) {
+                dirt[t] = 0.0f;
+                continue;
+            }
+            float n[3] = { normal->channels[0][t], normal->channels[1][t],
+                           normal->channels[2][t] };
+            float cos_c = fabsf(n[0] * view[0] + n[1] * view[1] + n[2] * view[2]);
+            bool owner = true;
+            if (other_count > 0) {
+                float u, v;
+                wx_map_texel_center(width, height, i, j, &u, &v);
+                double p[3];
+                map_to_world(sc->camera.ctw, u, v, d, p);
+                for (int k = 0; k < other_count && owner; ++k) {
+                    owner = !other_owns(&others[k], c, p, n, cos_c);
+                }
+            }
+            dirt[t] = owner ? density * texel_area / fmaxf(cos_c, MIN_COSINE) : 0.0f;
+        }
+    }
+    free(others);
+    return WX_OK;
+}
+
+// ---------------------------------------------------------------------------
+// The images handed to the caller.
+
+// Makes the set's images W x H: depth (R), normal, impact, dirt (R, G, B).
+static wx_result size_set(map_set *set, int width, int height, int count, wx_error *err)
+{
+    static const char *const rgb[3] = { "R", "G", "B" };
+    set->count = count;
+    for (int k = 0; k < count; ++k) {
+        wx_image *img = &set->maps[k];
+        if (img->width == width && img->height == height) {
+            continue; // every plane read back is overwritten; impact B stays 0
+        }
+        wx_image_free(img);
+        wx_result r = wx_image_alloc(img, width, height, k == 0 ? 1 : 3, rgb, err);
+        if (r != WX_OK) {
+            return r;
+        }
+    }
+    return WX_OK;
+}
+
+// ---------------------------------------------------------------------------
+// One camera.
+
+// Renders camera c and keeps only its depth plane (for the visibility test).
+static wx_result render_depth_only(baker *b, int c, wx_error *err)
+{
+    const wx_scene_camera *sc = &b->scene->cameras[c];
+    cam_state *cs = &b->cams[c];
+    size_t n = (size_t)sc->camera.width * (size_t)sc->camera.height;
+    cs->depth = malloc(n * sizeof(float));
+    if (cs->depth == NULL) {
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "bake: out of memory");
+    }
+    cs->depth_width = sc->camera.width;
+    cs->depth_height = sc->camera.height;
+    double t0 = wx_now_s();
+    wx_result r = draw_camera(b, c, 1, err);
+    if (r == WX_OK) {
+        plane_out out[4] = { { cs->depth }, { NULL }, { NULL }, { NULL } };
+        r = read_target(b, TARGET_DEPTH_NORMAL, 4, out, err);
+    }
+    b->stats->render_s += wx_now_s() - t0;
+    return r;
+}
+
+static wx_result bake_camera(baker *b, int c, wx_error *err)
+{
+    const wx_scene_camera *sc = &b->scene->cameras[c];
+    bool input = !sc->is_output;
+    char label[sizeof sc->name + 8];
+    snprintf(label, sizeof label, "bake %s", sc->name);
+    wx_progress progress;
+    wx_progress_begin(&progress, label, 4, b->def->quiet);
+
+    map_set *set = &b->set;
+    wx_result r = size_set(set, sc->camera.width, sc->camera.height, input ? 4 : 2, err);
+    wx_image *maps = set->maps;
+    double t0 = wx_now_s();
+    if (r == WX_OK) {
+        r = draw_camera(b, c, input ? TARGET_COUNT : 1, err);
+    }
+    wx_progress_update(&progress, 1);
+    if (r == WX_OK) {
+        plane_out out[4] = { { maps[0].channels[0] },
+                             { maps[1].channels[0] },
+                             { maps[1].channels[1] },
+                             { maps[1].channels[2] } };
+        r = read_target(b, TARGET_DEPTH_NORMAL, 4, out, err);
+    }
+    if (r == WX_OK && input) {
+        plane_out out[4] = { { maps[2].channels[0] },
+                             { maps[2].channels[1] },
+                             { maps[3].channels[1] },
+                             { maps[3].channels[2] } };
+        r = read_target(b, TARGET_IMPACT_DIRT, 4, out, err);
+        if (r == WX_OK) {
+            plane_out density[1] = { { maps[3].channels[0] } };
+            r = read_target(b, TARGET_DENSITY, 1, density, err);
+        }
+    }
+    double t1 = wx_now_s();
+    b->stats->render_s += t1 - t0;
+    wx_progress_update(&progress, 2);
+    if (r == WX_OK && input) {
+        r = compute_initial_dirt(b, c, maps[0].channels[0], &maps[1], maps[3].channels[0], err);
+    }
+    b->stats->dirt_s += wx_now_s() - t1;
+    wx_progress_update(&progress, 3);
+    if (r == WX_OK) {
+        double t2 = wx_now_s();
+        r = b->def->on_maps(c, set->maps, set->count, b->def->user, err);
+        b->stats->write_s += wx_now_s() - t2;
+        b->stats->cameras += r == WX_OK;
+    }
+    wx_progress_end(&progress);
+    return r;
+}
+
+// ---------------------------------------------------------------------------
+// The scene.
+
+static void baker_free(baker *b)
+{
+    for (int f = 0; f < 4; ++f) {
+        wx_image_free(&b->set.maps[f]);
+    }
+    if (b->current) {
+        for (int i = 0; i < b->mesh_count; ++i) {
+            delete_gpu_mesh(&b->meshes[i]);
+        }
+        if (b->fbo != 0) {
+            glDeleteFramebuffers(1, &b->fbo);
+            glDeleteRenderbuffers(TARGET_COUNT + 1, b->renderbuffers);
+        }
+        if (b->program != 0) {
+            glDeleteProgram(b->program);
+        }
+        OSMesaMakeCurrent(NULL, NULL, 0, 0, 0);
+    }
+    if (b->context != NULL) {
+        OSMesaDestroyContext(b->context);
+    }
+    free(b->meshes);
+    if (b->cams != NULL) {
+        for (int c = 0; c < b->scene->camera_count; ++c) {
+            free(b->cams[c].depth);
+        }
+    }
+    free(b->cams);
+    free(b->strip);
+    free(b);
+}
+
+static wx_result check_cameras(baker *b, int *bake_count, wx_error *err)
+{
+    const wx_scene *scene = b->scene;
+    *bake_count = 0;
+    for (int c = 0; c < scene->camera_count; ++c) {
+        const wx_scene_camera *sc = &scene->cameras[c];
+        cam_state *cs = &b->cams[c];
+        cs->bake = sc->has_view && sc->depth_path[0] == '\0';
+        cs->d_min = INFINITY;
+        cs->d_max = -INFINITY;
+        if (!cs->bake) {
+            continue;
+        }
+        ++*bake_count;
+        int w = sc->camera.width, h = sc->camera.height;
+        if (w < 1 || h < 1) {
+            return wx_fail(err, WX_CAUSE_BAD_SCENE, "%s:%d: camera '%s' has no map size",
+                                scene->path, sc->line, sc->name);
+        }
+    }
+    return WX_OK;
+}
+
+static wx_result check_sizes(baker *b, wx_error *err)
+{
+    const wx_scene *scene = b->scene;
+    for (int c = 0; c < scene->camera_count; ++c) {
+        const wx_scene_camera *sc = &scene->cameras[c];
+        if (!b->cams[c].bake) {
+            continue;
+        }
+        if (sc->camera.width > b->max_side || sc->camera.height > b->max_side) {
+            return wx_fail(err, WX_CAUSE_MAP_SIZE, "%s:%d: camera '%s' asks for %d x %d maps; the renderer bakes at "
+                                "most %d x %d",
+                                scene->path, sc->line, sc->name, sc->camera.width,
+                                sc->camera.height, (int)b->max_side, (int)b->max_side);
+        }
+    }
+    return WX_OK;
+}
+
+wx_bake_def wx_default_bake_def(void)
+{
+    wx_bake_def def;
+    memset(&def, 0, sizeof def);
+    def.threads = 1;
+    def.quiet = true;
+    return def;
+}
+
+wx_result wx_bake_render(const wx_bake_def *def, wx_bake_stats *stats, wx_error *err)
+{
+    const wx_scene *scene = def->scene;
+    wx_geometry *geometry = def->geometry;
+    wx_bake_stats local;
+    if (stats == NULL) {
+        stats = &local;
+    }
+    memset(stats, 0, sizeof *stats);
+    double start = wx_now_s();
+    baker *b = calloc(1, sizeof *b); // large (image sets): not on the stack
+    if (b == NULL) {
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "bake: out of memory");
+    }
+    b->scene = scene;
+    b->def = def;
+    b->stats = stats;
+    b->cams = calloc(scene->camera_count > 0 ? (size_t)scene->camera_count : 1, sizeof *b->cams);
+    if (b->cams == NULL) {
+        baker_free(b);
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "bake: out of memory");
+    }
+    int bake_count = 0;
+    wx_result r = check_cameras(b, &bake_count, err);
+    if (r != WX_OK || bake_count == 0) {
+        baker_free(b);
+        return r;
+    }
+    if (scene->mesh_count == 0) {
+        for (int c = 0; c < scene->camera_count; ++c) {
+            if (b->cams[c].bake) {
+                r = wx_fail(err, WX_CAUSE_BAD_SCENE, "%s:%d: camera '%s' is given by <View> without map files, and "
+                                 "the scene has no <Geometry> meshes to bake them from",
+                                 scene->path, scene->cameras[c].line, scene->cameras[c].name);
+                break;
+            }
+        }
+        baker_free(b);
+        return r;
+    }
+    double t0 = wx_now_s();
+    r = create_context(b, err);
+    if (r == WX_OK) {
+        r = check_sizes(b, err);
+    }
+    stats->setup_s += wx_now_s() - t0;
+    if (r == WX_OK) {
+        r = load_meshes(b, geometry, err);
+    }
+
+    // Initial dirt needs every input camera's depth before any dirt map is final.
+    int input_cameras = 0;
+    for (int c = 0; c < scene->camera_count; ++c) {
+        input_cameras += !scene->cameras[c].is_output;
+    }
+    bool visibility = b->has_dirt && input_cameras > 1;
+    double cameras_start = wx_now_s();
+    for (int c = 0; c < scene->camera_count && r == WX_OK && visibility; ++c) {
+        if (scene->cameras[c].is_output) {
+            continue;
+        }
+        r = b->cams[c].bake ? render_depth_only(b, c, err) : take_given_depth(b, c, err);
+    }
+    for (int c = 0; c < scene->camera_count && r == WX_OK; ++c) {
+        if (b->cams[c].bake) {
+            r = bake_camera(b, c, err);
+        }
+    }
+    stats->cameras_s = wx_now_s() - cameras_start;
+    baker_free(b);
+    stats->total_s = wx_now_s() - start;
+    return r;
+}
+

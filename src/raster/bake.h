@@ -1,0 +1,72 @@
+// bake.h: renders the maps of <View> cameras from the scene's meshes, offscreen
+// with OSMesa (GL 4.5 core, llvmpipe), replacing the thesis' Mental Ray passes
+// (thesis 4.9.2). Everything stays in memory: each camera's maps are handed to
+// the caller (pipeline/bake_phase.c writes them), and the depth maps of cameras
+// the scene gives as files come from the caller too.
+//
+// Every camera given by <View> without map files gets a depth map (R = d, +inf
+// where no surface), a normal map (R,G,B = world unit normal facing the
+// camera), and, for input cameras, an impact map (R absorption, G bounce, B 0)
+// and a dirt map (R dirt, G deposit, B erosion). Initial dirt (docs/design.md
+// section 3) is stored once: each texel of the input camera that sees its
+// surface patch most head-on holds density x texel area / |N.view|, the others
+// 0 (docs/cameras.md describes the visibility test).
+#ifndef WX_BAKE_H
+#define WX_BAKE_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "core/error.h"
+#include "model/geometry.h"
+#include "model/image.h"
+#include "model/maps.h"
+#include "model/scene.h"
+
+/// What a bake did and how long it took (wall-clock seconds).
+typedef struct wx_bake_stats {
+    int cameras;            ///< cameras baked
+    int64_t triangles;      ///< triangles drawn per camera (all meshes)
+    int64_t vertices;
+    double import_s;        ///< Assimp import and flattening, all meshes
+    double setup_s;         ///< GL context, shaders, uploads
+    double render_s;        ///< draws and readback, all cameras
+    double dirt_s;          ///< initial dirt ownership (visibility between cameras)
+    double write_s;         ///< in the caller's on_maps (writing the files)
+    double cameras_s;       ///< all cameras: render, dirt and on_maps, wall-clock
+    double total_s;
+} wx_bake_stats;
+
+/// Receives the maps of baked scene camera `camera`: maps[0] depth (R),
+/// maps[1] normal (R G B) and, for an input camera, maps[2] impact (R G B) and
+/// maps[3] dirt (R G B); count 2 or 4. The images are the bake's (valid during
+/// the call; the caller may add header attributes).
+typedef wx_result wx_bake_maps_fn(int camera, wx_image *maps, int count, void *user,
+                                  wx_error *err);
+
+/// What a bake renders, and for whom. Start from wx_default_bake_def().
+typedef struct wx_bake_def {
+    const wx_scene *scene;    ///< cameras with a <View> and no map files are baked
+    wx_geometry *geometry;    ///< meshes matched to surfaces; their arrays are released as uploaded
+    /// Per scene camera, the depth map of a camera whose maps the scene gives
+    /// (the initial-dirt visibility test needs every input camera's depth when
+    /// some surface starts with dirt), or NULL when no such camera is needed.
+    const wx_maps *given_depth;
+    int threads;              ///< llvmpipe's threads (LP_NUM_THREADS unless set)
+    bool quiet;               ///< no progress bar, no warnings
+    wx_bake_maps_fn *on_maps; ///< called once per baked camera, in scene order
+    void *user;
+} wx_bake_def;
+
+/// Defaults: no scene, one thread, quiet.
+wx_bake_def wx_default_bake_def(void);
+
+/// Bakes every camera of def->scene that has a <View> and no map files; does
+/// nothing when there is none. WX_BAD_INPUT (message with file and line) for
+/// cameras to bake and no geometry or no triangles, maps larger than the
+/// renderer allows; WX_FAIL for GL failures or out of memory; or what on_maps
+/// returns. Warnings (geometry outside a frame or behind an eye) go to stderr
+/// unless quiet. `stats` may be NULL.
+wx_result wx_bake_render(const wx_bake_def *def, wx_bake_stats *stats, wx_error *err);
+
+#endif

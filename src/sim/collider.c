@@ -1,0 +1,871 @@
+// collider.c: the projected-maps collider (thesis 4.8.4.1, DESIGN section 4):
+// coarse test, swept test, point rule.
+#include "sim/collider.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/matrix.h"
+#include "sim/force_field.h"
+#include "sim/particles.h"
+
+// --- building ----------------------------------------------------------------
+
+static wx_result setup_matrices(wx_collider_camera *cam, const float wtc[16], int index,
+                                wx_error *err)
+{
+    // [x y z 1] * wtc = [u v d w]; the collider needs w constant (orthographic).
+    double w = wtc[15];
+    if (!wx_matrix_is_orthographic(wtc)) {
+        return wx_fail(err, WX_CAUSE_BAD_CAMERA, "input camera %d: projective (perspective) matrices are not "
+                            "supported by the collider; use orthographic cameras",
+                            index);
+    }
+    double W = cam->width, H = cam->height;
+    for (int r = 0; r < 4; ++r) {
+        double u = wtc[r * 4 + 0] / w, v = wtc[r * 4 + 1] / w, d = wtc[r * 4 + 2] / w;
+        cam->mx[r] = u * W;
+        cam->my[r] = -v * H;
+        cam->md[r] = d;
+    }
+    cam->my[3] += H; // Y = (1 - v) * H
+    for (int r = 0; r < 4; ++r) {
+        cam->fmx[r] = (float)cam->mx[r];
+        cam->fmy[r] = (float)cam->my[r];
+        cam->fmd[r] = (float)cam->md[r];
+    }
+    double a[9], inv[9];
+    for (int r = 0; r < 3; ++r) {
+        a[r * 3 + 0] = wtc[r * 4 + 0] / w;
+        a[r * 3 + 1] = wtc[r * 4 + 1] / w;
+        a[r * 3 + 2] = wtc[r * 4 + 2] / w;
+    }
+    if (!wx_invert3(a, inv)) {
+        return wx_fail(err, WX_CAUSE_BAD_CAMERA, "input camera %d: singular matrix", index);
+    }
+    // Row k of inv is the world displacement per unit of u, v, d.
+    for (int k = 0; k < 3; ++k) {
+        cam->back[k] = (float)-inv[6 + k];
+    }
+    double du = sqrt(inv[0] * inv[0] + inv[1] * inv[1] + inv[2] * inv[2]) / W;
+    double dv = sqrt(inv[3] * inv[3] + inv[4] * inv[4] + inv[5] * inv[5]) / H;
+    cam->texel_ws = (float)fmin(du, dv);
+    return WX_OK;
+}
+
+// The coarse pyramid: block minima per level, then the minimum over the 3x3
+// blocks around each block, lowered by a margin for float rounding.
+static wx_result build_coarse(wx_collider_camera *cam, wx_error *err)
+{
+    int W = cam->width, H = cam->height;
+    int total = 0;
+    for (int l = 0; l < WX_COARSE_LEVELS; ++l) {
+        int shift = WX_COARSE_BLOCK_SHIFT + WX_COARSE_LEVEL_SHIFT * l;
+        cam->level_width[l] = ((W - 1) >> shift) + 1;
+        cam->level_height[l] = ((H - 1) >> shift) + 1;
+        cam->level_offset[l] = total;
+        total += cam->level_width[l] * cam->level_height[l];
+    }
+    cam->levels = WX_COARSE_LEVELS;
+    cam->coarse = malloc((size_t)total * sizeof *cam->coarse);
+    float *blockmin = malloc((size_t)total * sizeof *blockmin);
+    if (cam->coarse == NULL || blockmin == NULL) {
+        free(blockmin);
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (collider pyramid)");
+    }
+    for (int i = 0; i < total; ++i) {
+        blockmin[i] = INFINITY;
+    }
+    // Level 0 from the texels, each further level from the one below.
+    float *level0 = blockmin + cam->level_offset[0];
+    for (int j = 0; j < H; ++j) {
+        const float *row = cam->depth + (size_t)j * (size_t)W;
+        float *out = level0 + (size_t)(j >> WX_COARSE_BLOCK_SHIFT) * (size_t)cam->level_width[0];
+        for (int i = 0; i < W; ++i) {
+            float d = row[i];
+            float *m = &out[i >> WX_COARSE_BLOCK_SHIFT];
+            if (d < *m) {
+                *m = d;
+            }
+        }
+    }
+    for (int l = 1; l < WX_COARSE_LEVELS; ++l) {
+        const float *below = blockmin + cam->level_offset[l - 1];
+        float *here = blockmin + cam->level_offset[l];
+        int bw = cam->level_width[l - 1], bh = cam->level_height[l - 1];
+        for (int by = 0; by < bh; ++by) {
+            for (int bx = 0; bx < bw; ++bx) {
+                float d = below[by * bw + bx];
+                float *m = &here[(by >> WX_COARSE_LEVEL_SHIFT) * cam->level_width[l] +
+                                 (bx >> WX_COARSE_LEVEL_SHIFT)];
+                if (d < *m) {
+                    *m = d;
+                }
+            }
+        }
+    }
+    double margin_base = 1e-4 * cam->texel_ws;
+    for (int l = 0; l < WX_COARSE_LEVELS; ++l) {
+        const float *src = blockmin + cam->level_offset[l];
+        float *dst = cam->coarse + cam->level_offset[l];
+        int bw = cam->level_width[l], bh = cam->level_height[l];
+        for (int by = 0; by < bh; ++by) {
+            for (int bx = 0; bx < bw; ++bx) {
+                float m = INFINITY;
+                for (int y = by - 1; y <= by + 1; ++y) {
+                    for (int x = bx - 1; x <= bx + 1; ++x) {
+                        if (x >= 0 && x < bw && y >= 0 && y < bh && src[y * bw + x] < m) {
+                            m = src[y * bw + x];
+                        }
+                    }
+                }
+                if (isfinite(m)) {
+                    m = (float)(m - margin_base - 1e-6 * fabs(m));
+                }
+                dst[by * bw + bx] = m;
+            }
+        }
+    }
+    free(blockmin);
+    return WX_OK;
+}
+
+wx_result wx_collider_init(wx_collider *collider, const wx_camera *cameras, const wx_maps *maps,
+                           int count, bool nearest, wx_error *err)
+{
+    memset(collider, 0, sizeof *collider);
+    if (count > WX_MAX_INPUT_CAMERAS) {
+        return wx_fail(err, WX_CAUSE_TOO_MANY, "%d input cameras; the collider takes at most %d",
+                            count, WX_MAX_INPUT_CAMERAS);
+    }
+    collider->nearest = nearest;
+    collider->cameras = calloc(count > 0 ? (size_t)count : 1, sizeof *collider->cameras);
+    if (collider->cameras == NULL) {
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (collider)");
+    }
+    collider->camera_count = count;
+    for (int c = 0; c < count; ++c) {
+        wx_collider_camera *cam = &collider->cameras[c];
+        const wx_maps *m = &maps[c];
+        if (m->depth == NULL || m->normal == NULL || m->impact == NULL || m->width < 1 ||
+            m->height < 1) {
+            wx_collider_free(collider);
+            return wx_fail(err, WX_CAUSE_BAD_ARGUMENT, "input camera %d: the collider needs depth, normal and impact "
+                                "maps",
+                                c);
+        }
+        if ((cameras[c].width != 0 && cameras[c].width != m->width) ||
+            (cameras[c].height != 0 && cameras[c].height != m->height)) {
+            wx_collider_free(collider);
+            return wx_fail(err, WX_CAUSE_MAP_SIZE, "input camera %d: maps are %d x %d, the camera is %d x %d", c,
+                                m->width, m->height, cameras[c].width, cameras[c].height);
+        }
+        cam->width = m->width;
+        cam->height = m->height;
+        wx_result r = setup_matrices(cam, cameras[c].wtc, c, err);
+        if (r != WX_OK) {
+            wx_collider_free(collider);
+            return r;
+        }
+        size_t texels = (size_t)m->width * (size_t)m->height;
+        cam->depth = malloc(texels * sizeof *cam->depth);
+        if (cam->depth == NULL) {
+            wx_collider_free(collider);
+            return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (collider depth)");
+        }
+        for (size_t t = 0; t < texels; ++t) {
+            cam->depth[t] = wx_depth_is_empty(m->depth[t]) ? INFINITY : m->depth[t];
+        }
+        cam->normal = m->normal;
+        cam->impact = m->impact;
+        r = build_coarse(cam, err);
+        if (r != WX_OK) {
+            wx_collider_free(collider);
+            return r;
+        }
+    }
+    return WX_OK;
+}
+
+void wx_collider_free(wx_collider *collider)
+{
+    for (int c = 0; c < collider->camera_count; ++c) {
+        free(collider->cameras[c].depth);
+        free(collider->cameras[c].coarse);
+    }
+    free(collider->cameras);
+    memset(collider, 0, sizeof *collider);
+}
+
+// --- the depth surface ---------------------------------------------------------
+
+// fmin and fmax are library calls unless NaN semantics are relaxed; these are
+// plain compares (no NaN reaches them).
+static inline double dmin(double a, double b)
+{
+    return a < b ? a : b;
+}
+
+static inline double dmax(double a, double b)
+{
+    return a > b ? a : b;
+}
+
+static inline int clampi(int v, int lo, int hi)
+{
+    return v < lo ? lo : (v > hi ? hi : v);
+}
+
+// The depth function over one half-texel cell (hx, hy) (half-texel units):
+// depth(X, Y) = k0 + k1*fx + k2*fy + k3*fx*fy with fx = X - ox, fy = Y - oy.
+// Returns false when the cell's texel holds no surface.
+typedef struct cell_depth {
+    double k0, k1, k2, k3;
+    double ox, oy;
+} cell_depth;
+
+static bool cell_surface(const wx_collider *collider, const wx_collider_camera *cam, int hx,
+                         int hy, cell_depth *cd)
+{
+    int W = cam->width, H = cam->height;
+    int tx = hx >> 1, ty = hy >> 1;
+    float own = cam->depth[(size_t)ty * (size_t)W + (size_t)tx];
+    if (!isfinite(own)) {
+        return false;
+    }
+    cd->k1 = cd->k2 = cd->k3 = 0.0;
+    cd->k0 = own;
+    cd->ox = cd->oy = 0.0;
+    if (collider->nearest) {
+        return true;
+    }
+    // The bilinear cell between texel centres: corners i0, i0+1 and j0, j0+1.
+    int i0 = hx / 2 - 1 + (hx & 1), j0 = hy / 2 - 1 + (hy & 1);
+    int ia = clampi(i0, 0, W - 1), ib = clampi(i0 + 1, 0, W - 1);
+    int ja = clampi(j0, 0, H - 1), jb = clampi(j0 + 1, 0, H - 1);
+    const float *row_a = cam->depth + (size_t)ja * (size_t)W;
+    const float *row_b = cam->depth + (size_t)jb * (size_t)W;
+    double d00 = row_a[ia], d10 = row_a[ib], d01 = row_b[ia], d11 = row_b[ib];
+    if (!isfinite(d00) || !isfinite(d10) || !isfinite(d01) || !isfinite(d11)) {
+        return true; // silhouette: the texel's own depth
+    }
+    cd->ox = i0 + 0.5;
+    cd->oy = j0 + 0.5;
+    cd->k0 = d00;
+    cd->k1 = d10 - d00;
+    cd->k2 = d01 - d00;
+    cd->k3 = d00 - d10 - d01 + d11;
+    return true;
+}
+
+double wx_collider_depth_at(const wx_collider *collider, int c, double X, double Y)
+{
+    const wx_collider_camera *cam = &collider->cameras[c];
+    if (!(X >= 0.0 && X < cam->width && Y >= 0.0 && Y < cam->height)) {
+        return INFINITY;
+    }
+    int hx = clampi((int)(2.0 * X), 0, 2 * cam->width - 1);
+    int hy = clampi((int)(2.0 * Y), 0, 2 * cam->height - 1);
+    cell_depth cd;
+    if (!cell_surface(collider, cam, hx, hy, &cd)) {
+        return INFINITY;
+    }
+    double fx = X - cd.ox, fy = Y - cd.oy;
+    return cd.k0 + cd.k1 * fx + cd.k2 * fy + cd.k3 * fx * fy;
+}
+
+bool wx_collider_point_collides(const wx_collider *collider, const float p[3])
+{
+    bool informed = false;
+    for (int c = 0; c < collider->camera_count; ++c) {
+        const wx_collider_camera *cam = &collider->cameras[c];
+        double X = p[0] * cam->mx[0] + p[1] * cam->mx[1] + p[2] * cam->mx[2] + cam->mx[3];
+        double Y = p[0] * cam->my[0] + p[1] * cam->my[1] + p[2] * cam->my[2] + cam->my[3];
+        double D = p[0] * cam->md[0] + p[1] * cam->md[1] + p[2] * cam->md[2] + cam->md[3];
+        if (!(X >= 0.0 && X < cam->width && Y >= 0.0 && Y < cam->height)) {
+            continue; // no information
+        }
+        informed = true;
+        if (!(D > wx_collider_depth_at(collider, c, X, Y))) {
+            return false; // this camera sees the point in front (or no surface)
+        }
+    }
+    return informed;
+}
+
+// --- the swept test -------------------------------------------------------------
+
+// One camera's walk along the segment: X(s) = X0 + s*dX etc. in texel space,
+// through half-texel cells. f(s) = D(s) - depth(X(s), Y(s)) = A + B s + C s^2 in
+// the current cell; the camera says "behind" where f >= 0.
+typedef struct march {
+    const wx_collider_camera *cam;
+    double X0, Y0, D0, dX, dY, dD;
+    double rX, rY; ///< 1/dX, 1/dY (0 when the segment does not move along that axis)
+    double s_in, s_out; ///< the segment's line is inside the frame for s in [s_in, s_out)
+    bool placed;        ///< a current cell exists
+    int hx, hy;         ///< current half-texel cell
+    double tnx, tny;    ///< parameters of its next x and y boundaries
+    double sa, sb;      ///< its parameter interval
+    bool surface;       ///< the cell's texel holds a surface
+    double A, B, C;     ///< f over the cell
+} march;
+
+// Parameter interval where lo <= P0 + s*dP < hi, intersected into [*a, *b);
+// r = 1/dP, or 0 when dP is 0.
+static void clip_slab(double P0, double r, double lo, double hi, double *a, double *b)
+{
+    if (r == 0.0) {
+        if (!(P0 >= lo && P0 < hi)) {
+            *a = INFINITY;
+            *b = -INFINITY;
+        }
+        return;
+    }
+    double t0 = (lo - P0) * r, t1 = (hi - P0) * r;
+    if (t0 > t1) {
+        double t = t0;
+        t0 = t1;
+        t1 = t;
+    }
+    *a = dmax(*a, t0);
+    *b = dmin(*b, t1);
+}
+
+static void march_init(march *m, const wx_collider_camera *cam, const double p0[3],
+                       const double d[3])
+{
+    m->cam = cam;
+    m->X0 = p0[0] * cam->mx[0] + p0[1] * cam->mx[1] + p0[2] * cam->mx[2] + cam->mx[3];
+    m->Y0 = p0[0] * cam->my[0] + p0[1] * cam->my[1] + p0[2] * cam->my[2] + cam->my[3];
+    m->D0 = p0[0] * cam->md[0] + p0[1] * cam->md[1] + p0[2] * cam->md[2] + cam->md[3];
+    m->dX = d[0] * cam->mx[0] + d[1] * cam->mx[1] + d[2] * cam->mx[2];
+    m->dY = d[0] * cam->my[0] + d[1] * cam->my[1] + d[2] * cam->my[2];
+    m->dD = d[0] * cam->md[0] + d[1] * cam->md[1] + d[2] * cam->md[2];
+    m->rX = m->dX != 0.0 ? 1.0 / m->dX : 0.0;
+    m->rY = m->dY != 0.0 ? 1.0 / m->dY : 0.0;
+    m->s_in = -INFINITY;
+    m->s_out = INFINITY;
+    clip_slab(m->X0, m->rX, 0.0, cam->width, &m->s_in, &m->s_out);
+    clip_slab(m->Y0, m->rY, 0.0, cam->height, &m->s_in, &m->s_out);
+    m->placed = false;
+}
+
+static inline bool march_inside(const march *m, double s)
+{
+    return s >= m->s_in && s < m->s_out;
+}
+
+// Parameter of the next cell boundary along one axis after cell index h
+// (r = 1/dP, or 0 when the segment does not move along the axis).
+static double next_boundary(double P0, double r, int h)
+{
+    if (r > 0.0) {
+        return ((h + 1) * 0.5 - P0) * r;
+    }
+    if (r < 0.0) {
+        return (h * 0.5 - P0) * r;
+    }
+    return INFINITY;
+}
+
+static void cell_function(const wx_collider *collider, march *m)
+{
+    cell_depth cd;
+    m->surface = cell_surface(collider, m->cam, m->hx, m->hy, &cd);
+    if (!m->surface) {
+        return;
+    }
+    // depth(s) = k0 + k1 fx + k2 fy + k3 fx fy with fx = fx0 + s dX, fy = fy0 + s dY.
+    double fx0 = m->X0 - cd.ox, fy0 = m->Y0 - cd.oy;
+    double c0 = cd.k0 + cd.k1 * fx0 + cd.k2 * fy0 + cd.k3 * fx0 * fy0;
+    double c1 = cd.k1 * m->dX + cd.k2 * m->dY + cd.k3 * (fx0 * m->dY + fy0 * m->dX);
+    double c2 = cd.k3 * m->dX * m->dY;
+    m->A = m->D0 - c0;
+    m->B = m->dD - c1;
+    m->C = -c2;
+}
+
+// Puts the walk in the cell that holds parameter s (s inside the frame).
+static void march_place(const wx_collider *collider, march *m, double s)
+{
+    const wx_collider_camera *cam = m->cam;
+    double X = m->X0 + s * m->dX, Y = m->Y0 + s * m->dY;
+    m->hx = clampi((int)floor(2.0 * X), 0, 2 * cam->width - 1);
+    m->hy = clampi((int)floor(2.0 * Y), 0, 2 * cam->height - 1);
+    m->tnx = next_boundary(m->X0, m->rX, m->hx);
+    m->tny = next_boundary(m->Y0, m->rY, m->hy);
+    m->sa = s;
+    m->sb = dmin(m->tnx, m->tny);
+    m->placed = true;
+    cell_function(collider, m);
+}
+
+// Steps to the next cell; false when the walk leaves the map.
+static bool march_advance(const wx_collider *collider, march *m)
+{
+    const wx_collider_camera *cam = m->cam;
+    double nx = m->tnx, ny = m->tny;
+    if (nx <= ny) {
+        m->hx += m->rX > 0.0 ? 1 : -1;
+        m->tnx = next_boundary(m->X0, m->rX, m->hx);
+    }
+    if (ny <= nx) {
+        m->hy += m->rY > 0.0 ? 1 : -1;
+        m->tny = next_boundary(m->Y0, m->rY, m->hy);
+    }
+    if (m->hx < 0 || m->hx >= 2 * cam->width || m->hy < 0 || m->hy >= 2 * cam->height) {
+        return false;
+    }
+    m->sa = dmin(nx, ny);
+    m->sb = dmin(m->tnx, m->tny);
+    cell_function(collider, m);
+    return true;
+}
+
+// Smallest s in [lo, hi] with A + B s + C s^2 >= 0, or +inf.
+static double first_nonnegative(double A, double B, double C, double lo, double hi)
+{
+    double f = A + lo * (B + lo * C);
+    if (f >= 0.0) {
+        return lo;
+    }
+    double g = B + 2.0 * C * lo; // slope at lo
+    double len = hi - lo;
+    double tau;
+    // Relative to the other terms over the interval, is the curvature negligible?
+    if (fabs(C) * len * len <= 1e-12 * (fabs(f) + fabs(g) * len)) {
+        if (!(g > 0.0)) {
+            return INFINITY;
+        }
+        tau = -f / g;
+    } else {
+        double disc = g * g - 4.0 * C * f;
+        if (disc < 0.0) {
+            return INFINITY;
+        }
+        double q = -0.5 * (g + copysign(sqrt(disc), g));
+        double r1 = q / C;
+        double r2 = q != 0.0 ? f / q : INFINITY;
+        if (r1 > r2) {
+            double t = r1;
+            r1 = r2;
+            r2 = t;
+        }
+        tau = r1 > 0.0 ? r1 : r2;
+        if (!(tau > 0.0)) {
+            return INFINITY;
+        }
+    }
+    return tau <= len ? lo + tau : INFINITY;
+}
+
+// The smallest s' >= s where this camera puts the segment's point behind its
+// surface or outside its frame (both let a collision happen); > 1 when none
+// within the segment.
+static double march_entry(const wx_collider *collider, march *m, double s)
+{
+    if (!march_inside(m, s)) {
+        return s;
+    }
+    if (!m->placed || s >= m->sb || s < m->sa) {
+        march_place(collider, m, s);
+    }
+    double end = dmin(m->s_out, 1.0);
+    for (int guard = 0; guard < 8 * (m->cam->width + m->cam->height) + 16; ++guard) {
+        double lo = dmax(s, m->sa);
+        double hi = dmin(m->sb, end);
+        if (m->surface && lo <= hi) {
+            double r = first_nonnegative(m->A, m->B, m->C, lo, hi);
+            if (r <= hi) {
+                return r;
+            }
+        }
+        if (m->sb >= end) {
+            return m->s_out <= 1.0 ? m->s_out : 2.0;
+        }
+        if (!march_advance(collider, m)) {
+            return m->s_out <= 1.0 ? m->s_out : 2.0;
+        }
+    }
+    return 2.0;
+}
+
+// The camera that gives the hit at parameter s: DESIGN section 4's "smallest
+// d - depth", read to each map's precision. Across one texel, the depth of a
+// surface seen at angle theta changes by texel * tan(theta), so a camera that
+// sees the surface at a grazing angle has d - depth near 0 over a wide band and
+// would win hits that belong to a camera seeing the same surface head-on. Such a
+// camera's texel covers a long strip of surface while it wins only part of the
+// strip's hits, so its dirt per area comes out too low and the mask shows the
+// cameras' patches. So: among the cameras whose d - depth is within half a texel
+// plus one texel's worth of that slope (against the bilinear depth and against
+// the hit texel's own depth), the most head-on one (largest |N.view|,
+// the camera `bake` gives initial dirt to) gives the hit; without any, the
+// smallest d - depth. -1 when no camera sees a surface at s.
+static int pick_camera(const wx_collider *collider, const march *m, double s)
+{
+    int best = -1, closest = -1;
+    double best_cos = -1.0, closest_f = INFINITY;
+    for (int c = 0; c < collider->camera_count; ++c) {
+        if (!march_inside(&m[c], s) || !m[c].surface) {
+            continue;
+        }
+        const wx_collider_camera *cam = &collider->cameras[c];
+        double f = m[c].A + s * (m[c].B + s * m[c].C);
+        if (closest < 0 || f < closest_f) {
+            closest = c;
+            closest_f = f;
+        }
+        size_t texel = (size_t)(m[c].hy >> 1) * (size_t)cam->width + (size_t)(m[c].hx >> 1);
+        const float *n = cam->normal + 3 * texel;
+        double bl = sqrt((double)cam->back[0] * cam->back[0] + (double)cam->back[1] * cam->back[1] +
+                         (double)cam->back[2] * cam->back[2]);
+        double nl = sqrt((double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2]);
+        if (!(bl > 0.0) || !(nl > 1e-6) || !isfinite(nl)) {
+            continue;
+        }
+        double cos_view = fabs(n[0] * cam->back[0] + n[1] * cam->back[1] + n[2] * cam->back[2]) /
+                          (bl * nl);
+        double tan_view = sqrt(fmax(0.0, 1.0 - cos_view * cos_view)) / fmax(cos_view, 0.05);
+        double precision = cam->texel_ws * (0.5 + tan_view);
+        // The texel itself must record this surface too: between a wall and a
+        // slab's edge in front of it the bilinear depth is no surface at all,
+        // and a point behind it (on the ground between them) is not seen there.
+        double d = m[c].D0 + s * m[c].dD;
+        double off = fabs(d - (double)cam->depth[texel]) * bl;
+        if (f * bl <= precision && off <= precision && cos_view > best_cos) {
+            best = c;
+            best_cos = cos_view;
+        }
+    }
+    return best >= 0 ? best : closest;
+}
+
+// True when camera `cam` sees p inside its frame and in front of its surface (or
+// over no surface): then p does not collide, whatever the other cameras say.
+static bool camera_sees_in_front(const wx_collider *collider, const wx_collider_camera *cam,
+                                 const float p[3])
+{
+    double X = p[0] * cam->mx[0] + p[1] * cam->mx[1] + p[2] * cam->mx[2] + cam->mx[3];
+    double Y = p[0] * cam->my[0] + p[1] * cam->my[1] + p[2] * cam->my[2] + cam->my[3];
+    double D = p[0] * cam->md[0] + p[1] * cam->md[1] + p[2] * cam->md[2] + cam->md[3];
+    if (!(X >= 0.0 && X < cam->width && Y >= 0.0 && Y < cam->height)) {
+        return false;
+    }
+    int c = (int)(cam - collider->cameras);
+    return !(D > wx_collider_depth_at(collider, c, X, Y));
+}
+
+// Where the particle goes back after a hit at s, validated by the point rule:
+//  - when the hit is on the camera's surface (d - depth within half a texel),
+//    onto that surface along the camera's axis, slightly in front of it (a
+//    hundredth of a texel, at least a hair more than float rounding of d);
+//  - when the segment entered through a silhouette or a frame edge (d - depth
+//    larger: the surface that camera records is elsewhere), a little back along
+//    the segment, where it came from;
+//  - else the start of the segment (outside, since particles always are).
+static void put_back(const wx_collider *collider, const wx_collider_camera *cam,
+                     const double a[3], const double d[3], double s, double f, double D,
+                     float out[3])
+{
+    double eps = dmax(0.01 * cam->texel_ws, 2e-6 * (1.0 + fabs(D)));
+    double lift = dmax(f, 0.0) + eps;
+    float on_surface[3];
+    for (int k = 0; k < 3; ++k) {
+        on_surface[k] = (float)(a[k] + s * d[k] + lift * cam->back[k]);
+    }
+    bool surface_first = f <= 0.5 * cam->texel_ws;
+    if (surface_first && camera_sees_in_front(collider, cam, on_surface)) {
+        memcpy(out, on_surface, sizeof on_surface);
+        return;
+    }
+    double len = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    static const double back_off[3] = { 0.01, 0.1, 0.5 }; // texels
+    for (int t = 0; t < 3 && len > 0.0; ++t) {
+        double sb = dmax(0.0, s - back_off[t] * cam->texel_ws / len);
+        float q[3];
+        for (int k = 0; k < 3; ++k) {
+            q[k] = (float)(a[k] + sb * d[k]);
+        }
+        if (!wx_collider_point_collides(collider, q)) {
+            memcpy(out, q, sizeof q);
+            return;
+        }
+    }
+    float start[3] = { (float)a[0], (float)a[1], (float)a[2] };
+    if (!surface_first && !wx_collider_point_collides(collider, on_surface)) {
+        memcpy(out, on_surface, sizeof on_surface);
+    } else if (s > 0.0 && !wx_collider_point_collides(collider, start)) {
+        memcpy(out, start, sizeof start);
+    } else {
+        memcpy(out, on_surface, sizeof on_surface); // inside whatever we try: the surface
+    }
+}
+
+bool wx_collider_sweep(const wx_collider *collider, const float p0[3], const float p1[3],
+                       wx_hit *hit)
+{
+    int K = collider->camera_count;
+    march m[WX_MAX_INPUT_CAMERAS];
+    double a[3] = { p0[0], p0[1], p0[2] };
+    double d[3] = { (double)p1[0] - p0[0], (double)p1[1] - p0[1], (double)p1[2] - p0[2] };
+    for (int c = 0; c < K; ++c) {
+        march_init(&m[c], &collider->cameras[c], a, d);
+    }
+    // Leapfrog: raise s until every camera agrees that P(s) may collide and at
+    // least one camera sees it (DESIGN section 4, thesis 4.8.4.1).
+    double s = 0.0;
+    bool agreed = false;
+    for (int round = 0; round < 1 << 20 && !agreed; ++round) {
+        double s_frame = INFINITY;
+        for (int c = 0; c < K; ++c) {
+            if (march_inside(&m[c], s)) {
+                s_frame = s;
+                break;
+            }
+            if (m[c].s_in > s && m[c].s_in < s_frame) {
+                s_frame = m[c].s_in;
+            }
+        }
+        if (!(s_frame <= 1.0)) {
+            return false;
+        }
+        s = s_frame;
+        agreed = true;
+        for (int c = 0; c < K; ++c) {
+            double e = march_entry(collider, &m[c], s);
+            if (!(e <= 1.0)) {
+                return false;
+            }
+            if (e > s) {
+                s = e;
+                agreed = false;
+            }
+        }
+    }
+    if (!agreed) {
+        return false;
+    }
+    int best = pick_camera(collider, m, s);
+    double best_f = best >= 0 ? m[best].A + s * (m[best].B + s * m[best].C) : 0.0;
+    if (best < 0) {
+        return false; // only when rounding puts s on a frame edge: no surface there
+    }
+    const wx_collider_camera *cam = &collider->cameras[best];
+    int tx = m[best].hx >> 1, ty = m[best].hy >> 1;
+    size_t texel = (size_t)ty * (size_t)cam->width + (size_t)tx;
+    hit->s = (float)s;
+    hit->camera = best;
+    hit->texel = (uint32_t)texel;
+    double point[3];
+    for (int k = 0; k < 3; ++k) {
+        point[k] = a[k] + s * d[k];
+        hit->point[k] = (float)point[k];
+    }
+    put_back(collider, cam, a, d, s, best_f, m[best].D0 + s * m[best].dD, hit->front);
+    const float *n = cam->normal + 3 * texel;
+    float len = sqrtf(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    if (len > 1e-6f && isfinite(len)) {
+        for (int k = 0; k < 3; ++k) {
+            hit->normal[k] = n[k] / len;
+        }
+    } else {
+        // No usable normal: face the camera.
+        float bl = sqrtf(cam->back[0] * cam->back[0] + cam->back[1] * cam->back[1] +
+                         cam->back[2] * cam->back[2]);
+        for (int k = 0; k < 3; ++k) {
+            hit->normal[k] = cam->back[k] / bl;
+        }
+    }
+    hit->absorption = cam->impact[2 * texel];
+    hit->bounce = cam->impact[2 * texel + 1];
+    return true;
+}
+
+// --- the coarse test -------------------------------------------------------------
+
+// |v| clamped to `limit` on the bit pattern (vectorises; NaN becomes limit).
+WX_INLINE float abs_clamped(float v, float limit)
+{
+    uint32_t u, l;
+    memcpy(&u, &v, sizeof u);
+    memcpy(&l, &limit, sizeof l);
+    u &= 0x7fffffffu;
+    uint32_t big = -(uint32_t)(u > l);
+    u = (u & ~big) | (l & big);
+    memcpy(&v, &u, sizeof v);
+    return v;
+}
+
+// max(a, b) without a float select (rounding error: one ulp of the larger).
+WX_INLINE float max_arith(float a, float b)
+{
+    return 0.5f * (a + b + fabsf(a - b));
+}
+
+// One lane of the coarse test against one camera. Sets *usable when the segment
+// lies inside the frame and short enough for a pyramid level, *index to that
+// level's cell, *dmax to the segment's largest d (plus rounding slack) and
+// returns 1 when the segment lies wholly outside the frame.
+typedef struct coarse_geometry {
+    const float *mx, *my, *md;
+    float W, H, slack_scale, slack_base;
+    int offset0, width0, offset1, width1, offset2, width2, offset3, width3, offset4, width4;
+} coarse_geometry;
+
+static inline coarse_geometry coarse_setup(const wx_collider_camera *cam)
+{
+    coarse_geometry g;
+    g.mx = cam->fmx;
+    g.my = cam->fmy;
+    g.md = cam->fmd;
+    g.W = (float)cam->width;
+    g.H = (float)cam->height;
+    g.slack_scale = 4e-7f * (fabsf(g.md[0]) + fabsf(g.md[1]) + fabsf(g.md[2]));
+    g.slack_base = 4e-7f * fabsf(g.md[3]);
+    // Level geometry in locals: a load under a condition "could trap" and keeps
+    // gcc from vectorising.
+    g.offset0 = cam->level_offset[0];
+    g.width0 = cam->level_width[0];
+    g.offset1 = cam->level_offset[1];
+    g.width1 = cam->level_width[1];
+    g.offset2 = cam->level_offset[2];
+    g.width2 = cam->level_width[2];
+    g.offset3 = cam->level_offset[3];
+    g.width3 = cam->level_width[3];
+    g.offset4 = cam->level_offset[4];
+    g.width4 = cam->level_width[4];
+    return g;
+}
+
+WX_INLINE int coarse_lane(const coarse_geometry *g, float x0, float y0, float z0, float x1,
+                          float y1, float z1, int *usable, int *index, float *dmax)
+{
+    const float margin = 1.0f / 64.0f; // texels kept from the frame edge
+    const float *mx = g->mx, *my = g->my, *md = g->md;
+    float W = g->W, H = g->H;
+    float X0 = x0 * mx[0] + y0 * mx[1] + z0 * mx[2] + mx[3];
+    float Y0 = x0 * my[0] + y0 * my[1] + z0 * my[2] + my[3];
+    float D0 = x0 * md[0] + y0 * md[1] + z0 * md[2] + md[3];
+    float X1 = x1 * mx[0] + y1 * mx[1] + z1 * mx[2] + mx[3];
+    float Y1 = x1 * my[0] + y1 * my[1] + z1 * my[2] + my[3];
+    float D1 = x1 * md[0] + y1 * md[1] + z1 * md[2] + md[3];
+    int in = (X0 >= margin) & (X0 < W - margin) & (Y0 >= margin) & (Y0 < H - margin) &
+             (X1 >= margin) & (X1 < W - margin) & (Y1 >= margin) & (Y1 < H - margin);
+    int out = ((X0 < -margin) & (X1 < -margin)) | ((X0 > W + margin) & (X1 > W + margin)) |
+              ((Y0 < -margin) & (Y1 < -margin)) | ((Y0 > H + margin) & (Y1 > H + margin));
+    // How far the segment reaches, in texels, picks the pyramid level.
+    int reach = (int)max_arith(abs_clamped(X1 - X0, 1e9f), abs_clamped(Y1 - Y0, 1e9f));
+    int xi = (int)abs_clamped(X0, 1e9f), yi = (int)abs_clamped(Y0, 1e9f);
+    // (Written out level by level: an inner loop keeps gcc from vectorising.)
+    int chosen = 0, found = 0;
+#define WX_COARSE_PICK(l)                                                                  \
+    {                                                                                      \
+        int shift = WX_COARSE_BLOCK_SHIFT + WX_COARSE_LEVEL_SHIFT * (l);                   \
+        int fits = ((reach + 2) <= (1 << shift)) & !found;                                 \
+        int here = g->offset##l + (yi >> shift) * g->width##l + (xi >> shift);             \
+        chosen = fits ? here : chosen;                                                     \
+        found |= fits;                                                                     \
+    }
+    WX_COARSE_PICK(0)
+    WX_COARSE_PICK(1)
+    WX_COARSE_PICK(2)
+    WX_COARSE_PICK(3)
+    WX_COARSE_PICK(4)
+#undef WX_COARSE_PICK
+    *usable = in & found;
+    *index = *usable ? chosen : 0;
+    float slack = g->slack_base + g->slack_scale * (fabsf(x0) + fabsf(y0) + fabsf(z0) +
+                                                    fabsf(x1) + fabsf(y1) + fabsf(z1));
+    *dmax = max_arith(D0, D1) + slack;
+    return out;
+}
+
+_Static_assert(WX_PARTICLE_BLOCK == 16, "lane_bit below has 16 entries");
+
+WX_HOT uint32_t wx_collider_coarse_block(const wx_collider *collider, const int *cams,
+                                         int count, uint32_t *restrict credit,
+                                         const float *restrict x0, const float *restrict y0,
+                                         const float *restrict z0, const float *restrict x1,
+                                         const float *restrict y1, const float *restrict z1,
+                                         uint32_t *restrict outside)
+{
+    enum { B = WX_PARTICLE_BLOCK };
+    static const uint32_t lane_bit[B] = { 1u << 0,  1u << 1,  1u << 2,  1u << 3,
+                                          1u << 4,  1u << 5,  1u << 6,  1u << 7,
+                                          1u << 8,  1u << 9,  1u << 10, 1u << 11,
+                                          1u << 12, 1u << 13, 1u << 14, 1u << 15 };
+    const uint32_t all = (1u << B) - 1u;
+    uint32_t cleared = 0, out_all = all;
+    for (int n = 0; n < count; ++n) {
+        int c = cams[n];
+        const wx_collider_camera *cam = &collider->cameras[c];
+        coarse_geometry g = coarse_setup(cam);
+        int idx[B], usable[B], out[B];
+        float dmax[B];
+        for (int k = 0; k < B; ++k) {
+            out[k] = coarse_lane(&g, x0[k], y0[k], z0[k], x1[k], y1[k], z1[k], &usable[k],
+                                 &idx[k], &dmax[k]);
+        }
+        float least[B];
+        for (int k = 0; k < B; ++k) {
+            least[k] = cam->coarse[idx[k]];
+        }
+        // Lane k to bit k as an OR reduction with constant weights (vectorises;
+        // a shift by k does not).
+        uint32_t clear_bits = 0, out_bits = 0;
+        for (int k = 0; k < B; ++k) {
+            clear_bits |= -(uint32_t)(usable[k] & (dmax[k] < least[k])) & lane_bit[k];
+            out_bits |= -(uint32_t)out[k] & lane_bit[k];
+        }
+        if (credit != NULL) {
+            credit[c] += (uint32_t)__builtin_popcount(clear_bits & ~cleared);
+        }
+        cleared |= clear_bits;
+        out_all &= out_bits;
+        if (cleared == all) {
+            break; // one camera vouches for every lane: the others are not needed
+        }
+    }
+    *outside = out_all;
+    return cleared;
+}
+
+bool wx_collider_coarse_clear(const wx_collider *collider, const float p0[3], const float p1[3])
+{
+    bool outside = collider->camera_count > 0;
+    for (int c = 0; c < collider->camera_count; ++c) {
+        const wx_collider_camera *cam = &collider->cameras[c];
+        coarse_geometry g = coarse_setup(cam);
+        int usable, index;
+        float dmax;
+        outside &= coarse_lane(&g, p0[0], p0[1], p0[2], p1[0], p1[1], p1[2], &usable, &index,
+                               &dmax) != 0;
+        if (usable && dmax < cam->coarse[index]) {
+            return true;
+        }
+    }
+    return outside || collider->camera_count == 0;
+}
+
+void wx_collider_prefetch(const wx_collider *collider, const float p[3])
+{
+    for (int c = 0; c < collider->camera_count; ++c) {
+        const wx_collider_camera *cam = &collider->cameras[c];
+        float X = p[0] * cam->fmx[0] + p[1] * cam->fmx[1] + p[2] * cam->fmx[2] + cam->fmx[3];
+        float Y = p[0] * cam->fmy[0] + p[1] * cam->fmy[1] + p[2] * cam->fmy[2] + cam->fmy[3];
+        if (!(X >= 0.0f && X < (float)cam->width && Y >= 0.0f && Y < (float)cam->height)) {
+            continue;
+        }
+        int i = (int)X, j = (int)Y;
+        size_t t = (size_t)j * (size_t)cam->width + (size_t)i;
+        // The texel's row and the neighbouring row bilinear depth reads.
+        __builtin_prefetch(&cam->depth[t]);
+        int other = Y - (float)j < 0.5f ? j - 1 : j + 1;
+        if (other >= 0 && other < cam->height) {
+            __builtin_prefetch(&cam->depth[(size_t)other * (size_t)cam->width + (size_t)i]);
+        }
+    }
+}

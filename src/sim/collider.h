@@ -1,0 +1,127 @@
+// collider.h: the projected-maps collider (thesis 4.8.4.1, DESIGN section 4).
+//
+// The geometry is known only through the depth maps of the input cameras. A
+// point collides when at least one camera sees it inside its frame and every
+// camera that does says it lies behind its surface (d > depth); a texel with no
+// surface says "not behind". A step is a segment, and the collider finds the
+// first point of the segment that collides (the swept test): for each camera it
+// walks the segment through the map half a texel at a time and solves, in each
+// half-texel, where the segment passes behind the surface; the cameras' answers
+// are intersected by leapfrogging from one to the next. So a particle never
+// passes through a surface that a map records, however fast it flies.
+//
+// Depth between texel centres is bilinear when the four texels around the
+// point all hold a surface (a smooth surface: no terraces, no banding, thesis
+// 5.1.2), and the texel's own depth otherwise (silhouettes, the thesis'
+// nearest-texel rule everywhere when `nearest` is set).
+//
+// A conservative coarse test answers most steps without the walk: per camera a
+// pyramid of minimum depths over 3x3 blocks around each block proves that a short
+// segment stays in front of every surface near it.
+#ifndef WX_COLLIDER_H
+#define WX_COLLIDER_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "model/camera.h"
+#include "core/error.h"
+#include "core/limits.h"
+#include "model/maps.h"
+
+/// Levels of the coarse pyramid: blocks of 4, 16, 64, ... texels.
+#define WX_COARSE_LEVELS 5 ///< collider.c writes the five levels out one by one
+#define WX_COARSE_BLOCK_SHIFT 2
+#define WX_COARSE_LEVEL_SHIFT 2
+
+/// One input camera as the collider sees it.
+typedef struct wx_collider_camera {
+    int width;
+    int height;
+    /// Texel space: X = u*W, Y = (1-v)*H (texel (i, j) covers [i, i+1) x [j, j+1)),
+    /// D = d. X = x*mx[0] + y*mx[1] + z*mx[2] + mx[3], likewise Y and D.
+    double mx[4], my[4], md[4];
+    float fmx[4], fmy[4], fmd[4]; ///< the same in float, for the coarse test
+    float back[3];  ///< world displacement that lowers d by 1 and keeps u, v
+    float texel_ws; ///< world size of the smaller side of a texel
+    float *depth;   ///< W*H, +inf where there is no surface (owned copy)
+    const float *normal; ///< 3*W*H world normals (borrowed)
+    const float *impact; ///< 2*W*H absorption, bounce (borrowed)
+    /// Coarse pyramid: level l has blocks of 4 << 2l texels; its value at block
+    /// (bx, by) is the least depth over the 3x3 blocks around it, lowered by a
+    /// rounding margin. Levels are stored one after the other in `coarse`.
+    int levels;
+    int level_width[WX_COARSE_LEVELS];
+    int level_height[WX_COARSE_LEVELS];
+    int level_offset[WX_COARSE_LEVELS];
+    float *coarse;
+} wx_collider_camera;
+
+typedef struct wx_collider {
+    int camera_count;
+    wx_collider_camera *cameras;
+    bool nearest; ///< nearest-texel depth everywhere (the thesis' rule)
+} wx_collider;
+
+/// Builds the collider over `count` cameras and their maps (depth, normal and
+/// impact are needed; normal and impact are borrowed and must outlive the
+/// collider). Fails (WX_BAD_INPUT) on a projective (non-orthographic) matrix, a
+/// map whose size differs from the camera's, or too many cameras.
+wx_result wx_collider_init(wx_collider *collider, const wx_camera *cameras, const wx_maps *maps,
+                           int count, bool nearest, wx_error *err);
+
+/// Frees what the collider owns; the struct is zeroed.
+void wx_collider_free(wx_collider *collider);
+
+/// The first collision along a segment.
+typedef struct wx_hit {
+    float s;          ///< segment parameter of the hit, in [0, 1]
+    int camera;       ///< the camera that gives the hit (smallest d - depth)
+    uint32_t texel;   ///< j*W + i in that camera's maps
+    float point[3];   ///< world point where the segment enters the surface
+    /// Where the particle is put back: on that camera's surface slightly in
+    /// front of it (or, when it entered through a silhouette or frame edge, just
+    /// back along its segment); never a colliding point unless the segment
+    /// started inside.
+    float front[3];
+    float normal[3];  ///< unit world normal at the texel
+    float absorption; ///< impact R
+    float bounce;     ///< impact G
+} wx_hit;
+
+/// Swept test of the segment p0 -> p1: true and the first colliding point when
+/// there is one. If p0 itself collides (a particle emitted inside the geometry),
+/// the hit is at s = 0.
+bool wx_collider_sweep(const wx_collider *collider, const float p0[3], const float p1[3],
+                       wx_hit *hit);
+
+/// The point rule of DESIGN section 4 for one point (no sweep).
+bool wx_collider_point_collides(const wx_collider *collider, const float p[3]);
+
+/// Coarse test of WX_PARTICLE_BLOCK segments (x0, y0, z0) -> (x1, y1, z1) against
+/// the `count` cameras listed in `cams`: bit k of the result is set when one of
+/// them sees all of segment k in front of its surfaces (then it cannot collide);
+/// bit k of *outside when segment k lies outside the frames of all of them (it
+/// cannot collide when that holds for every camera of the collider). The test
+/// stops once every lane is cleared (then *outside is meaningless): any order
+/// gives the same clearing, a good one (the camera that clears most first) is
+/// faster. When `credit` is not NULL, credit[c] counts the lanes camera c
+/// cleared first.
+uint32_t wx_collider_coarse_block(const wx_collider *collider, const int *cams, int count,
+                                  uint32_t *restrict credit, const float *restrict x0,
+                                  const float *restrict y0, const float *restrict z0,
+                                  const float *restrict x1, const float *restrict y1,
+                                  const float *restrict z1, uint32_t *restrict outside);
+
+/// The coarse test of one segment: true when it certainly does not collide.
+bool wx_collider_coarse_clear(const wx_collider *collider, const float p0[3], const float p1[3]);
+
+/// Asks the memory system for the depth texels a swept test near p will read
+/// (a hint: it changes no result).
+void wx_collider_prefetch(const wx_collider *collider, const float p[3]);
+
+/// Depth of the collider's surface at texel-space point (X, Y) of camera c (the
+/// bilinear or nearest rule above); +inf where there is no surface or outside.
+double wx_collider_depth_at(const wx_collider *collider, int c, double X, double Y);
+
+#endif

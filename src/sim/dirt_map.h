@@ -1,0 +1,64 @@
+// dirt_map.h: the dirt on the surface seen by one input camera, and the
+// exchange of dirt between particles and surface (thesis 3.5, 4.8.4.3, DESIGN
+// section 4).
+//
+// Surface dirt is kept in double precision during the simulation so that the
+// ledger (initial surface + emitted = final surface + in flight + escaped)
+// holds to rounding of doubles; the written map is float32 (a relative rounding
+// of at most 2^-24 per texel).
+#ifndef WX_DIRT_MAP_H
+#define WX_DIRT_MAP_H
+
+#include <stdint.h>
+
+#include "model/camera.h"
+#include "core/error.h"
+
+/// One texel: its dirt and its exchange rates, already scaled by the collider's
+/// deposit D and erosion E and clamped to [0, 1].
+typedef struct wx_dirt_texel {
+    double dirt;
+    float deposit; ///< clamp(D * kd, 0, 1)
+    float erosion; ///< clamp(E * ke, 0, 1)
+} wx_dirt_texel;
+
+typedef struct wx_dirt_map {
+    int width;
+    int height;
+    wx_dirt_texel *texels; ///< W*H, row 0 at the top
+    const float *depth;    ///< W*H (borrowed): streaks skip texels without surface
+} wx_dirt_map;
+
+/// Builds the map from the dirt planes (any may be NULL: zeros) and the
+/// collider's D and E. `depth` (borrowed, may be NULL) marks the texels with a
+/// surface (finite depth). Fails with WX_FAIL when out of memory.
+wx_result wx_dirt_map_init(wx_dirt_map *map, int width, int height, const float *dirt,
+                           const float *deposit, const float *erosion, float D, float E,
+                           const float *depth, wx_error *err);
+
+/// Frees the texels; the struct is zeroed.
+void wx_dirt_map_free(wx_dirt_map *map);
+
+/// Sum of the dirt of every texel, in texel order.
+double wx_dirt_map_total(const wx_dirt_map *map);
+
+/// One impact at `texel`: dep = deposit*p, ero = erosion*s, then p += ero - dep,
+/// s += dep - ero (thesis 4.8.4.3, as pinned in DESIGN section 4).
+void wx_dirt_map_exchange(wx_dirt_map *map, uint32_t texel, double *load);
+
+/// A slide that follows a slide: the same exchange spread evenly over the
+/// surface texels of the Bresenham line from `from` to `to`, without `from` (it
+/// took its share at the previous hit): each of the n texels exchanges with
+/// dep_k = deposit_k*p/n and ero_k = erosion_k*s_k/n, p being the load on
+/// arrival. With no surface texel on the line, a plain exchange at `to`.
+void wx_dirt_map_exchange_line(wx_dirt_map *map, uint32_t from, uint32_t to, double *load);
+
+/// Deposits all of *load at `texel` (absorbed and settled particles).
+void wx_dirt_map_deposit_all(wx_dirt_map *map, uint32_t texel, double *load);
+
+/// Bresenham's line from (x0, y0) to (x1, y1), both ends included (thesis 3.5):
+/// writes up to `max` texels as x, y pairs into `out` (may be NULL) and returns
+/// how many the line has.
+int wx_bresenham(int x0, int y0, int x1, int y1, int *out, int max);
+
+#endif

@@ -1,0 +1,33 @@
+// emitter.h: particle emitters (thesis 4.8.2, DESIGN section 3): how many
+// particles an emitter has emitted by a given time, and where and how fast each
+// one starts.
+//
+// Emission is exact: by time t an emitter has emitted floor(rate * (t - start))
+// particles (t clipped to its end), whatever the time step. A particle's start
+// depends only on the seed and its id (emitter index, serial number), never on
+// which thread or step created it.
+#ifndef WX_EMITTER_H
+#define WX_EMITTER_H
+
+#include <stdint.h>
+
+#include "model/scene.h"
+
+/// Particles emitter `e` has emitted by time t: floor(rate * (min(t, end) - start)),
+/// 0 before start. A relative 1e-12 guards against decimal time steps landing just
+/// below an integer (1000 * (29 * 0.01) is 289.99999999999997 in binary).
+int64_t wx_emitter_count_at(const wx_emitter *e, double t);
+
+/// A unit direction uniform over the sphere, from two uniforms in [0, 1).
+void wx_uniform_sphere(float u1, float u2, float d[3]);
+
+/// A unit direction uniform over the upper (+Y) hemisphere, from two uniforms.
+void wx_uniform_hemisphere(float u1, float u2, float d[3]);
+
+/// Start position and velocity of the particle with id `id` (see wx_particle_id):
+/// PointEmitter: the centre, speed times a uniform direction; HemisphereEmitter:
+/// c + radius*d with d uniform on the upper hemisphere, velocity -speed*d.
+void wx_emitter_sample(const wx_emitter *e, uint64_t seed, uint64_t id, float pos[3],
+                       float vel[3]);
+
+#endif
