@@ -14,7 +14,7 @@
 #include <stddef.h>
 
 #include "core/error.h"
-#include "model/scene.h"
+#include "core/limits.h"
 
 /// The temporary name for `path`: "<folder>/.<basename>.tmp<pid>". The name is
 /// remembered until wx_atomic_commit (or wx_temp_forget) for wx_temp_remove_all.
