@@ -1,7 +1,7 @@
 // gather.c: the output mask (docs/design.md section 5, thesis 4.8.4.4 with its visibility
 // test added and its second pass made a weighted mean).
 //
-// Both passes run on worker threads that take work items (first pass: 64 x 64
+// Both passes run on the thread pool (core/parallel.h), whose workers take work items (first pass: 64 x 64
 // tiles, which keep the input maps' footprint in cache; second pass: bands of
 // rows) from a shared counter. Every texel is computed from the inputs alone, so
 // the result does not depend on the thread count. The second pass visits a
@@ -10,8 +10,6 @@
 #include "gather/gather.h"
 
 #include <math.h>
-#include <pthread.h>
-#include <stdatomic.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -19,6 +17,7 @@
 
 #include "core/limits.h"
 #include "core/matrix.h"
+#include "core/parallel.h"
 #include "core/progress.h"
 
 enum {
@@ -133,7 +132,6 @@ typedef struct gather_job {
     int pass; // 1 or 2
     int tiles_x, tiles_y;
     int items; // work items of the current pass: tiles, then bands of rows
-    atomic_int next_item;
     wx_progress *progress;
     int64_t progress_base;
 } gather_job;
@@ -361,46 +359,26 @@ static void do_item(const gather_job *job, int item)
     }
 }
 
-static void *worker(void *arg)
+// Items [begin, end) of the current pass; the calling thread (worker 0) also
+// draws the progress bar.
+static void do_items(int64_t begin, int64_t end, int worker, void *context)
 {
-    gather_job *job = arg;
-    for (int item; (item = atomic_fetch_add(&job->next_item, 1)) < job->items;) {
-        do_item(job, item);
-    }
-    return NULL;
-}
-
-// Runs one pass on `threads` threads; the calling thread works too and draws
-// the progress bar.
-static void run_pass(gather_job *job, int pass, int items, int threads)
-{
-    job->pass = pass;
-    job->items = items;
-    atomic_store(&job->next_item, 0);
-    enum { MAX_THREADS = 256 };
-    pthread_t ids[MAX_THREADS];
-    int started = 0;
-    if (threads > MAX_THREADS) {
-        threads = MAX_THREADS;
-    }
-    if (threads > items) {
-        threads = items;
-    }
-    for (int t = 1; t < threads; ++t) {
-        if (pthread_create(&ids[started], NULL, worker, job) != 0) {
-            break; // fewer threads: the others take more items
-        }
-        started++;
-    }
-    for (int item; (item = atomic_fetch_add(&job->next_item, 1)) < items;) {
-        do_item(job, item);
-        if (job->progress != NULL) {
+    const gather_job *job = context;
+    for (int64_t item = begin; item < end; ++item) {
+        do_item(job, (int)item);
+        if (worker == 0 && job->progress != NULL) {
             wx_progress_update(job->progress, job->progress_base + item + 1);
         }
     }
-    for (int t = 0; t < started; ++t) {
-        pthread_join(ids[t], NULL);
-    }
+}
+
+// Runs one pass on the pool: every item is computed from the inputs alone, so
+// the result does not depend on which thread takes it.
+static void run_pass(gather_job *job, int pass, int items, wx_pool *pool)
+{
+    job->pass = pass;
+    job->items = items;
+    wx_pool_for(pool, items, 1, do_items, job);
 }
 
 // ---------------------------------------------------------------------------
@@ -693,7 +671,11 @@ wx_result wx_gather_compute(const wx_gather_def *def, float *mask_out, wx_gather
         job.inv_radius = 1.0f / def->radius;
         job.sum = def->second_pass == WX_SECOND_PASS_SUM;
     }
-    const int threads = def->threads > 1 ? def->threads : 1;
+    // Out of memory for the pool: it stays NULL and the passes run serially.
+    wx_pool *pool = NULL;
+    if (def->threads > 1) {
+        wx_pool_create(def->threads, &pool, NULL);
+    }
     const int tiles = job.tiles_x * job.tiles_y;
     const int bands = (out->height + ROWS_PER_ITEM - 1) / ROWS_PER_ITEM;
 
@@ -701,11 +683,11 @@ wx_result wx_gather_compute(const wx_gather_def *def, float *mask_out, wx_gather
     wx_progress_begin(&progress, "gather", tiles + (second ? bands : 0), def->quiet);
     job.progress = &progress;
     double t0 = wx_now_s();
-    run_pass(&job, 1, tiles, threads);
+    run_pass(&job, 1, tiles, pool);
     double t1 = wx_now_s();
     if (second) {
         job.progress_base = tiles;
-        run_pass(&job, 2, bands, threads);
+        run_pass(&job, 2, bands, pool);
     }
     double t2 = wx_now_s();
     wx_progress_end(&progress);
@@ -730,6 +712,7 @@ wx_result wx_gather_compute(const wx_gather_def *def, float *mask_out, wx_gather
         stats->first_pass_s = t1 - t0;
         stats->second_pass_s = t2 - t1;
     }
+    wx_pool_destroy(pool);
     free(scratch);
     free(offsets);
     free(cams);

@@ -21,7 +21,6 @@
 #include "sim/simulate.h"
 
 #include <math.h>
-#include <pthread.h>
 #include <sched.h>
 #include <stdatomic.h>
 #include <stdio.h>
@@ -88,10 +87,8 @@ typedef struct sim_chunk {
     atomic_int done; ///< set (release) when the chunk's records are complete
 } sim_chunk;
 
+// The state of one worker of the pool (wx_pool worker index = array index).
 typedef struct sim_worker {
-    struct wx_sim *sim;
-    int index;
-    pthread_t thread;
     sim_chunk *chunk; ///< the chunk being stepped
     sim_candidate *cands;
     int64_t cand_count, cand_capacity;
@@ -133,14 +130,8 @@ struct wx_sim {
     sim_chunk *chunks;
     int64_t chunk_particles;             ///< particles per chunk
     int64_t chunk_count, chunk_capacity; ///< chunks of this step, allocated
-    atomic_int_fast64_t next_chunk;      ///< the next chunk a thread takes
     int64_t applied;                     ///< chunks whose events are applied
-    pthread_mutex_t lock;
-    pthread_cond_t start, done;
-    uint64_t generation;
-    int pending;
-    bool quit;
-    bool pool_started;
+    wx_pool *pool; ///< the threads (core/parallel.h)
 };
 
 // --- per-thread recording -------------------------------------------------------
@@ -520,50 +511,23 @@ static void apply_ready(wx_sim *sim, bool wait)
 
 // --- the thread pool -----------------------------------------------------------
 
-// Steps chunks until none is left; the calling thread (`apply`) also applies
-// what is ready after each of its chunks.
-static void take_chunks(wx_sim *sim, sim_worker *w, bool apply)
+// Steps chunks [begin, end) on pool worker `worker`; the calling thread (worker
+// 0) also applies what is ready after each of its chunks.
+static void step_chunks(int64_t begin, int64_t end, int worker, void *context)
 {
+    wx_sim *sim = context;
+    sim_worker *w = &sim->workers[worker];
     int64_t n = sim->particles.count;
-    for (;;) {
-        int64_t c = atomic_fetch_add_explicit(&sim->next_chunk, 1, memory_order_relaxed);
-        if (c >= sim->chunk_count) {
-            return;
-        }
-        int64_t begin = c * sim->chunk_particles;
-        int64_t end = n - begin < sim->chunk_particles ? n : begin + sim->chunk_particles;
+    for (int64_t c = begin; c < end; ++c) {
+        int64_t first = c * sim->chunk_particles;
+        int64_t last = n - first < sim->chunk_particles ? n : first + sim->chunk_particles;
         w->chunk = &sim->chunks[c];
-        step_range(sim, w, begin, end);
+        step_range(sim, w, first, last);
         atomic_store_explicit(&sim->chunks[c].done, 1, memory_order_release);
-        if (apply) {
+        if (worker == 0) {
             apply_ready(sim, false);
         }
     }
-}
-
-static void *worker_main(void *arg)
-{
-    sim_worker *w = arg;
-    wx_sim *sim = w->sim;
-    uint64_t seen = 0;
-    pthread_mutex_lock(&sim->lock);
-    for (;;) {
-        while (sim->generation == seen && !sim->quit) {
-            pthread_cond_wait(&sim->start, &sim->lock);
-        }
-        if (sim->quit) {
-            break;
-        }
-        seen = sim->generation;
-        pthread_mutex_unlock(&sim->lock);
-        take_chunks(sim, w, false);
-        pthread_mutex_lock(&sim->lock);
-        if (--sim->pending == 0) {
-            pthread_cond_signal(&sim->done);
-        }
-    }
-    pthread_mutex_unlock(&sim->lock);
-    return NULL;
 }
 
 // One chunk record per chunk_particles particles, reset for a new step. Records
@@ -593,33 +557,18 @@ static wx_result prepare_chunks(wx_sim *sim, wx_error *err)
     }
     sim->chunk_count = count;
     sim->applied = 0;
-    atomic_store_explicit(&sim->next_chunk, 0, memory_order_relaxed);
     for (int t = 0; t < sim->thread_count; ++t) {
         sim->workers[t].failed = false;
     }
     return WX_OK;
 }
 
-// Steps every particle and applies every event (phases 1 and 2).
+// Steps every particle and applies every event (phases 1 and 2): the pool's
+// workers claim chunks in turn, the calling thread applies them in order.
 static void run_workers(wx_sim *sim)
 {
-    int T = sim->thread_count;
-    if (T > 1) {
-        pthread_mutex_lock(&sim->lock);
-        sim->pending = T - 1;
-        sim->generation++;
-        pthread_cond_broadcast(&sim->start);
-        pthread_mutex_unlock(&sim->lock);
-    }
-    take_chunks(sim, &sim->workers[0], true);
+    wx_pool_for(sim->pool, sim->chunk_count, 1, step_chunks, sim);
     apply_ready(sim, true);
-    if (T > 1) {
-        pthread_mutex_lock(&sim->lock);
-        while (sim->pending > 0) {
-            pthread_cond_wait(&sim->done, &sim->lock);
-        }
-        pthread_mutex_unlock(&sim->lock);
-    }
 }
 
 // --- the serial phases -----------------------------------------------------------
@@ -734,23 +683,14 @@ wx_sim_def wx_default_sim_def(const wx_scene *scene)
 
 static wx_result start_pool(wx_sim *sim, wx_error *err)
 {
+    wx_result r = wx_pool_create(sim->thread_count, &sim->pool, err);
+    if (r != WX_OK) {
+        return r;
+    }
+    sim->thread_count = wx_pool_threads(sim->pool); // fewer when a thread could not start
     sim->workers = calloc((size_t)sim->thread_count, sizeof *sim->workers);
     if (sim->workers == NULL) {
         return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (threads)");
-    }
-    for (int t = 0; t < sim->thread_count; ++t) {
-        sim->workers[t].sim = sim;
-        sim->workers[t].index = t;
-    }
-    pthread_mutex_init(&sim->lock, NULL);
-    pthread_cond_init(&sim->start, NULL);
-    pthread_cond_init(&sim->done, NULL);
-    sim->pool_started = true;
-    for (int t = 1; t < sim->thread_count; ++t) {
-        if (pthread_create(&sim->workers[t].thread, NULL, worker_main, &sim->workers[t]) != 0) {
-            sim->thread_count = t; // the ones started are stopped by destroy
-            return wx_fail(err, WX_CAUSE_THREAD, "cannot start simulation thread %d", t);
-        }
     }
     return WX_OK;
 }
@@ -864,18 +804,7 @@ void wx_sim_destroy(wx_sim *sim)
     if (sim == NULL) {
         return;
     }
-    if (sim->pool_started) {
-        pthread_mutex_lock(&sim->lock);
-        sim->quit = true;
-        pthread_cond_broadcast(&sim->start);
-        pthread_mutex_unlock(&sim->lock);
-        for (int t = 1; t < sim->thread_count; ++t) {
-            pthread_join(sim->workers[t].thread, NULL);
-        }
-        pthread_mutex_destroy(&sim->lock);
-        pthread_cond_destroy(&sim->start);
-        pthread_cond_destroy(&sim->done);
-    }
+    wx_pool_destroy(sim->pool);
     if (sim->workers != NULL) {
         for (int t = 0; t < sim->thread_count; ++t) {
             free(sim->workers[t].cands);
