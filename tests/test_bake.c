@@ -41,8 +41,8 @@ static const char *data_path(const char *name)
 static void scene_begin(wx_scene *s)
 {
     memset(s, 0, sizeof *s);
-    snprintf(s->path, sizeof s->path, "scene.xml");
-    snprintf(s->dir, sizeof s->dir, ".");
+    wx_scene_set_path(&s->path, "scene.xml");
+    wx_scene_set_path(&s->dir, ".");
     snprintf(s->name, sizeof s->name, "scene");
     s->output_index = -1;
 }
@@ -88,7 +88,7 @@ static wx_mesh *add_mesh(wx_scene *s, const char *path, int line)
     s->meshes = realloc(s->meshes, (size_t)(s->mesh_count + 1) * sizeof *s->meshes);
     wx_mesh *m = &s->meshes[s->mesh_count++];
     memset(m, 0, sizeof *m);
-    snprintf(m->path, sizeof m->path, "%s", path);
+    wx_scene_set_path(&m->path, path);
     m->line = line;
     return m;
 }
@@ -111,12 +111,7 @@ static wx_surface *add_surface(wx_mesh *m, const char *material, float absorptio
 
 static void scene_end(wx_scene *s)
 {
-    for (int i = 0; i < s->mesh_count; ++i) {
-        free(s->meshes[i].surfaces);
-    }
-    free(s->meshes);
-    free(s->cameras);
-    memset(s, 0, sizeof *s);
+    wx_scene_free(s);
 }
 
 static void options_for(wx_run_def *o, const char *test)
@@ -489,7 +484,7 @@ TEST(unmatched_material_lists_names)
     ENSURE(ensure_contains(err.message, "scene.xml:42: mesh '"));
     ENSURE(ensure_contains(err.message, "bake_two_materials.obj' has material 'Wood' that no "
                                         "<Surface> matches (materials in the file: Wood, Glass)"));
-    ENSURE(s.cameras[0].depth_path[0] == '\0');
+    ENSURE(!wx_has_path(s.cameras[0].depth_path));
     scene_end(&s);
 }
 
@@ -727,7 +722,7 @@ TEST(output_camera_gets_depth_and_normal_only)
     const wx_scene_camera *shot = &s.cameras[1];
     ENSURE(ensure_contains(shot->depth_path, "shot_depth.exr"));
     ENSURE(ensure_contains(shot->normal_path, "shot_normal.exr"));
-    ENSURE(shot->impact_path[0] == '\0' && shot->dirt_path[0] == '\0');
+    ENSURE(!wx_has_path(shot->impact_path) && !wx_has_path(shot->dirt_path));
     char path[4200];
     snprintf(path, sizeof path, "%s/shot_impact.exr", o.out_dir);
     struct stat st;
@@ -767,7 +762,7 @@ TEST(missing_and_unsupported_mesh_files)
         ENSURE(wx_bake_scene(&s, &o, &err) == WX_BAD_INPUT);
         ENSURE(ensure_contains(err.message, "scene.xml:7"));
         ENSURE(ensure_contains(err.message, files[k]));
-        ENSURE(s.cameras[0].depth_path[0] == '\0');
+        ENSURE(!wx_has_path(s.cameras[0].depth_path));
         scene_end(&s);
     }
 }
@@ -785,7 +780,7 @@ TEST(no_geometry_is_an_error)
     ENSURE(ensure_contains(err.message, "camera 'front'"));
     ENSURE(ensure_contains(err.message, "no <Geometry>"));
     // Nothing to bake (maps given): no mesh needed, nothing written.
-    snprintf(s.cameras[0].depth_path, WX_PATH_MAX, "given.exr");
+    wx_scene_set_path(&s.cameras[0].depth_path, "given.exr");
     ENSURE(wx_bake_scene(&s, &o, &err) == WX_OK);
     scene_end(&s);
 }
@@ -894,7 +889,7 @@ TEST(scene_file_bakes_maps_the_scene_reads_back)
         wx_maps_free(&m);
     }
     const wx_scene_camera *shot = &s.cameras[2];
-    ENSURE(shot->is_output && shot->impact_path[0] == '\0');
+    ENSURE(shot->is_output && !wx_has_path(shot->impact_path));
     wx_maps m;
     memset(&m, 0, sizeof m);
     ENSURE(wx_maps_load(&m, WX_MAPS_DEPTH | WX_MAPS_NORMAL, shot->depth_path, shot->normal_path,
@@ -919,7 +914,7 @@ TEST(scene_file_bakes_maps_the_scene_reads_back)
 
     // A later phase in another process finds the baked maps in the same folder.
     ENSURE(wx_scene_load(path, &s, &err) == WX_OK);
-    ENSURE(s.cameras[0].depth_path[0] == '\0');
+    ENSURE(!wx_has_path(s.cameras[0].depth_path));
     r = wx_use_baked_maps(&s, &o, &err);
     if (r != WX_OK) {
         fprintf(stderr, "%s\n", err.message);

@@ -680,6 +680,7 @@ typedef struct file_scene {
     wx_run_def opts;
     test_maps in, out;
     char dir[2048];
+    char paths[6][WX_PATH_MAX]; ///< the maps' and the scene's paths the structs point at
 } file_scene;
 
 // Input camera "front" (maps in dir/maps, simulated dirt in dir/out unless
@@ -723,19 +724,25 @@ static bool make_file_scene(file_scene *fs, const char *tag, bool no_simulated)
     wx_scene_camera *in = &fs->cams[0], *out = &fs->cams[1];
     snprintf(in->name, sizeof in->name, "front");
     in->camera = fs->in.cam;
-    snprintf(in->depth_path, WX_PATH_MAX, "%s/front_depth.exr", maps_dir);
-    snprintf(in->normal_path, WX_PATH_MAX, "%s/front_normal.exr", maps_dir);
-    snprintf(in->dirt_path, WX_PATH_MAX, "%s/front_dirt.exr", maps_dir);
+    snprintf(fs->paths[0], WX_PATH_MAX, "%s/front_depth.exr", maps_dir);
+    snprintf(fs->paths[1], WX_PATH_MAX, "%s/front_normal.exr", maps_dir);
+    snprintf(fs->paths[2], WX_PATH_MAX, "%s/front_dirt.exr", maps_dir);
+    in->depth_path = fs->paths[0];
+    in->normal_path = fs->paths[1];
+    in->dirt_path = fs->paths[2];
     snprintf(out->name, sizeof out->name, "out");
     out->is_output = true;
     out->camera = fs->out.cam;
-    snprintf(out->depth_path, WX_PATH_MAX, "%s/out_depth.exr", maps_dir);
-    snprintf(out->normal_path, WX_PATH_MAX, "%s/out_normal.exr", maps_dir);
+    snprintf(fs->paths[3], WX_PATH_MAX, "%s/out_depth.exr", maps_dir);
+    snprintf(fs->paths[4], WX_PATH_MAX, "%s/out_normal.exr", maps_dir);
+    out->depth_path = fs->paths[3];
+    out->normal_path = fs->paths[4];
     snprintf(out->output_file, sizeof out->output_file, "mask.exr");
     out->output_width = 40;
     out->output_height = 30;
     out->radius = 0.0f;
-    snprintf(fs->scene.path, WX_PATH_MAX, "%s/scene.xml", fs->dir);
+    snprintf(fs->paths[5], WX_PATH_MAX, "%s/scene.xml", fs->dir);
+    fs->scene.path = fs->paths[5];
     fs->scene.cameras = fs->cams;
     fs->scene.camera_count = 2;
     fs->scene.input_count = 1;

@@ -64,9 +64,12 @@ TEST(an_input_file_is_never_an_output)
     wx_scene_camera cam = { 0 };
     scene.cameras = &cam;
     scene.camera_count = 1;
-    snprintf(scene.path, sizeof scene.path, "%s", ensure_write_file(dir, "s.xml", "<x/>"));
-    snprintf(cam.depth_path, sizeof cam.depth_path, "%s",
+    char scene_path[WX_PATH_MAX], depth_path[WX_PATH_MAX]; // the structs only point at them
+    snprintf(scene_path, sizeof scene_path, "%s", ensure_write_file(dir, "s.xml", "<x/>"));
+    snprintf(depth_path, sizeof depth_path, "%s",
              ensure_write_file(dir, "front_depth.exr", "not really"));
+    scene.path = scene_path;
+    cam.depth_path = depth_path;
     wx_run_def opts = { 0 };
     snprintf(opts.out_dir, sizeof opts.out_dir, "%s", dir);
     char path[WX_PATH_MAX];

@@ -176,7 +176,7 @@ TEST(element_defaults)
     // 2 output texels: the frame is 4 m wide over 8 texels.
     ENSURE_NEAR(out->radius, 1.0, 1e-6);
     ENSURE(out->second_pass == WX_SECOND_PASS_MEAN && !out->normalize);
-    ENSURE(out->impact_path[0] == '\0' && out->dirt_path[0] == '\0');
+    ENSURE(!wx_has_path(out->impact_path) && !wx_has_path(out->dirt_path));
 
     ENSURE(s.mesh_count == 1 && s.meshes[0].surface_count == 1);
     ENSURE(strcmp(s.meshes[0].path, data_path("box.obj")) == 0);
@@ -244,7 +244,7 @@ TEST(full_scene)
     ENSURE(side->view.width_ws == 4.0f && side->view.height_ws == 2.0f);
     ENSURE(side->view.width_px == 8 && side->view.height_px == 4);
     ENSURE(side->camera.width == 8 && side->camera.height == 4);
-    ENSURE(side->depth_path[0] == '\0' && side->dirt_path[0] == '\0');
+    ENSURE(!wx_has_path(side->depth_path) && !wx_has_path(side->dirt_path));
 
     const wx_scene_camera *top = &s.cameras[2];
     ENSURE(top->has_view && top->view.up[2] == -1.0f);
@@ -319,7 +319,7 @@ TEST(view_camera_matrices)
     ENSURE(out->is_output && strcmp(out->output_file, "mask.exr") == 0);
     ENSURE(out->output_width == 8 && out->output_height == 4);
     ENSURE_NEAR(out->radius, 1.0, 1e-6);
-    ENSURE(out->depth_path[0] == '\0');
+    ENSURE(!wx_has_path(out->depth_path));
     wx_scene_free(&s);
 }
 

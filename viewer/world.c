@@ -7,6 +7,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "core/array.h"
 #include "gather/gather.h"
 #include "io/maps_file.h"
 #include "io/scene_xml.h"
@@ -49,7 +50,7 @@ wx_result vw_world_parse(vw_world *world, const vw_settings *settings, wx_error 
 static bool file_mtime(const char *path, struct timespec *out)
 {
     struct stat st;
-    if (path[0] == '\0' || stat(path, &st) != 0) {
+    if (!wx_has_path(path) || stat(path, &st) != 0) {
         return false;
     }
     *out = st.st_mtim;
@@ -115,7 +116,7 @@ bool vw_world_needs_bake(const vw_world *world, const vw_world *running)
     struct timespec oldest = { 0, 0 };
     for (int c = 0; c < scene->camera_count; ++c) {
         const wx_scene_camera *cam = &scene->cameras[c];
-        if (!cam->has_view || cam->depth_path[0] != '\0') {
+        if (!cam->has_view || wx_has_path(cam->depth_path)) {
             continue;
         }
         int count = cam->is_output ? 2 : 4;
@@ -156,21 +157,16 @@ bool vw_world_needs_bake(const vw_world *world, const vw_world *running)
 typedef struct vertex_list {
     vw_vertex *data;
     int count;
-    int capacity;
+    int64_t capacity;
     bool failed;
 } vertex_list;
 
 static void push_vertex(vertex_list *list, const float p[3], const float color[3])
 {
-    if (list->count == list->capacity) {
-        int capacity = list->capacity > 0 ? 2 * list->capacity : 256;
-        vw_vertex *bigger = realloc(list->data, (size_t)capacity * sizeof *bigger);
-        if (bigger == NULL) {
-            list->failed = true;
-            return;
-        }
-        list->data = bigger;
-        list->capacity = capacity;
+    if (!wx_array_reserve((void **)&list->data, &list->capacity, (int64_t)list->count + 1,
+                          sizeof *list->data, 256)) {
+        list->failed = true;
+        return;
     }
     vw_vertex *v = &list->data[list->count++];
     memcpy(v->position, p, sizeof v->position);
@@ -440,14 +436,14 @@ static wx_result load_maps(vw_world *world, wx_error *err)
     }
     for (int c = 0; c < n; ++c) {
         const wx_scene_camera *cam = &scene->cameras[c];
-        if (cam->depth_path[0] == '\0') {
+        if (!wx_has_path(cam->depth_path)) {
             return wx_fail(err, WX_CAUSE_MISSING_PHASE, "%s: camera '%s' has no maps; run `weathering bake %s` first",
                                 scene->path, cam->name, scene->path);
         }
         unsigned which = WX_MAPS_DEPTH | WX_MAPS_NORMAL;
         if (!cam->is_output) {
             which |= WX_MAPS_IMPACT;
-            if (cam->dirt_path[0] != '\0') {
+            if (wx_has_path(cam->dirt_path)) {
                 // After G the file holds simulated dirt; start from its initialDirt.
                 which |= WX_MAPS_DIRT | WX_MAPS_INITIAL_DIRT;
             }

@@ -30,6 +30,7 @@
 #include <libxml/tree.h>
 #include <libxml/xmlerror.h>
 
+#include "core/array.h"
 #include "core/matrix.h"
 #include "io/exr.h"
 #include "core/input_file.h"
@@ -62,7 +63,7 @@ typedef struct parser {
     const char *path; ///< the scene file as given, the prefix of every message
     wx_error *err;
     wx_scene *scene;
-    int field_cap, emitter_cap, camera_cap, mesh_cap;
+    int64_t field_cap, emitter_cap, camera_cap, mesh_cap;
     const xmlNode *collider; ///< <Collider>, once seen
 } parser;
 
@@ -112,19 +113,11 @@ static wx_result out_of_memory(parser *p)
     return wx_fail(p->err, WX_CAUSE_OUT_OF_MEMORY, "%s: out of memory", p->path);
 }
 
-/// Makes room for one more item of an array that grows by doubling; returns the
+/// Makes room for one more item of an array (core/array.h); returns the
 /// (possibly moved) array, or NULL when out of memory (the old one is kept).
-static void *reserve(void *items, int count, int *capacity, size_t item_size)
+static void *reserve(void *items, int count, int64_t *capacity, size_t item_size)
 {
-    if (count < *capacity) {
-        return items;
-    }
-    int cap = *capacity > 0 ? *capacity * 2 : 4;
-    void *grown = realloc(items, (size_t)cap * item_size);
-    if (grown != NULL) {
-        *capacity = cap;
-    }
-    return grown;
+    return wx_array_reserve(&items, capacity, (int64_t)count + 1, item_size, 4) ? items : NULL;
 }
 
 // ---------------------------------------------------------------------------
@@ -356,7 +349,8 @@ typedef enum attr_type {
     T_MATRIX,     ///< float[16]
     T_RESOLUTION, ///< int[2], "px [py]" in [lo, hi]
     T_NAME,       ///< plain name: letters digits _ - . , not starting with '.'
-    T_TEXT,       ///< any non-empty text (paths, labels)
+    T_TEXT,       ///< any non-empty text (labels), into a buffer of `size`
+    T_STRING,     ///< any non-empty text shorter than `size` (paths), as an owned char *
     T_ENUM,       ///< int: index into `choices`
 } attr_type;
 
@@ -373,7 +367,7 @@ typedef struct attr_spec {
     size_t offset;  ///< where the value goes in the destination struct
     attr_range range;
     long long lo, hi;            ///< T_INT, T_INT64, T_RESOLUTION bounds (inclusive)
-    size_t size;                 ///< T_NAME, T_TEXT: buffer size with the NUL
+    size_t size;                 ///< T_NAME, T_TEXT: buffer size with the NUL; T_STRING: limit
     const char *const *choices;  ///< T_ENUM: NULL-terminated
     bool required;
 } attr_spec;
@@ -706,6 +700,10 @@ static wx_result parse_text_value(parser *p, const xmlNode *node, const attr_spe
             return fail(p, node, WX_CAUSE_BAD_VALUE, "<%s> %s holds a control character", name_of(node), s->name);
         }
     }
+    if (s->type == T_STRING) {
+        char **slot = dst;
+        return wx_scene_set_path(slot, text) ? WX_OK : out_of_memory(p);
+    }
     memcpy(dst, text, len + 1);
     return WX_OK;
 }
@@ -729,6 +727,7 @@ static wx_result parse_value(parser *p, const xmlNode *node, const attr_spec *s,
         return parse_keyword_value(p, node, s, text, dst);
     case T_NAME:
     case T_TEXT:
+    case T_STRING:
         return parse_text_value(p, node, s, text, dst);
     }
     return fail(p, node, WX_CAUSE_BAD_ARGUMENT, "internal error: unknown attribute type");
@@ -850,23 +849,24 @@ static wx_result parse_children(parser *p, const xmlNode *parent, const child_sp
 // ---------------------------------------------------------------------------
 // Paths
 
-/// Resolves `file` against the scene's folder (absolute paths stay as they are).
-static wx_result resolve_path(parser *p, const xmlNode *node, const char *file,
-                              char out[WX_PATH_MAX])
+/// Resolves `file` against the scene's folder (absolute paths stay as they are)
+/// into the owned string *out.
+static wx_result resolve_path(parser *p, const xmlNode *node, const char *file, char **out)
 {
     const char *dir = p->scene->dir;
+    char joined[WX_PATH_MAX];
     int n;
     if (file[0] == '/' || strcmp(dir, ".") == 0) {
-        n = snprintf(out, WX_PATH_MAX, "%s", file);
+        n = snprintf(joined, sizeof joined, "%s", file);
     } else {
         size_t len = strlen(dir);
-        n = snprintf(out, WX_PATH_MAX, "%s%s%s", dir, len > 0 && dir[len - 1] == '/' ? "" : "/",
-                     file);
+        n = snprintf(joined, sizeof joined, "%s%s%s", dir,
+                     len > 0 && dir[len - 1] == '/' ? "" : "/", file);
     }
-    if (n < 0 || n >= WX_PATH_MAX) {
+    if (n < 0 || n >= (int)sizeof joined) {
         return fail(p, node, WX_CAUSE_PATH_TOO_LONG, "path '%.200s...' is too long", file);
     }
-    return WX_OK;
+    return wx_scene_set_path(out, joined) ? WX_OK : out_of_memory(p);
 }
 
 // ---------------------------------------------------------------------------
@@ -1127,11 +1127,11 @@ static const attr_spec matrix_attrs[] = {
 };
 
 typedef struct map_def {
-    char file[WX_PATH_MAX];
+    char *file; ///< owned
 } map_def;
 
 static const attr_spec map_attrs[] = {
-    { "file", T_TEXT, offsetof(map_def, file), .size = WX_PATH_MAX, .required = true },
+    { "file", T_STRING, offsetof(map_def, file), .size = WX_PATH_MAX, .required = true },
 };
 
 typedef struct output_def {
@@ -1179,7 +1179,7 @@ typedef struct ortho_def {
     const xmlNode *ctw_node, *wtc_node, *view_node, *output_node;
     float ctw[16], wtc[16];
     const xmlNode *map_nodes[MAP_KINDS];
-    char map_files[MAP_KINDS][WX_PATH_MAX]; ///< as written in the scene
+    char *map_files[MAP_KINDS]; ///< as written in the scene (owned)
     unsigned output_present;
 } ortho_def;
 
@@ -1204,16 +1204,15 @@ static wx_result parse_map(parser *p, const xmlNode *node, void *user)
     while (k < MAP_KINDS && strcmp(map_elements[k], name_of(node)) != 0) {
         ++k;
     }
-    map_def *m = malloc(sizeof *m); // 4 KiB: off the stack
-    if (m == NULL) {
-        return out_of_memory(p);
-    }
-    wx_result r = ATTRS(map_attrs, m, NULL);
+    map_def m = { NULL };
+    wx_result r = ATTRS(map_attrs, &m, NULL);
     if (r == WX_OK) {
-        memcpy(o->map_files[k], m->file, sizeof m->file);
+        free(o->map_files[k]);
+        o->map_files[k] = m.file;
         o->map_nodes[k] = node;
+    } else {
+        free(m.file);
     }
-    free(m);
     return r;
 }
 
@@ -1329,8 +1328,8 @@ static wx_result camera_matrices(parser *p, const xmlNode *node, ortho_def *o)
 static wx_result camera_maps(parser *p, const xmlNode *node, ortho_def *o)
 {
     wx_scene_camera *cam = o->cam;
-    char *paths[MAP_KINDS] = { cam->depth_path, cam->normal_path, cam->impact_path,
-                               cam->dirt_path };
+    char **paths[MAP_KINDS] = { &cam->depth_path, &cam->normal_path, &cam->impact_path,
+                                &cam->dirt_path };
     int needed = cam->is_output ? 2 : 4; // depth, normal (+ impact, dirt for inputs)
     int named = 0;
     for (int k = 0; k < needed; ++k) {
@@ -1358,19 +1357,20 @@ static wx_result camera_maps(parser *p, const xmlNode *node, ortho_def *o)
         }
         const char *file = o->map_files[k];
         wx_result r = resolve_path(p, map, file, paths[k]);
+        const char *path = *paths[k];
         if (r != WX_OK) {
             return r;
         }
         char why[WX_INPUT_WHY_MAX];
         wx_cause cause = WX_CAUSE_NONE;
-        if (!wx_is_regular_file(paths[k], why, &cause)) {
+        if (!wx_is_regular_file(path, why, &cause)) {
             return fail(p, map, cause, "map file '%s' %s", file,
                         cause == WX_CAUSE_FILE_MISSING ? "not found" : why);
         }
         wx_image header;
         wx_error exr_err;
         memset(&header, 0, sizeof header);
-        r = wx_exr_read_header(paths[k], &header, &exr_err);
+        r = wx_exr_read_header(path, &header, &exr_err);
         int w = header.width, h = header.height;
         wx_image_free(&header);
         if (r != WX_OK) {
@@ -1484,16 +1484,14 @@ static wx_result parse_ortho(parser *p, const xmlNode *node, void *user)
     }
     s->camera_count++;
 
-    ortho_def *o = calloc(1, sizeof *o); // 16 KiB of file names: off the stack
-    if (o == NULL) {
-        return out_of_memory(p);
+    ortho_def o = { .cam = cam };
+    if ((r = CHILDREN(ortho_children, &o, NULL)) == WX_OK &&
+        (r = camera_matrices(p, node, &o)) == WX_OK && (r = camera_maps(p, node, &o)) == WX_OK) {
+        r = camera_output(p, node, &o);
     }
-    o->cam = cam;
-    if ((r = CHILDREN(ortho_children, o, NULL)) == WX_OK &&
-        (r = camera_matrices(p, node, o)) == WX_OK && (r = camera_maps(p, node, o)) == WX_OK) {
-        r = camera_output(p, node, o);
+    for (int k = 0; k < MAP_KINDS; ++k) {
+        free(o.map_files[k]);
     }
-    free(o);
     return r;
 }
 
@@ -1555,7 +1553,7 @@ static const attr_spec surface_attrs[] = {
 
 typedef struct mesh_state {
     wx_mesh *mesh;
-    int surface_cap;
+    int64_t surface_cap;
 } mesh_state;
 
 static wx_result parse_surface(parser *p, const xmlNode *node, void *user)
@@ -1592,7 +1590,7 @@ static wx_result parse_surface(parser *p, const xmlNode *node, void *user)
 }
 
 static const attr_spec mesh_attrs[] = {
-    { "file", T_TEXT, offsetof(map_def, file), .size = WX_PATH_MAX, .required = true },
+    { "file", T_STRING, offsetof(map_def, file), .size = WX_PATH_MAX, .required = true },
 };
 
 static const child_spec mesh_children[] = {
@@ -1614,19 +1612,16 @@ static wx_result parse_mesh(parser *p, const xmlNode *node, void *user)
     wx_mesh *mesh = &grown[s->mesh_count++];
     memset(mesh, 0, sizeof *mesh);
     mesh->line = line_of(node);
-    map_def *file = malloc(sizeof *file);
-    if (file == NULL) {
-        return out_of_memory(p);
-    }
-    wx_result r = ATTRS(mesh_attrs, file, NULL);
+    map_def file = { NULL };
+    wx_result r = ATTRS(mesh_attrs, &file, NULL);
     char why[WX_INPUT_WHY_MAX];
     wx_cause cause = WX_CAUSE_NONE;
-    if (r == WX_OK && (r = resolve_path(p, node, file->file, mesh->path)) == WX_OK &&
+    if (r == WX_OK && (r = resolve_path(p, node, file.file, &mesh->path)) == WX_OK &&
         !wx_is_regular_file(mesh->path, why, &cause)) {
-        r = fail(p, node, cause, "mesh file '%s' %s", file->file,
+        r = fail(p, node, cause, "mesh file '%s' %s", file.file,
                  cause == WX_CAUSE_FILE_MISSING ? "not found" : why);
     }
-    free(file);
+    free(file.file);
     mesh_state m = { .mesh = mesh };
     return r != WX_OK ? r : CHILDREN(mesh_children, &m, NULL);
 }
@@ -1704,14 +1699,17 @@ static wx_result scene_init(wx_scene *s, const char *path, wx_error *err)
     if (strlen(path) >= WX_PATH_MAX) {
         return wx_fail(err, WX_CAUSE_PATH_TOO_LONG, "%.200s...: path too long", path);
     }
-    snprintf(s->path, sizeof s->path, "%s", path);
     const char *slash = strrchr(path, '/');
+    char dir[WX_PATH_MAX];
     if (slash == NULL) {
-        snprintf(s->dir, sizeof s->dir, ".");
+        snprintf(dir, sizeof dir, ".");
     } else if (slash == path) {
-        snprintf(s->dir, sizeof s->dir, "/");
+        snprintf(dir, sizeof dir, "/");
     } else {
-        snprintf(s->dir, sizeof s->dir, "%.*s", (int)(slash - path), path);
+        snprintf(dir, sizeof dir, "%.*s", (int)(slash - path), path);
+    }
+    if (!wx_scene_set_path(&s->path, path) || !wx_scene_set_path(&s->dir, dir)) {
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "%s: out of memory", path);
     }
     const char *base = slash != NULL ? slash + 1 : path;
     const char *dot = strrchr(base, '.');

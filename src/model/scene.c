@@ -17,11 +17,27 @@ double wx_scene_duration(const wx_scene *scene)
 
 const char *wx_mesh_display_name(const wx_scene *scene, const wx_mesh *mesh)
 {
-    size_t n = strlen(scene->dir);
+    size_t n = scene->dir != NULL ? strlen(scene->dir) : 0;
     if (n > 0 && strncmp(mesh->path, scene->dir, n) == 0 && mesh->path[n] == '/') {
         return mesh->path + n + 1;
     }
     return mesh->path;
+}
+
+bool wx_scene_set_path(char **slot, const char *path)
+{
+    char *copy = NULL;
+    if (path != NULL) {
+        size_t n = strlen(path) + 1;
+        copy = malloc(n);
+        if (copy == NULL) {
+            return false;
+        }
+        memcpy(copy, path, n);
+    }
+    free(*slot);
+    *slot = copy;
+    return true;
 }
 
 void wx_scene_free(wx_scene *scene)
@@ -31,9 +47,19 @@ void wx_scene_free(wx_scene *scene)
     }
     for (int m = 0; m < scene->mesh_count; ++m) {
         free(scene->meshes[m].surfaces);
+        free(scene->meshes[m].path);
     }
     free(scene->meshes);
+    for (int c = 0; c < scene->camera_count; ++c) {
+        wx_scene_camera *cam = &scene->cameras[c];
+        free(cam->depth_path);
+        free(cam->normal_path);
+        free(cam->impact_path);
+        free(cam->dirt_path);
+    }
     free(scene->cameras);
+    free(scene->path);
+    free(scene->dir);
     free(scene->emitters);
     free(scene->fields);
     memset(scene, 0, sizeof *scene);

@@ -67,12 +67,12 @@ typedef struct wx_scene_camera {
     wx_camera camera;  ///< matrices, and map size (from the maps or the View)
     bool has_view;     ///< given by <View> rather than (only) by matrices
     wx_view view;
-    /// Map files resolved against the scene's folder; "" where the scene names
-    /// none (a <View> camera whose maps `bake` will write).
-    char depth_path[WX_PATH_MAX];
-    char normal_path[WX_PATH_MAX];
-    char impact_path[WX_PATH_MAX];
-    char dirt_path[WX_PATH_MAX];
+    /// Map files resolved against the scene's folder (owned strings); NULL where
+    /// the scene names none (a <View> camera whose maps `bake` will write).
+    char *depth_path;
+    char *normal_path;
+    char *impact_path;
+    char *dirt_path;
     /// The map paths point at maps this program wrote into the output folder
     /// (`bake`), not at files the scene names: later phases may replace them.
     bool maps_in_output;
@@ -105,15 +105,15 @@ typedef struct wx_surface {
 } wx_surface;
 
 typedef struct wx_mesh {
-    char path[WX_PATH_MAX]; ///< resolved against the scene's folder
+    char *path; ///< resolved against the scene's folder (owned)
     wx_surface *surfaces;
     int surface_count;
     int line;
 } wx_mesh;
 
 typedef struct wx_scene {
-    char path[WX_PATH_MAX]; ///< the scene file as given
-    char dir[WX_PATH_MAX];  ///< its folder (relative paths resolve here)
+    char *path;             ///< the scene file as given (owned)
+    char *dir;              ///< its folder, where relative paths resolve (owned)
     char name[256];         ///< file name without folder and extension
 
     float bbox_size;        ///< BoundingBox cube side, default 100
@@ -137,7 +137,17 @@ typedef struct wx_scene {
     int mesh_count;
 } wx_scene;
 
-/// Default collider parameters (DESIGN section 3).
+/// True when a path is given (not NULL, not empty).
+static inline bool wx_has_path(const char *path)
+{
+    return path != NULL && path[0] != '\0';
+}
+
+/// Replaces the owned string *slot by a copy of `path` (NULL: none). Returns
+/// false when out of memory (*slot is then unchanged).
+bool wx_scene_set_path(char **slot, const char *path);
+
+/// Default collider parameters (docs/design.md section 3).
 wx_collider_def wx_default_collider_def(void);
 
 /// The mesh path as the scene file wrote it (relative to the scene's folder).

@@ -79,9 +79,11 @@ static wx_result write_maps(int camera, wx_image *maps, int count, void *user, w
             return w->files[k].result;
         }
     }
-    char *dest[4] = { sc->depth_path, sc->normal_path, sc->impact_path, sc->dirt_path };
+    char **dest[4] = { &sc->depth_path, &sc->normal_path, &sc->impact_path, &sc->dirt_path };
     for (int k = 0; k < count; ++k) {
-        memcpy(dest[k], w->files[k].path, WX_PATH_MAX);
+        if (!wx_scene_set_path(dest[k], w->files[k].path)) {
+            return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "bake: out of memory");
+        }
     }
     sc->maps_in_output = true; // ours: later phases may replace them
     return WX_OK;
@@ -104,7 +106,7 @@ static wx_result read_given_depths(const wx_scene *scene, const wx_geometry *geo
     *given = maps;
     for (int c = 0; c < scene->camera_count; ++c) {
         const wx_scene_camera *sc = &scene->cameras[c];
-        if (sc->is_output || (sc->has_view && sc->depth_path[0] == '\0')) {
+        if (sc->is_output || (sc->has_view && !wx_has_path(sc->depth_path))) {
             continue; // the output camera has no dirt; a baked camera renders its own
         }
         wx_result r = wx_maps_load(&maps[c], WX_MAPS_DEPTH, sc->depth_path, NULL, NULL, NULL,

@@ -20,12 +20,12 @@ wx_result wx_load_simulation_maps(const wx_scene *scene, wx_maps *maps, wx_error
         if (cam->is_output) {
             continue;
         }
-        if (cam->depth_path[0] == '\0') {
+        if (!wx_has_path(cam->depth_path)) {
             return wx_fail(err, WX_CAUSE_MISSING_PHASE, "%s: camera '%s' has no maps yet; run `weathering bake` first",
                                 scene->path, cam->name);
         }
         unsigned which = WX_MAPS_DEPTH | WX_MAPS_NORMAL | WX_MAPS_IMPACT;
-        if (cam->dirt_path[0] != '\0') {
+        if (wx_has_path(cam->dirt_path)) {
             // A dirt map that an earlier `simulate` wrote starts from the dirt it
             // started from (channel initialDirt), so running again is repeatable.
             which |= WX_MAPS_DIRT | WX_MAPS_INITIAL_DIRT;
@@ -71,7 +71,7 @@ wx_result wx_load_gather_maps(const wx_scene *scene, const wx_run_def *opts, wx_
         }
         const char *dirt_path = simulated;
         if (access(simulated, R_OK) != 0) {
-            if (cam->dirt_path[0] == '\0') {
+            if (!wx_has_path(cam->dirt_path)) {
                 return wx_fail(err, WX_CAUSE_MISSING_PHASE,
                                     "%s: camera '%s' has no dirt map (no %s); run `weathering "
                                     "simulate %s --out %s` first",

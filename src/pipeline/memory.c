@@ -17,7 +17,7 @@ void wx_memory_estimate(const wx_scene *scene, unsigned phases, wx_memory_need *
 {
     memset(need, 0, sizeof *need);
     need->baseline_bytes = WX_MEMORY_BASELINE;
-    need->camera_line = scene->path[0] != '\0' ? 1 : 0;
+    need->camera_line = wx_has_path(scene->path) ? 1 : 0;
     double largest = -1.0, input_texels = 0.0, largest_input = 0.0, output_texels = 0.0;
     double framebuffer = 0.0, images = 0.0, baked_inputs = 0.0;
     bool bake = (phases & WX_PHASE_BAKE) && wx_scene_needs_bake(scene);
@@ -34,7 +34,7 @@ void wx_memory_estimate(const wx_scene *scene, unsigned phases, wx_memory_need *
             largest = texels;
             need->camera_line = sc->line;
         }
-        if (bake && sc->has_view && sc->depth_path[0] == '\0') {
+        if (bake && sc->has_view && !wx_has_path(sc->depth_path)) {
             framebuffer = fmax(framebuffer, WX_BAKE_FRAMEBUFFER_BYTES_PER_TEXEL * texels);
             images = fmax(images, texels * (sc->is_output ? WX_BAKE_OUTPUT_IMAGE_BYTES_PER_TEXEL
                                                           : WX_BAKE_INPUT_IMAGE_BYTES_PER_TEXEL));

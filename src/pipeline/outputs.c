@@ -13,6 +13,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "core/array.h"
 #include "core/atomic_file.h"
 
 void wx_preview_name(const char *mask_name, char *out, size_t cap)
@@ -26,22 +27,17 @@ void wx_preview_name(const char *mask_name, char *out, size_t cap)
 // A <View> camera whose maps `bake` writes into the output folder.
 static bool baked_camera(const wx_scene_camera *cam)
 {
-    return cam->has_view && (cam->depth_path[0] == '\0' || cam->maps_in_output);
+    return cam->has_view && (!wx_has_path(cam->depth_path) || cam->maps_in_output);
 }
 
-static wx_result add_name(wx_output_names *list, int *capacity, const char *fmt, ...)
+static wx_result add_name(wx_output_names *list, int64_t *capacity, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
 
-static wx_result add_name(wx_output_names *list, int *capacity, const char *fmt, ...)
+static wx_result add_name(wx_output_names *list, int64_t *capacity, const char *fmt, ...)
 {
-    if (list->count == *capacity) {
-        int grown_capacity = *capacity > 0 ? 2 * *capacity : 16;
-        void *grown = realloc(list->names, (size_t)grown_capacity * sizeof *list->names);
-        if (grown == NULL) {
-            return WX_FAIL;
-        }
-        list->names = grown;
-        *capacity = grown_capacity;
+    if (!wx_array_reserve((void **)&list->names, capacity, list->count + 1, sizeof *list->names,
+                          16)) {
+        return WX_FAIL;
     }
     va_list args;
     va_start(args, fmt);
@@ -61,7 +57,7 @@ wx_result wx_output_names_list(const wx_scene *scene, unsigned phases, wx_output
 {
     static const char *const kinds[4] = { "depth", "normal", "impact", "dirt" };
     memset(out, 0, sizeof *out);
-    int capacity = 0;
+    int64_t capacity = 0;
     wx_result r = WX_OK;
     for (int c = 0; c < scene->camera_count && r == WX_OK; ++c) {
         const wx_scene_camera *cam = &scene->cameras[c];
@@ -213,7 +209,7 @@ void wx_output_remove_empty(const char *out_dir, const char *created)
 static bool same_file(const struct stat *a, const char *path)
 {
     struct stat b;
-    return path[0] != '\0' && stat(path, &b) == 0 && a->st_dev == b.st_dev &&
+    return wx_has_path(path) && stat(path, &b) == 0 && a->st_dev == b.st_dev &&
            a->st_ino == b.st_ino;
 }
 
@@ -400,7 +396,7 @@ wx_result wx_check_outputs(const wx_scene *scene, const wx_run_def *opts, unsign
 bool wx_scene_needs_bake(const wx_scene *scene)
 {
     for (int c = 0; c < scene->camera_count; ++c) {
-        if (scene->cameras[c].has_view && scene->cameras[c].depth_path[0] == '\0') {
+        if (scene->cameras[c].has_view && !wx_has_path(scene->cameras[c].depth_path)) {
             return true;
         }
     }
@@ -412,19 +408,24 @@ wx_result wx_use_baked_maps(wx_scene *scene, const wx_run_def *opts, wx_error *e
     static const char *const kinds[4] = { "depth", "normal", "impact", "dirt" };
     for (int c = 0; c < scene->camera_count; ++c) {
         wx_scene_camera *cam = &scene->cameras[c];
-        if (!cam->has_view || cam->depth_path[0] != '\0') {
+        if (!cam->has_view || wx_has_path(cam->depth_path)) {
             continue;
         }
         cam->maps_in_output = true;
-        char *paths[4] = { cam->depth_path, cam->normal_path, cam->impact_path, cam->dirt_path };
+        char **paths[4] = { &cam->depth_path, &cam->normal_path, &cam->impact_path,
+                            &cam->dirt_path };
         int count = cam->is_output ? 2 : 4;
         for (int k = 0; k < count; ++k) {
-            int n = snprintf(paths[k], WX_PATH_MAX, "%s/%s_%s.exr", opts->out_dir, cam->name,
+            char path[WX_PATH_MAX];
+            int n = snprintf(path, sizeof path, "%s/%s_%s.exr", opts->out_dir, cam->name,
                              kinds[k]);
-            if (n < 0 || n >= WX_PATH_MAX) {
+            if (n < 0 || n >= (int)sizeof path) {
                 return wx_fail(err, WX_CAUSE_PATH_TOO_LONG, "%s: output path too long", opts->out_dir);
             }
-            if (access(paths[k], R_OK) != 0) {
+            if (!wx_scene_set_path(paths[k], path)) {
+                return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (paths)");
+            }
+            if (access(path, R_OK) != 0) {
                 return wx_fail(err, WX_CAUSE_MISSING_PHASE, "%s: camera '%s' has no baked %s map in %s; run `weathering "
                                     "bake %s --out %s` first",
                                     scene->path, cam->name, kinds[k], opts->out_dir, scene->path,

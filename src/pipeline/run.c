@@ -22,7 +22,7 @@ static bool mark_baked_cameras(wx_scene *scene)
     bool any = wx_scene_needs_bake(scene);
     for (int c = 0; c < scene->camera_count; ++c) {
         wx_scene_camera *cam = &scene->cameras[c];
-        cam->maps_in_output = cam->maps_in_output || (cam->has_view && cam->depth_path[0] == '\0');
+        cam->maps_in_output = cam->maps_in_output || (cam->has_view && !wx_has_path(cam->depth_path));
     }
     return any;
 }

@@ -878,7 +878,7 @@ static wx_result check_cameras(baker *b, int *bake_count, wx_error *err)
     for (int c = 0; c < scene->camera_count; ++c) {
         const wx_scene_camera *sc = &scene->cameras[c];
         cam_state *cs = &b->cams[c];
-        cs->bake = sc->has_view && sc->depth_path[0] == '\0';
+        cs->bake = sc->has_view && !wx_has_path(sc->depth_path);
         cs->d_min = INFINITY;
         cs->d_max = -INFINITY;
         if (!cs->bake) {

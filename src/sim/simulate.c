@@ -31,6 +31,7 @@
 #include "sim/emitter.h"
 #include "sim/force_field.h"
 #include "sim/particles.h"
+#include "core/array.h"
 #include "core/parallel.h"
 
 enum {
@@ -139,15 +140,10 @@ struct wx_sim {
 static bool push_event(sim_worker *w, const sim_event *e)
 {
     sim_chunk *ch = w->chunk;
-    if (ch->event_count == ch->event_capacity) {
-        int64_t capacity = ch->event_capacity > 0 ? 2 * ch->event_capacity : 256;
-        sim_event *bigger = realloc(ch->events, (size_t)capacity * sizeof *bigger);
-        if (bigger == NULL) {
-            w->failed = true;
-            return false;
-        }
-        ch->events = bigger;
-        ch->event_capacity = capacity;
+    if (!wx_array_reserve((void **)&ch->events, &ch->event_capacity, ch->event_count + 1,
+                          sizeof *ch->events, 256)) {
+        w->failed = true;
+        return false;
     }
     ch->events[ch->event_count++] = *e;
     return true;
@@ -155,15 +151,10 @@ static bool push_event(sim_worker *w, const sim_event *e)
 
 static void push_candidate(sim_worker *w, const sim_candidate *c)
 {
-    if (w->cand_count == w->cand_capacity) {
-        int64_t capacity = w->cand_capacity > 0 ? 2 * w->cand_capacity : 1024;
-        sim_candidate *bigger = realloc(w->cands, (size_t)capacity * sizeof *bigger);
-        if (bigger == NULL) {
-            w->failed = true;
-            return;
-        }
-        w->cands = bigger;
-        w->cand_capacity = capacity;
+    if (!wx_array_reserve((void **)&w->cands, &w->cand_capacity, w->cand_count + 1,
+                          sizeof *w->cands, 1024)) {
+        w->failed = true;
+        return;
     }
     w->cands[w->cand_count++] = *c;
 }
@@ -171,15 +162,10 @@ static void push_candidate(sim_worker *w, const sim_candidate *c)
 static void push_dead(sim_worker *w, int64_t index, bool escaped)
 {
     sim_chunk *ch = w->chunk;
-    if (ch->dead_count == ch->dead_capacity) {
-        int64_t capacity = ch->dead_capacity > 0 ? 2 * ch->dead_capacity : 256;
-        int64_t *bigger = realloc(ch->dead, (size_t)capacity * sizeof *bigger);
-        if (bigger == NULL) {
-            w->failed = true;
-            return;
-        }
-        ch->dead = bigger;
-        ch->dead_capacity = capacity;
+    if (!wx_array_reserve((void **)&ch->dead, &ch->dead_capacity, ch->dead_count + 1,
+                          sizeof *ch->dead, 256)) {
+        w->failed = true;
+        return;
     }
     ch->dead[ch->dead_count++] = index << 1 | (escaped ? 1 : 0);
 }

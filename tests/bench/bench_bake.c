@@ -109,8 +109,9 @@ static bool bake_rows(const char *mesh, const char *out_dir, int px, float dirt,
     for (int k = 0; k < repeats; ++k) {
         wx_scene s;
         memset(&s, 0, sizeof s);
-        snprintf(s.path, sizeof s.path, "bench.xml");
-        snprintf(s.dir, sizeof s.dir, ".");
+        char scene_path[] = "bench.xml", scene_dir[] = ".";
+        s.path = scene_path;
+        s.dir = scene_dir;
         s.output_index = -1;
         wx_scene_camera cams[3];
         s.cameras = cams;
@@ -119,7 +120,9 @@ static bool bake_rows(const char *mesh, const char *out_dir, int px, float dirt,
         add_camera(&s, "top", 0, 5, 0, 0, 0, -1, px);
         wx_mesh m;
         memset(&m, 0, sizeof m);
-        snprintf(m.path, sizeof m.path, "%s", mesh);
+        char mesh_path[4096];
+        snprintf(mesh_path, sizeof mesh_path, "%s", mesh);
+        m.path = mesh_path;
         wx_surface surf;
         memset(&surf, 0, sizeof surf);
         snprintf(surf.material, sizeof surf.material, "*");
@@ -139,7 +142,14 @@ static bool bake_rows(const char *mesh, const char *out_dir, int px, float dirt,
         o.quiet = true;
         wx_bake_stats st;
         wx_error err;
-        if (wx_bake_scene_stats(&s, &o, &st, &err) != WX_OK) {
+        wx_result baked = wx_bake_scene_stats(&s, &o, &st, &err);
+        for (int c = 0; c < 3; ++c) { // the paths of the maps the bake wrote
+            free(cams[c].depth_path);
+            free(cams[c].normal_path);
+            free(cams[c].impact_path);
+            free(cams[c].dirt_path);
+        }
+        if (baked != WX_OK) {
             fprintf(stderr, "bench_bake: %s\n", err.message);
             return false;
         }
