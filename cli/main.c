@@ -15,6 +15,7 @@
 
 #include "core/atomic_file.h"
 #include "core/progress.h"
+#include "core/usage.h"
 #include "io/scene_xml.h"
 #include "io/stats_json.h"
 #include "model/geometry.h"
@@ -93,25 +94,7 @@ static void print_usage(FILE *out)
 
 static int usage_error(const char *fmt, const char *detail)
 {
-    fprintf(stderr, "weathering: ");
-    fprintf(stderr, fmt, detail);
-    fprintf(stderr, "\nTry 'weathering --help'.\n");
-    return WX_BAD_INPUT;
-}
-
-static bool parse_u64(const char *text, uint64_t *out)
-{
-    if (text[0] < '0' || text[0] > '9') {
-        return false;
-    }
-    errno = 0;
-    char *end = NULL;
-    unsigned long long v = strtoull(text, &end, 10);
-    if (errno != 0 || *end != '\0') {
-        return false;
-    }
-    *out = (uint64_t)v;
-    return true;
+    return wx_usage_error("weathering", fmt, detail);
 }
 
 // Takes the value of an option given as "--opt VALUE" or "--opt=VALUE".
@@ -171,14 +154,14 @@ static int parse_args(int argc, char **argv, cli_args *args)
             }
         } else if (is_option(arg, "--seed")) {
             const char *v = option_value(argc, argv, &i, "--seed", &missing);
-            if (!missing && !parse_u64(v, &args->seed)) {
+            if (!missing && !wx_parse_whole(v, 0, UINT64_MAX, &args->seed)) {
                 return usage_error("--seed takes a whole number from 0 to 2^64-1, not '%s'", v);
             }
             args->seed_set = true;
         } else if (is_option(arg, "--threads")) {
             const char *v = option_value(argc, argv, &i, "--threads", &missing);
             uint64_t n = 0;
-            if (!missing && (!parse_u64(v, &n) || n < 1 || n > 1024)) {
+            if (!missing && !wx_parse_whole(v, 1, 1024, &n)) {
                 return usage_error("--threads takes a whole number from 1 to 1024, not '%s'", v);
             }
             args->threads = (int)n;
@@ -251,7 +234,7 @@ static void print_camera(const wx_scene_camera *sc)
            sc->name, sc->is_output ? "output" : "input", cam->width, cam->height, w_ws, h_ws,
            center[0], center[1], center[2], dir[0], dir[1], dir[2],
            cam->width > 0 ? w_ws / (float)cam->width : 0.0f,
-           sc->has_view && sc->depth_path[0] == '\0' ? ", maps baked from geometry" : "");
+           sc->has_view && !wx_has_path(sc->depth_path) ? ", maps baked from geometry" : "");
     if (sc->is_output) {
         printf("  %-12s        mask '%s' %d x %d, radius %g m, %s%s\n", "", sc->output_file,
                sc->output_width, sc->output_height, sc->radius,

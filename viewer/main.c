@@ -18,6 +18,7 @@
 #include <string.h>
 
 #include "bake_child.h"
+#include "core/usage.h"
 #include "draw.h"
 #include "overlay.h"
 #include "screenshot.h"
@@ -176,21 +177,13 @@ static void report(app *a, bool is_error, const char *fmt, ...)
 
 static int usage_error(const char *fmt, const char *detail)
 {
-    fprintf(stderr, "weathering-viewer: ");
-    fprintf(stderr, fmt, detail);
-    fprintf(stderr, "\nTry 'weathering-viewer --help'.\n");
-    return WX_BAD_INPUT;
+    return wx_usage_error("weathering-viewer", fmt, detail);
 }
 
-static bool parse_int(const char *text, long lo, long hi, int *out)
+static bool parse_int(const char *text, int lo, int hi, int *out)
 {
-    if (text == NULL || text[0] < '0' || text[0] > '9') {
-        return false;
-    }
-    errno = 0;
-    char *end = NULL;
-    long v = strtol(text, &end, 10);
-    if (errno != 0 || *end != '\0' || v < lo || v > hi) {
+    uint64_t v = 0;
+    if (!wx_parse_whole(text, (uint64_t)lo, (uint64_t)hi, &v)) {
         return false;
     }
     *out = (int)v;

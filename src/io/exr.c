@@ -65,34 +65,43 @@ static void stream_on_error(exr_const_context_t ctxt, exr_result_t code, const c
     }
 }
 
+// Reads or writes `size` bytes at `offset` of the stream's file, retrying short
+// transfers. A read stops at the end of the file (the library reports the short
+// read); a write that makes no progress is an error (EIO).
+static int64_t stream_transfer(exr_stream *s, uint8_t *bytes, uint64_t size, uint64_t offset,
+                               bool write)
+{
+    if (size > (uint64_t)INT64_MAX || offset > (uint64_t)INT64_MAX - size) {
+        return -1;
+    }
+    uint64_t done = 0;
+    while (done < size) {
+        size_t want = (size_t)(size - done);
+        off_t at = (off_t)(offset + done);
+        ssize_t n = write ? pwrite(s->fd, bytes + done, want, at) : pread(s->fd, bytes + done, want, at);
+        if (n < 0 && errno == EINTR) {
+            continue;
+        }
+        if (n < 0 || (n == 0 && write)) {
+            if (s->io_errno == 0) {
+                s->io_errno = n < 0 ? errno : EIO;
+            }
+            return -1;
+        }
+        if (n == 0) {
+            break;
+        }
+        done += (uint64_t)n;
+    }
+    return (int64_t)done;
+}
+
 static int64_t stream_read(exr_const_context_t ctxt, void *user, void *buffer, uint64_t size,
                            uint64_t offset, exr_stream_error_func_ptr_t error_cb)
 {
     (void)ctxt;
     (void)error_cb;
-    exr_stream *s = user;
-    if (size > (uint64_t)INT64_MAX || offset > (uint64_t)INT64_MAX - size) {
-        return -1;
-    }
-    uint8_t *bytes = buffer;
-    uint64_t done = 0;
-    while (done < size) {
-        ssize_t n = pread(s->fd, bytes + done, (size_t)(size - done), (off_t)(offset + done));
-        if (n < 0) {
-            if (errno == EINTR) {
-                continue;
-            }
-            if (s->io_errno == 0) {
-                s->io_errno = errno;
-            }
-            return -1;
-        }
-        if (n == 0) {
-            break; // end of file: the library reports the short read
-        }
-        done += (uint64_t)n;
-    }
-    return (int64_t)done;
+    return stream_transfer(user, buffer, size, offset, false);
 }
 
 static int64_t stream_size(exr_const_context_t ctxt, void *user)
@@ -111,32 +120,7 @@ static int64_t stream_write(exr_const_context_t ctxt, void *user, const void *bu
 {
     (void)ctxt;
     (void)error_cb;
-    exr_stream *s = user;
-    if (size > (uint64_t)INT64_MAX || offset > (uint64_t)INT64_MAX - size) {
-        return -1;
-    }
-    const uint8_t *bytes = buffer;
-    uint64_t done = 0;
-    while (done < size) {
-        ssize_t n = pwrite(s->fd, bytes + done, (size_t)(size - done), (off_t)(offset + done));
-        if (n < 0) {
-            if (errno == EINTR) {
-                continue;
-            }
-            if (s->io_errno == 0) {
-                s->io_errno = errno;
-            }
-            return -1;
-        }
-        if (n == 0) {
-            if (s->io_errno == 0) {
-                s->io_errno = EIO;
-            }
-            return -1;
-        }
-        done += (uint64_t)n;
-    }
-    return (int64_t)done;
+    return stream_transfer(user, (uint8_t *)(uintptr_t)buffer, size, offset, true);
 }
 
 static const char *stream_detail(const exr_stream *s, exr_result_t rv)
@@ -458,6 +442,23 @@ static wx_result reader_decode(exr_reader *r, const char *path, const read_targe
     return result;
 }
 
+// reader_open, then the channel list of part 0.
+static wx_result reader_open_channels(exr_reader *r, const char *path,
+                                      const exr_attr_chlist_t **chlist, wx_error *err)
+{
+    wx_result result = reader_open(r, path, err);
+    if (result != WX_OK) {
+        return result;
+    }
+    *chlist = NULL;
+    if (exr_get_channels(r->ctx, 0, chlist) != EXR_ERR_SUCCESS || *chlist == NULL) {
+        reader_close(r);
+        return wx_fail(err, WX_CAUSE_BAD_MAP, "%s: corrupt OpenEXR header (no channel list)",
+                       path);
+    }
+    return WX_OK;
+}
+
 // Reads the wanted channels of `path`. With `planar`, each channel into its own plane
 // out->channels[i]; otherwise into one interleaved buffer returned in *interleaved.
 static wx_result read_channels(const char *path, const char *const *wanted, int wanted_count,
@@ -468,15 +469,10 @@ static wx_result read_channels(const char *path, const char *const *wanted, int 
                             wanted_count, WX_IMAGE_MAX_CHANNELS);
     }
     exr_reader r;
-    wx_result result = reader_open(&r, path, err);
+    const exr_attr_chlist_t *chlist = NULL;
+    wx_result result = reader_open_channels(&r, path, &chlist, err);
     if (result != WX_OK) {
         return result;
-    }
-    const exr_attr_chlist_t *chlist = NULL;
-    if (exr_get_channels(r.ctx, 0, &chlist) != EXR_ERR_SUCCESS || chlist == NULL) {
-        reader_close(&r);
-        return wx_fail(err, WX_CAUSE_BAD_MAP, "%s: corrupt OpenEXR header (no channel list)",
-                            path);
     }
     read_target targets[WX_IMAGE_MAX_CHANNELS];
     for (int i = 0; i < wanted_count; i++) {
@@ -550,15 +546,10 @@ wx_result wx_exr_read_header(const char *path, wx_image *out, wx_error *err)
 {
     memset(out, 0, sizeof *out);
     exr_reader r;
-    wx_result result = reader_open(&r, path, err);
+    const exr_attr_chlist_t *chlist = NULL;
+    wx_result result = reader_open_channels(&r, path, &chlist, err);
     if (result != WX_OK) {
         return result;
-    }
-    const exr_attr_chlist_t *chlist = NULL;
-    if (exr_get_channels(r.ctx, 0, &chlist) != EXR_ERR_SUCCESS || chlist == NULL) {
-        reader_close(&r);
-        return wx_fail(err, WX_CAUSE_BAD_MAP, "%s: corrupt OpenEXR header (no channel list)",
-                            path);
     }
     if (chlist->num_channels > WX_IMAGE_MAX_CHANNELS) {
         reader_close(&r);

@@ -76,6 +76,22 @@ static wx_result load_interleaved(const char *path, const char *const *channels,
     return result;
 }
 
+// An interleaved map whose values must all be finite (normal, impact).
+static wx_result load_finite(const char *path, const char *what, const char *const *channels,
+                             int count, float **out, size_check *check, wx_error *err)
+{
+    wx_result result = need_path(path, what, err);
+    if (result == WX_OK) {
+        result = load_interleaved(path, channels, count, out, check, err);
+    }
+    if (result == WX_OK) {
+        result = check_finite(path, what, *out,
+                              (size_t)count * (size_t)check->width * (size_t)check->height,
+                              check->width, count, channels, err);
+    }
+    return result;
+}
+
 wx_result wx_maps_load(wx_maps *maps, unsigned which, const char *depth_path,
                        const char *normal_path, const char *impact_path, const char *dirt_path,
                        wx_error *err)
@@ -102,27 +118,11 @@ wx_result wx_maps_load(wx_maps *maps, unsigned which, const char *depth_path,
     }
     if (result == WX_OK && wanted(which, WX_MAPS_NORMAL)) {
         static const char *const channels[] = {"R", "G", "B"};
-        result = need_path(normal_path, "normal", err);
-        if (result == WX_OK) {
-            result = load_interleaved(normal_path, channels, 3, &maps->normal, &check, err);
-        }
-        if (result == WX_OK) {
-            result = check_finite(normal_path, "normal", maps->normal,
-                                  3 * (size_t)check.width * (size_t)check.height, check.width, 3,
-                                  channels, err);
-        }
+        result = load_finite(normal_path, "normal", channels, 3, &maps->normal, &check, err);
     }
     if (result == WX_OK && wanted(which, WX_MAPS_IMPACT)) {
         static const char *const channels[] = {"R", "G"};
-        result = need_path(impact_path, "impact", err);
-        if (result == WX_OK) {
-            result = load_interleaved(impact_path, channels, 2, &maps->impact, &check, err);
-        }
-        if (result == WX_OK) {
-            result = check_finite(impact_path, "impact", maps->impact,
-                                  2 * (size_t)check.width * (size_t)check.height, check.width, 2,
-                                  channels, err);
-        }
+        result = load_finite(impact_path, "impact", channels, 2, &maps->impact, &check, err);
     }
     if (result == WX_OK && wanted(which, WX_MAPS_DIRT)) {
         // A dirt map that `simulate` wrote keeps the dirt it started from in

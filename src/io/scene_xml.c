@@ -113,11 +113,19 @@ static wx_result out_of_memory(parser *p)
     return wx_fail(p->err, WX_CAUSE_OUT_OF_MEMORY, "%s: out of memory", p->path);
 }
 
-/// Makes room for one more item of an array (core/array.h); returns the
-/// (possibly moved) array, or NULL when out of memory (the old one is kept).
-static void *reserve(void *items, int count, int64_t *capacity, size_t item_size)
+/// Makes room for one more item at the end of a scene array of at most `max`
+/// items (core/array.h): "too many WHAT (at most MAX)" at the element's line
+/// when full, or out of memory.
+static wx_result grow_list(parser *p, const xmlNode *node, void **items, int count,
+                           int64_t *capacity, size_t item_size, int max, const char *what)
 {
-    return wx_array_reserve(&items, capacity, (int64_t)count + 1, item_size, 4) ? items : NULL;
+    if (count >= max) {
+        return fail(p, node, WX_CAUSE_TOO_MANY, "too many %s (at most %d)", what, max);
+    }
+    if (!wx_array_reserve(items, capacity, (int64_t)count + 1, item_size, 4)) {
+        return out_of_memory(p);
+    }
+    return WX_OK;
 }
 
 // ---------------------------------------------------------------------------
@@ -501,6 +509,23 @@ static void trimmed(const char *s, char out[48])
     snprintf(out, 48, "%.*s%s", (int)(n > 40 ? 40 : n), s, n > 40 ? "..." : "");
 }
 
+/// "path:LINE: <Element> name="value" <what>" (WX_CAUSE_BAD_VALUE), the value
+/// trimmed for the message.
+static wx_result bad_value(parser *p, const xmlNode *node, const attr_spec *s, const char *text,
+                           const char *fmt, ...) __attribute__((format(printf, 5, 6)));
+static wx_result bad_value(parser *p, const xmlNode *node, const attr_spec *s, const char *text,
+                           const char *fmt, ...)
+{
+    char shown[48], what[256];
+    trimmed(text, shown);
+    va_list args;
+    va_start(args, fmt);
+    vsnprintf(what, sizeof what, fmt, args);
+    va_end(args);
+    return fail(p, node, WX_CAUSE_BAD_VALUE, "<%s> %s=\"%s\" %s", name_of(node), s->name, shown,
+                what);
+}
+
 static wx_result check_range(parser *p, const xmlNode *node, const attr_spec *s, const char *text,
                              double v)
 {
@@ -519,9 +544,7 @@ static wx_result check_range(parser *p, const xmlNode *node, const attr_spec *s,
         break;
     }
     if (what != NULL) {
-        char shown[48];
-        trimmed(text, shown);
-        return fail(p, node, WX_CAUSE_BAD_VALUE, "<%s> %s=\"%s\" must be %s", name_of(node), s->name, shown, what);
+        return bad_value(p, node, s, text, "must be %s", what);
     }
     return WX_OK;
 }
@@ -531,12 +554,9 @@ static wx_result check_range(parser *p, const xmlNode *node, const attr_spec *s,
 static wx_result parse_finite_list(parser *p, const xmlNode *node, const attr_spec *s,
                                    const char *text, double *values, int want, bool as_float)
 {
-    char shown[48];
-    trimmed(text, shown);
     int count = parse_numbers(text, values, want);
     if (count < 0 || (want == 1 && count != 1)) {
-        return fail(p, node, WX_CAUSE_BAD_VALUE, "<%s> %s=\"%s\" is not a number%s", name_of(node), s->name, shown,
-                    want == 1 ? "" : " list");
+        return bad_value(p, node, s, text, "is not a number%s", want == 1 ? "" : " list");
     }
     if (count != want) {
         return fail(p, node, WX_CAUSE_BAD_VALUE, "<%s> %s has %d numbers, expected %d", name_of(node), s->name, count,
@@ -544,14 +564,12 @@ static wx_result parse_finite_list(parser *p, const xmlNode *node, const attr_sp
     }
     for (int i = 0; i < want; ++i) {
         if (!isfinite(values[i])) {
-            return fail(p, node, WX_CAUSE_BAD_VALUE, "<%s> %s=\"%s\" is not a finite number", name_of(node), s->name,
-                        shown);
+            return bad_value(p, node, s, text, "is not a finite number");
         }
         if (as_float) {
             float f = (float)values[i];
             if (!isfinite(f)) {
-                return fail(p, node, WX_CAUSE_BAD_VALUE, "<%s> %s=\"%s\" is out of range", name_of(node), s->name,
-                            shown);
+                return bad_value(p, node, s, text, "is out of range");
             }
             values[i] = f;
         }
@@ -590,13 +608,10 @@ static wx_result parse_real_value(parser *p, const xmlNode *node, const attr_spe
 static wx_result parse_integer_value(parser *p, const xmlNode *node, const attr_spec *s,
                                      const char *text, void *dst)
 {
-    char shown[48];
-    trimmed(text, shown);
     if (s->type == T_UINT64) {
         unsigned long long v;
         if (!parse_unsigned(text, &v)) {
-            return fail(p, node, WX_CAUSE_BAD_VALUE, "<%s> %s=\"%s\" is not an integer in [0, 2^64-1]", name_of(node),
-                        s->name, shown);
+            return bad_value(p, node, s, text, "is not an integer in [0, 2^64-1]");
         }
         uint64_t u = (uint64_t)v;
         memcpy(dst, &u, sizeof u);
@@ -606,8 +621,7 @@ static wx_result parse_integer_value(parser *p, const xmlNode *node, const attr_
         int px[2];
         int count = parse_integers(text, px, 2, s->lo, s->hi);
         if (count < 1 || count > 2) {
-            return fail(p, node, WX_CAUSE_BAD_VALUE, "<%s> %s=\"%s\" must be one or two integers in [%lld, %lld]",
-                        name_of(node), s->name, shown, s->lo, s->hi);
+            return bad_value(p, node, s, text, "must be one or two integers in [%lld, %lld]", s->lo, s->hi);
         }
         if (count == 1) {
             px[1] = px[0];
@@ -617,11 +631,10 @@ static wx_result parse_integer_value(parser *p, const xmlNode *node, const attr_
     }
     long long v;
     if (!parse_integer(text, &v)) {
-        return fail(p, node, WX_CAUSE_BAD_VALUE, "<%s> %s=\"%s\" is not an integer", name_of(node), s->name, shown);
+        return bad_value(p, node, s, text, "is not an integer");
     }
     if (v < s->lo || v > s->hi) {
-        return fail(p, node, WX_CAUSE_BAD_VALUE, "<%s> %s=\"%s\" must be in [%lld, %lld]", name_of(node), s->name,
-                    shown, s->lo, s->hi);
+        return bad_value(p, node, s, text, "must be in [%lld, %lld]", s->lo, s->hi);
     }
     if (s->type == T_INT) {
         int i = (int)v;
@@ -642,8 +655,7 @@ static wx_result parse_keyword_value(parser *p, const xmlNode *node, const attr_
     if (s->type == T_BOOL) {
         bool b = strcmp(shown, "true") == 0;
         if (!b && strcmp(shown, "false") != 0) {
-            return fail(p, node, WX_CAUSE_BAD_VALUE, "<%s> %s=\"%s\" must be \"true\" or \"false\"", name_of(node),
-                        s->name, shown);
+            return bad_value(p, node, s, text, "must be \"true\" or \"false\"");
         }
         memcpy(dst, &b, sizeof b);
         return WX_OK;
@@ -656,8 +668,7 @@ static wx_result parse_keyword_value(parser *p, const xmlNode *node, const attr_
         }
         wx_list_append(list, sizeof list, s->choices[i]);
     }
-    return fail(p, node, WX_CAUSE_BAD_VALUE, "<%s> %s=\"%s\" must be one of: %s", name_of(node), s->name, shown,
-                list);
+    return bad_value(p, node, s, text, "must be one of: %s", list);
 }
 
 static bool is_plain_name(const char *text)
@@ -688,12 +699,9 @@ static wx_result parse_text_value(parser *p, const xmlNode *node, const attr_spe
                     s->name, s->size - 1);
     }
     if (s->type == T_NAME && !is_plain_name(text)) {
-        char shown[48];
-        trimmed(text, shown);
-        return fail(p, node, WX_CAUSE_BAD_VALUE,
-                    "<%s> %s=\"%s\" must be a plain name (letters, digits, '_', '-', '.', not "
-                    "starting with '.'; no folders)",
-                    name_of(node), s->name, shown);
+        return bad_value(p, node, s, text,
+                         "must be a plain name (letters, digits, '_', '-', '.', not starting "
+                         "with '.'; no folders)");
     }
     for (size_t i = 0; i < len; ++i) {
         if ((unsigned char)text[i] < 0x20) {
@@ -931,15 +939,12 @@ static const attr_spec turbulence_attrs[] = {
 static wx_result add_field(parser *p, const xmlNode *node, wx_field_kind kind, wx_field **out)
 {
     wx_scene *s = p->scene;
-    if (s->field_count >= SCENE_MAX_FIELDS) {
-        return fail(p, node, WX_CAUSE_TOO_MANY, "too many force fields (at most %d)", SCENE_MAX_FIELDS);
+    wx_result r = grow_list(p, node, (void **)&s->fields, s->field_count, &p->field_cap,
+                            sizeof *s->fields, SCENE_MAX_FIELDS, "force fields");
+    if (r != WX_OK) {
+        return r;
     }
-    wx_field *grown = reserve(s->fields, s->field_count, &p->field_cap, sizeof *grown);
-    if (grown == NULL) {
-        return out_of_memory(p);
-    }
-    s->fields = grown;
-    wx_field *f = &grown[s->field_count++];
+    wx_field *f = &s->fields[s->field_count++];
     // Defaults (DESIGN section 3; the Wind direction is ours: +X).
     *f = (wx_field){ .kind = kind, .strength = 0.0f, .frequency = 1.0f, .octaves = 4,
                      .line = line_of(node) };
@@ -1027,21 +1032,18 @@ static const attr_spec hemisphere_emitter_attrs[] = {
 static wx_result parse_emitter(parser *p, const xmlNode *node, wx_emitter_kind kind)
 {
     wx_scene *s = p->scene;
-    if (s->emitter_count >= SCENE_MAX_EMITTERS) {
-        return fail(p, node, WX_CAUSE_TOO_MANY, "too many emitters (at most %d)", SCENE_MAX_EMITTERS);
+    wx_result r = grow_list(p, node, (void **)&s->emitters, s->emitter_count, &p->emitter_cap,
+                            sizeof *s->emitters, SCENE_MAX_EMITTERS, "emitters");
+    if (r != WX_OK) {
+        return r;
     }
-    wx_emitter *grown = reserve(s->emitters, s->emitter_count, &p->emitter_cap, sizeof *grown);
-    if (grown == NULL) {
-        return out_of_memory(p);
-    }
-    s->emitters = grown;
-    wx_emitter *e = &grown[s->emitter_count++];
+    wx_emitter *e = &s->emitters[s->emitter_count++];
     // end = NAN until the simulation's duration is known (finish_emitters).
     *e = (wx_emitter){ .kind = kind, .radius = kind == WX_EMITTER_HEMISPHERE ? 1.0f : 0.0f,
                        .rate = 1000.0, .start = 0.0, .end = NAN, .speed = 1.0f, .mass = 1.0f,
                        .dirt = 1.0f, .max_collisions = 100, .line = line_of(node) };
-    wx_result r = kind == WX_EMITTER_POINT ? ATTRS(point_emitter_attrs, e, NULL)
-                                           : ATTRS(hemisphere_emitter_attrs, e, NULL);
+    r = kind == WX_EMITTER_POINT ? ATTRS(point_emitter_attrs, e, NULL)
+                                 : ATTRS(hemisphere_emitter_attrs, e, NULL);
     if (r != WX_OK) {
         return r;
     }
@@ -1460,19 +1462,18 @@ static wx_result parse_ortho(parser *p, const xmlNode *node, void *user)
                     "has at most one",
                     attrs.name, first->name, first->line);
     }
-    if (s->camera_count >= SCENE_MAX_CAMERAS) {
-        return fail(p, node, WX_CAUSE_TOO_MANY, "too many cameras (at most %d)", SCENE_MAX_CAMERAS);
-    }
-    if (!attrs.out && s->input_count >= WX_MAX_INPUT_CAMERAS) {
-        return fail(p, node, WX_CAUSE_TOO_MANY, "too many input cameras (the collider takes at most %d)",
+    if (s->camera_count < SCENE_MAX_CAMERAS && !attrs.out &&
+        s->input_count >= WX_MAX_INPUT_CAMERAS) {
+        return fail(p, node, WX_CAUSE_TOO_MANY,
+                    "too many input cameras (the collider takes at most %d)",
                     WX_MAX_INPUT_CAMERAS);
     }
-    wx_scene_camera *grown = reserve(s->cameras, s->camera_count, &p->camera_cap, sizeof *grown);
-    if (grown == NULL) {
-        return out_of_memory(p);
+    r = grow_list(p, node, (void **)&s->cameras, s->camera_count, &p->camera_cap,
+                  sizeof *s->cameras, SCENE_MAX_CAMERAS, "cameras");
+    if (r != WX_OK) {
+        return r;
     }
-    s->cameras = grown;
-    wx_scene_camera *cam = &grown[s->camera_count];
+    wx_scene_camera *cam = &s->cameras[s->camera_count];
     memset(cam, 0, sizeof *cam);
     memcpy(cam->name, attrs.name, sizeof attrs.name);
     cam->is_output = attrs.out;
@@ -1571,17 +1572,13 @@ static wx_result parse_surface(parser *p, const xmlNode *node, void *user)
                         d.material, mesh->surfaces[i].line);
         }
     }
-    if (mesh->surface_count >= SCENE_MAX_SURFACES) {
-        return fail(p, node, WX_CAUSE_TOO_MANY, "too many surfaces (at most %d)", SCENE_MAX_SURFACES);
+    r = grow_list(p, node, (void **)&mesh->surfaces, mesh->surface_count, &m->surface_cap,
+                  sizeof *mesh->surfaces, SCENE_MAX_SURFACES, "surfaces");
+    if (r != WX_OK) {
+        return r;
     }
-    wx_surface *grown = reserve(mesh->surfaces, mesh->surface_count, &m->surface_cap,
-                                sizeof *grown);
-    if (grown == NULL) {
-        return out_of_memory(p);
-    }
-    mesh->surfaces = grown;
     static const wx_color_use colors[] = { WX_COLOR_NONE, WX_COLOR_IMPACT, WX_COLOR_DIRT };
-    wx_surface *sf = &grown[mesh->surface_count++];
+    wx_surface *sf = &mesh->surfaces[mesh->surface_count++];
     *sf = (wx_surface){ .absorption = d.absorption, .bounce = d.bounce, .dirt = d.dirt,
                         .deposit = d.deposit, .erosion = d.erosion, .colors = colors[d.colors],
                         .line = line_of(node) };
@@ -1601,19 +1598,16 @@ static wx_result parse_mesh(parser *p, const xmlNode *node, void *user)
 {
     (void)user;
     wx_scene *s = p->scene;
-    if (s->mesh_count >= SCENE_MAX_MESHES) {
-        return fail(p, node, WX_CAUSE_TOO_MANY, "too many meshes (at most %d)", SCENE_MAX_MESHES);
+    wx_result r = grow_list(p, node, (void **)&s->meshes, s->mesh_count, &p->mesh_cap,
+                            sizeof *s->meshes, SCENE_MAX_MESHES, "meshes");
+    if (r != WX_OK) {
+        return r;
     }
-    wx_mesh *grown = reserve(s->meshes, s->mesh_count, &p->mesh_cap, sizeof *grown);
-    if (grown == NULL) {
-        return out_of_memory(p);
-    }
-    s->meshes = grown;
-    wx_mesh *mesh = &grown[s->mesh_count++];
+    wx_mesh *mesh = &s->meshes[s->mesh_count++];
     memset(mesh, 0, sizeof *mesh);
     mesh->line = line_of(node);
     map_def file = { NULL };
-    wx_result r = ATTRS(mesh_attrs, &file, NULL);
+    r = ATTRS(mesh_attrs, &file, NULL);
     char why[WX_INPUT_WHY_MAX];
     wx_cause cause = WX_CAUSE_NONE;
     if (r == WX_OK && (r = resolve_path(p, node, file.file, &mesh->path)) == WX_OK &&

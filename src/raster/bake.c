@@ -28,6 +28,7 @@
 #include "model/maps.h"
 #include "model/geometry.h"
 #include "model/mesh.h"
+#include "core/matrix.h"
 #include "core/progress.h"
 #include "shaders.h"
 
@@ -368,15 +369,10 @@ static wx_result upload_mesh(baker *b, wx_mesh_data *mesh, const float *props, g
 // so that [p - origin, 1] * m = [p, 1] * wtc (computed in double).
 static void local_matrix(const float wtc[16], const double origin[3], float out[16])
 {
+    double folded[16];
+    wx_matrix_fold_origin(wtc, origin, folded);
     for (int k = 0; k < 16; ++k) {
-        out[k] = wtc[k];
-    }
-    for (int col = 0; col < 4; ++col) {
-        double t = wtc[12 + col];
-        for (int j = 0; j < 3; ++j) {
-            t += origin[j] * (double)wtc[4 * j + col];
-        }
-        out[12 + col] = (float)t;
+        out[k] = (float)folded[k];
     }
 }
 
@@ -409,14 +405,7 @@ static void survey_vertices(baker *b, const wx_mesh *mesh, const wx_mesh_data *d
         }
         const wx_scene_camera *sc = &scene->cameras[c];
         double m[16];
-        for (int k = 0; k < 16; ++k) {
-            m[k] = sc->camera.wtc[k];
-        }
-        for (int col = 0; col < 3; ++col) {
-            for (int j = 0; j < 3; ++j) {
-                m[12 + col] += data->origin[j] * m[4 * j + col];
-            }
-        }
+        wx_matrix_fold_origin(sc->camera.wtc, data->origin, m);
         int64_t outside = 0, behind = 0;
         double d_min = cs->d_min, d_max = cs->d_max;
         const float *p = data->positions;
@@ -632,13 +621,6 @@ typedef struct other_view {
     float texel_ws;    // larger side of one texel, world units
 } other_view;
 
-static void map_to_world(const float ctw[16], double u, double v, double d, double p[3])
-{
-    for (int k = 0; k < 3; ++k) {
-        p[k] = u * ctw[k] + v * ctw[4 + k] + d * ctw[8 + k] + ctw[12 + k];
-    }
-}
-
 // True when camera k sees world point p (on a surface with unit normal n) and
 // sees it more head-on than camera c (|n.view_c| = cos_c), ties going to the
 // camera listed first. Visibility: p projects into k's frame onto a texel whose
@@ -652,11 +634,8 @@ static bool other_owns(const other_view *k, int c, const double p[3], const floa
     if (!better) {
         return false;
     }
-    const float *m = k->cam->wtc;
     double uvd[3];
-    for (int col = 0; col < 3; ++col) {
-        uvd[col] = p[0] * m[col] + p[1] * m[4 + col] + p[2] * m[8 + col] + m[12 + col];
-    }
+    wx_matrix_apply_affine(k->cam->wtc, p, uvd);
     int i, j;
     if (!wx_map_texel(k->width, k->height, (float)uvd[0], (float)uvd[1], &i, &j)) {
         return false;
@@ -724,7 +703,8 @@ static wx_result compute_initial_dirt(baker *b, int c, const float *depth,
                 float u, v;
                 wx_map_texel_center(width, height, i, j, &u, &v);
                 double p[3];
-                map_to_world(sc->camera.ctw, u, v, d, p);
+                const double uvd[3] = { u, v, d };
+                wx_matrix_apply_affine(sc->camera.ctw, uvd, p);
                 for (int k = 0; k < other_count && owner; ++k) {
                     owner = !other_owns(&others[k], c, p, n, cos_c);
                 }
