@@ -223,6 +223,20 @@ void wx_turbulence_force(const wx_turbulence *turb, const float p[3], float t, f
     }
 }
 
+// Inputs the compiler cannot fold: (1 + 2^-12)^2 - (1 + 2^-11) is 2^-24 when the
+// product is not rounded before the addition, 0 when it is.
+static volatile float probe_a = 1.0f + 0x1p-12f, probe_c = -(1.0f + 0x1p-11f);
+
+WX_HOT static float multiply_add(float a, float b, float c)
+{
+    return a * b + c;
+}
+
+bool wx_kernels_fuse_multiply_add(void)
+{
+    return multiply_add(probe_a, probe_a, probe_c) != 0.0f;
+}
+
 WX_HOT void wx_forces_block(const wx_forces *forces, float t, const float *restrict x,
                             const float *restrict y, const float *restrict z, float *restrict fx,
                             float *restrict fy, float *restrict fz)

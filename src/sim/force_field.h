@@ -16,6 +16,7 @@
 #ifndef WX_FORCE_FIELD_H
 #define WX_FORCE_FIELD_H
 
+#include <stdbool.h>
 #include <stdint.h>
 
 #include "core/error.h"
@@ -34,6 +35,13 @@
 #else
 #define WX_HOT
 #endif
+
+/// Whether the hot kernels (WX_HOT) of this build, on this machine, fuse
+/// multiply-adds into one rounding. It is what makes a simulation's last bits
+/// differ between machines and builds (a baseline x86-64 CPU or an -O1 build
+/// does not fuse): same-build, same-machine runs stay identical for any thread
+/// count either way. Tests pin the simulation's hash per answer.
+bool wx_kernels_fuse_multiply_add(void);
 
 typedef struct wx_turbulence {
     float strength;  ///< force scale (N)
