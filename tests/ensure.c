@@ -27,6 +27,49 @@ void ensure_report_near(const char *file, int line, const char *what, double a, 
     ensure_failed_checks++;
 }
 
+void ensure_report_cause(const char *file, int line, const wx_error *err, wx_cause want)
+{
+    fprintf(stderr, "%s:%d: ENSURE_CAUSE failed: %s, expected %s (\"%s\")\n", file, line,
+            wx_cause_name(err->cause), wx_cause_name(want), err->message);
+    ensure_failed_checks++;
+}
+
+bool ensure_read_expectation(const char *path, ensure_expectation *out)
+{
+    char *text = ensure_read_file(path);
+    const char *prefix = "<!-- expect: ";
+    bool ok = false;
+    if (text != NULL && strncmp(text, prefix, strlen(prefix)) == 0) {
+        char *rest = text + strlen(prefix);
+        char *after_line;
+        long line = strtol(rest, &after_line, 10);
+        char *cause = after_line + 2;
+        size_t cause_len = strspn(cause, "ABCDEFGHIJKLMNOPQRSTUVWXYZ_");
+        char *substring = cause + cause_len + 2;
+        char *end = strstr(rest, " -->");
+        char *newline = strchr(rest, '\n');
+        if (after_line != rest && strncmp(after_line, ": ", 2) == 0 && cause_len > 0 &&
+            strncmp(cause + cause_len, ": ", 2) == 0 && end != NULL && end > substring &&
+            (newline == NULL || end < newline)) {
+            for (int c = 0; c < WX_CAUSE_COUNT && !ok; ++c) {
+                const char *name = wx_cause_name((wx_cause)c);
+                if (strlen(name) == cause_len && strncmp(name, cause, cause_len) == 0) {
+                    out->line = (int)line;
+                    out->cause = (wx_cause)c;
+                    snprintf(out->substring, sizeof out->substring, "%.*s",
+                             (int)(end - substring), substring);
+                    ok = true;
+                }
+            }
+        }
+    }
+    free(text);
+    if (!ok) {
+        fprintf(stderr, "%s: no '<!-- expect: LINE: CAUSE: substring -->' first line\n", path);
+    }
+    return ok;
+}
+
 void ensure_run(const char *name, void (*fn)(void))
 {
     ensure_failed_checks = 0;

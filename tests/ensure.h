@@ -14,6 +14,8 @@
 #include <stddef.h>
 #include <stdio.h>
 
+#include "core/error.h"
+
 extern int ensure_failed_checks; // failed checks in the running test
 
 void ensure_report(const char *file, int line, const char *what);
@@ -43,6 +45,19 @@ int ensure_summary(void);
         }                                                                                    \
     } while (0)
 
+/// Ends the test unless the error's cause is WX_CAUSE_<want>: tests branch on the
+/// cause, and check in the message only what a person reads there (the file, the
+/// line, the numbers). ENSURE_CAUSE(err, BAD_VALUE).
+#define ENSURE_CAUSE(err, want)                                                              \
+    do {                                                                                     \
+        if ((err).cause != WX_CAUSE_##want) {                                                \
+            ensure_report_cause(__FILE__, __LINE__, &(err), WX_CAUSE_##want);                \
+            return;                                                                          \
+        }                                                                                    \
+    } while (0)
+
+void ensure_report_cause(const char *file, int line, const wx_error *err, wx_cause want);
+
 /// Folder of the built programs ($WX_BUILD, default "build").
 const char *ensure_build_dir(void);
 
@@ -62,6 +77,18 @@ const char *ensure_write_file(const char *dir, const char *name, const char *tex
 
 /// Reads a whole file into a malloc'd NUL-terminated string (NULL on failure).
 char *ensure_read_file(const char *path);
+
+/// What a bad input of tests/bad/ must do, from its first line
+/// "<!-- expect: LINE: CAUSE: substring -->": fail for WX_CAUSE_<CAUSE> with a
+/// message that starts "path:LINE: " (LINE 0: names no XML line) and contains
+/// the substring. False (with a note on stderr) when the line is not there.
+typedef struct ensure_expectation {
+    int line;
+    wx_cause cause;
+    char substring[512];
+} ensure_expectation;
+
+bool ensure_read_expectation(const char *path, ensure_expectation *out);
 
 /// True when `haystack` contains `needle`.
 bool ensure_contains(const char *haystack, const char *needle);

@@ -481,6 +481,7 @@ TEST(unmatched_material_lists_names)
     options_for(&o, "unmatched");
     wx_error err = { 0 };
     ENSURE(wx_bake_scene(&s, &o, &err) == WX_BAD_INPUT);
+    ENSURE_CAUSE(err, UNMATCHED_MATERIAL);
     ENSURE(ensure_contains(err.message, "scene.xml:42: mesh '"));
     ENSURE(ensure_contains(err.message, "bake_two_materials.obj' has material 'Wood' that no "
                                         "<Surface> matches (materials in the file: Wood, Glass)"));
@@ -552,6 +553,7 @@ TEST(vertex_colours_missing_is_an_error)
     options_for(&o, "nocolors");
     wx_error err = { 0 };
     ENSURE(wx_bake_scene(&s, &o, &err) == WX_BAD_INPUT);
+    ENSURE_CAUSE(err, UNMATCHED_MATERIAL);
     ENSURE(ensure_contains(err.message, "vertex colours"));
     ENSURE(ensure_contains(err.message, "bake_box.obj"));
     scene_end(&s);
@@ -750,6 +752,7 @@ TEST(output_camera_gets_depth_and_normal_only)
 TEST(missing_and_unsupported_mesh_files)
 {
     const char *files[2] = { "bake_missing_mesh.obj", "bake_not_a_mesh.txt" };
+    const wx_cause causes[2] = { WX_CAUSE_FILE_MISSING, WX_CAUSE_BAD_MESH };
     for (int k = 0; k < 2; ++k) {
         wx_scene s;
         scene_begin(&s);
@@ -760,6 +763,7 @@ TEST(missing_and_unsupported_mesh_files)
         options_for(&o, "missing");
         wx_error err = { 0 };
         ENSURE(wx_bake_scene(&s, &o, &err) == WX_BAD_INPUT);
+        ENSURE(err.cause == causes[k]);
         ENSURE(ensure_contains(err.message, "scene.xml:7"));
         ENSURE(ensure_contains(err.message, files[k]));
         ENSURE(!wx_has_path(s.cameras[0].depth_path));
@@ -777,6 +781,7 @@ TEST(no_geometry_is_an_error)
     options_for(&o, "nogeometry");
     wx_error err = { 0 };
     ENSURE(wx_bake_scene(&s, &o, &err) == WX_BAD_INPUT);
+    ENSURE_CAUSE(err, MISSING);
     ENSURE(ensure_contains(err.message, "camera 'front'"));
     ENSURE(ensure_contains(err.message, "no <Geometry>"));
     // Nothing to bake (maps given): no mesh needed, nothing written.
@@ -796,6 +801,7 @@ TEST(maps_beyond_the_renderer_are_refused)
     options_for(&o, "huge");
     wx_error err = { 0 };
     ENSURE(wx_bake_scene(&s, &o, &err) == WX_BAD_INPUT);
+    ENSURE_CAUSE(err, MAP_SIZE);
     ENSURE(ensure_contains(err.message, "camera 'huge'"));
     ENSURE(ensure_contains(err.message, "at most"));
     scene_end(&s);

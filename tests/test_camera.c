@@ -162,10 +162,12 @@ TEST(singular_and_bad_views_are_refused)
     wx_view same = { .eye = { 1, 1, 1 }, .target = { 1, 1, 1 }, .up = { 0, 1, 0 },
                      .width_ws = 1, .height_ws = 1, .width_px = 4, .height_px = 4 };
     ENSURE(wx_camera_from_view(&same, &cam, &err) == WX_BAD_INPUT);
+    ENSURE_CAUSE(err, BAD_CAMERA);
     ENSURE(ensure_contains(err.message, "same point"));
     wx_view parallel = { .eye = { 0, 5, 0 }, .target = { 0, 0, 0 }, .up = { 0, 1, 0 },
                          .width_ws = 1, .height_ws = 1, .width_px = 4, .height_px = 4 };
     ENSURE(wx_camera_from_view(&parallel, &cam, &err) == WX_BAD_INPUT);
+    ENSURE_CAUSE(err, BAD_CAMERA);
     ENSURE(ensure_contains(err.message, "parallel"));
 }
 

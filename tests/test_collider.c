@@ -322,6 +322,7 @@ TEST(projective_cameras_are_refused)
     wx_maps_free(&maps);
     ENSURE(r == WX_BAD_INPUT);
     ENSURE(ensure_contains(err.message, "orthographic"));
+    ENSURE_CAUSE(err, BAD_CAMERA);
 }
 
 int main(void)

@@ -207,18 +207,19 @@ static bool write_noisy_file(const char *path)
     return ok;
 }
 
-// Expects reading `path` to fail with WX_BAD_INPUT, a message naming the file and
-// containing `needle`, and the image left empty.
-static bool read_fails(const char *path, const char *needle)
+// Expects reading `path` to fail for `cause` (a bad input), a message naming the
+// file and containing `needle`, and the image left empty.
+static bool read_fails(const char *path, wx_cause cause, const char *needle)
 {
     static const char *const wanted[] = {"R"};
     wx_image image;
     wx_error err = { 0 };
     wx_result r = wx_exr_read(path, wanted, 1, &image, &err);
-    bool ok = r == WX_BAD_INPUT && ensure_contains(err.message, path) &&
+    bool ok = r == WX_BAD_INPUT && err.cause == cause && ensure_contains(err.message, path) &&
               ensure_contains(err.message, needle) && image.channels[0] == NULL && image.width == 0;
     if (!ok) {
-        fprintf(stderr, "    reading %s: result %d, message \"%s\"\n", path, (int)r, err.message);
+        fprintf(stderr, "    reading %s: result %d, cause %s, message \"%s\"\n", path, (int)r,
+                wx_cause_name(err.cause), err.message);
     }
     return ok;
 }
@@ -554,6 +555,7 @@ TEST(depth_alternatives_read_z)
     // Two entries naming the same channel are refused (a caller's mistake).
     static const char *const twice[] = {"R|Z", "Z"};
     ENSURE(wx_exr_read(path, twice, 2, &back, &err) == WX_FAIL);
+    ENSURE_CAUSE(err, INTERNAL);
     ENSURE(ensure_contains(err.message, "channel Z asked for twice"));
     ENSURE(back.channels[0] == NULL);
 }
@@ -570,11 +572,13 @@ TEST(missing_channel_lists_what_the_file_has)
     wx_image back;
     wx_error err = { 0 };
     ENSURE(wx_exr_read(path, wanted, 1, &back, &err) == WX_BAD_INPUT);
+    ENSURE_CAUSE(err, BAD_MAP);
     ENSURE(ensure_contains(err.message, path));
     ENSURE(ensure_contains(err.message, ": no channel R or Z (has: B, G)"));
     ENSURE(back.channels[0] == NULL);
     static const char *const two[] = {"G", "A"};
     ENSURE(wx_exr_read(path, two, 2, &back, &err) == WX_BAD_INPUT);
+    ENSURE_CAUSE(err, BAD_MAP);
     ENSURE(ensure_contains(err.message, "no channel A (has: B, G)"));
     ENSURE(back.channels[0] == NULL);
 }
@@ -584,25 +588,26 @@ TEST(missing_channel_lists_what_the_file_has)
 
 TEST(missing_file_is_bad_input)
 {
-    ENSURE(read_fails(path_in("does_not_exist.exr"), "cannot open (No such file or directory)"));
+    ENSURE(read_fails(path_in("does_not_exist.exr"), WX_CAUSE_FILE_MISSING, "cannot open (No such file or directory)"));
     wx_image image;
     wx_error err = { 0 };
     const char *path = path_in("does_not_exist_either.exr");
     ENSURE(wx_exr_read_header(path, &image, &err) == WX_BAD_INPUT);
+    ENSURE_CAUSE(err, FILE_MISSING);
     ENSURE(ensure_contains(err.message, path));
 }
 
 TEST(empty_file_is_bad_input)
 {
     const char *path = ensure_write_file(ensure_tmpdir(), "empty.exr", "");
-    ENSURE(read_fails(path, "not an OpenEXR file"));
+    ENSURE(read_fails(path, WX_CAUSE_BAD_MAP, "not an OpenEXR file"));
 }
 
 TEST(text_file_is_bad_input)
 {
     const char *path = ensure_write_file(ensure_tmpdir(), "text.exr", "depth map goes here\n");
-    ENSURE(read_fails(path, "not an OpenEXR file"));
-    ENSURE(read_fails(ensure_tmpdir(), "not a regular file"));
+    ENSURE(read_fails(path, WX_CAUSE_BAD_MAP, "not an OpenEXR file"));
+    ENSURE(read_fails(ensure_tmpdir(), WX_CAUSE_NOT_REGULAR_FILE, "not a regular file"));
 }
 
 TEST(truncated_file_is_bad_input)
@@ -615,7 +620,7 @@ TEST(truncated_file_is_bad_input)
     bool written = write_bytes(path, bytes, size / 2);
     free(bytes);
     ENSURE(written);
-    ENSURE(read_fails(path, "truncated or corrupt (reading scanlines "));
+    ENSURE(read_fails(path, WX_CAUSE_BAD_MAP, "truncated or corrupt (reading scanlines "));
 }
 
 // A valid 64 x 64 ZIP file with smooth data, which compresses well.
@@ -663,7 +668,7 @@ TEST(corrupt_chunk_is_bad_input)
         bytes[k] = (unsigned char)(k * 7u + 3u);
     }
     ENSURE(write_bytes(path, bytes, size));
-    ENSURE(read_fails(path, "truncated or corrupt (reading scanlines 32-47"));
+    ENSURE(read_fails(path, WX_CAUSE_BAD_MAP, "truncated or corrupt (reading scanlines 32-47"));
 
     // The same chunk claiming 2 GB of data.
     ENSURE(write_smooth_file(path));
@@ -677,7 +682,7 @@ TEST(corrupt_chunk_is_bad_input)
     bool written = write_bytes(path, bytes, size);
     free(bytes);
     ENSURE(written);
-    ENSURE(read_fails(path, "truncated or corrupt (reading scanlines 32-47"));
+    ENSURE(read_fails(path, WX_CAUSE_BAD_MAP, "truncated or corrupt (reading scanlines 32-47"));
 }
 
 TEST(garbage_after_magic_is_bad_input)
@@ -692,12 +697,12 @@ TEST(garbage_after_magic_is_bad_input)
     }
     const char *path = path_in("garbage.exr");
     ENSURE(write_bytes(path, bytes, sizeof bytes));
-    ENSURE(read_fails(path, "corrupt OpenEXR header"));
+    ENSURE(read_fails(path, WX_CAUSE_BAD_MAP, "corrupt OpenEXR header"));
     // Magic and version 2, then garbage.
     bytes[4] = 2;
     bytes[5] = bytes[6] = bytes[7] = 0;
     ENSURE(write_bytes(path, bytes, sizeof bytes));
-    ENSURE(read_fails(path, "corrupt OpenEXR header"));
+    ENSURE(read_fails(path, WX_CAUSE_BAD_MAP, "corrupt OpenEXR header"));
 }
 
 // Rewrites the dataWindow of the EXR at `path` to (0, 0) - (max_x, max_y).
@@ -733,15 +738,16 @@ TEST(absurd_size_is_bad_input)
     const char *path = path_in("huge.exr");
     ENSURE(write_noisy_file(path));
     ENSURE(patch_data_window(path, 99999, 99999));
-    ENSURE(read_fails(path, "100000 x 100000 exceeds the largest map size 16384 x 16384"));
+    ENSURE(read_fails(path, WX_CAUSE_MAP_SIZE, "100000 x 100000 exceeds the largest map size 16384 x 16384"));
     wx_image image;
     wx_error err = { 0 };
     ENSURE(wx_exr_read_header(path, &image, &err) == WX_BAD_INPUT);
+    ENSURE_CAUSE(err, MAP_SIZE);
     ENSURE(ensure_contains(err.message, "exceeds the largest map size"));
     // One side over the limit is enough.
     ENSURE(write_noisy_file(path));
     ENSURE(patch_data_window(path, 16384, 15));
-    ENSURE(read_fails(path, "16385 x 16 exceeds"));
+    ENSURE(read_fails(path, WX_CAUSE_MAP_SIZE, "16385 x 16 exceeds"));
 }
 
 TEST(tiled_file_is_refused)
@@ -759,7 +765,7 @@ TEST(tiled_file_is_refused)
     raw.planes[0] = plane;
     const char *path = path_in("tiled.exr");
     ENSURE(write_raw_exr(path, &raw));
-    ENSURE(read_fails(path, "tiled OpenEXR files are not supported"));
+    ENSURE(read_fails(path, WX_CAUSE_BAD_MAP, "tiled OpenEXR files are not supported"));
 }
 
 // ---------------------------------------------------------------------------
@@ -775,6 +781,7 @@ TEST(write_to_missing_folder_fails_cleanly)
     wx_result r = wx_exr_write(path, &image, &err);
     wx_image_free(&image);
     ENSURE(r == WX_FAIL);
+    ENSURE_CAUSE(err, IO);
     ENSURE(ensure_contains(err.message, path));
     ENSURE(ensure_contains(err.message, "No such file or directory"));
     struct stat st;
@@ -863,6 +870,7 @@ TEST(write_failure_keeps_the_old_file)
     signal(SIGXFSZ, old_handler);
     wx_image_free(&image);
     ENSURE(r == WX_FAIL);
+    ENSURE_CAUSE(err, IO);
     ENSURE(ensure_contains(err.message, path));
     ENSURE(ensure_contains(err.message, strerror(EFBIG)));
     ENSURE(count_temporaries(dir) == 0);
@@ -881,9 +889,12 @@ TEST(image_alloc_checks_sizes)
     wx_image image;
     wx_error err = { 0 };
     ENSURE(wx_image_alloc(&image, 16385, 1, 1, names, &err) == WX_BAD_INPUT);
+    ENSURE_CAUSE(err, MAP_SIZE);
     ENSURE(image.channels[0] == NULL);
     ENSURE(wx_image_alloc(&image, 0, 5, 1, names, &err) == WX_BAD_INPUT);
+    ENSURE_CAUSE(err, MAP_SIZE);
     ENSURE(wx_image_alloc(&image, 5, 5, 9, names, &err) == WX_BAD_INPUT);
+    ENSURE_CAUSE(err, BAD_ARGUMENT);
     ENSURE(wx_image_alloc(&image, 3, 2, 2, names, &err) == WX_OK);
     bool right = image.width == 3 && image.height == 2 && image.channel_count == 2 &&
                  strcmp(image.channel_names[1], "G") == 0 && image.channels[1][5] == 0.0f;

@@ -48,6 +48,7 @@ TEST(bad_octaves_are_refused)
     wx_forces forces;
     wx_error err;
     ENSURE(wx_forces_init(&forces, &f, 1, 1, &err) == WX_BAD_INPUT);
+    ENSURE_CAUSE(err, BAD_VALUE);
     ENSURE(ensure_contains(err.message, "octaves"));
 }
 

@@ -559,19 +559,24 @@ TEST(bad_definitions_are_refused)
     wx_error err;
     def.radius = -1.0f;
     ENSURE(wx_gather_compute(&def, mask, NULL, &err) == WX_BAD_INPUT);
+    ENSURE_CAUSE(err, BAD_VALUE);
     def.radius = 1e6f; // two million texels across
     ENSURE(wx_gather_compute(&def, mask, NULL, &err) == WX_BAD_INPUT);
+    ENSURE_CAUSE(err, BAD_VALUE);
     ENSURE(ensure_contains(err.message, "radius"));
     def.radius = 0.0f;
     wx_camera persp = out.cam;
     persp.wtc[11] = 1.0f; // w depends on z: not orthographic
     def.target.camera = &persp;
     ENSURE(wx_gather_compute(&def, mask, NULL, &err) == WX_BAD_INPUT);
+    ENSURE_CAUSE(err, BAD_CAMERA);
     ENSURE(ensure_contains(err.message, "orthographic"));
     def.target.camera = &out.cam;
     def.target.width = 9; // camera is 8 x 4
-    ENSURE(wx_gather_compute(&def, mask, NULL, &err) == WX_BAD_INPUT);
+    wx_result r = wx_gather_compute(&def, mask, NULL, &err);
     maps_free(&out);
+    ENSURE(r == WX_BAD_INPUT);
+    ENSURE_CAUSE(err, MAP_SIZE);
 }
 
 // ---------------------------------------------------------------------------
@@ -881,6 +886,7 @@ TEST(missing_output_camera_is_an_error)
     free_file_scene(&fs);
     ENSURE(r == WX_BAD_INPUT);
     ENSURE(ensure_contains(err.message, "output camera"));
+    ENSURE_CAUSE(err, MISSING);
 }
 
 int main(void)

@@ -142,6 +142,7 @@ TEST(only_selected_maps_are_loaded)
     // A selected map without a file is an error.
     ENSURE(wx_maps_load(&maps, WX_MAPS_DIRT | WX_MAPS_NORMAL, NULL, NULL, NULL, dirt_path, &err) ==
            WX_BAD_INPUT);
+    ENSURE_CAUSE(err, BAD_ARGUMENT);
     ENSURE(ensure_contains(err.message, "normal"));
     ENSURE(all_null(&maps));
 }
@@ -157,6 +158,7 @@ TEST(mismatched_sizes_name_both_files)
     wx_error err = { 0 };
     ENSURE(wx_maps_load(&maps, WX_MAPS_DEPTH | WX_MAPS_NORMAL, depth_path, normal_path, NULL, NULL,
                         &err) == WX_BAD_INPUT);
+    ENSURE_CAUSE(err, MAP_SIZE);
     ENSURE(ensure_contains(err.message, depth_path));
     ENSURE(ensure_contains(err.message, normal_path));
     ENSURE(ensure_contains(err.message, "16 x 8"));
@@ -178,14 +180,17 @@ TEST(missing_channels_are_errors)
     wx_error err = { 0 };
     ENSURE(wx_maps_load(&maps, WX_MAPS_IMPACT, NULL, NULL, impact_path, NULL, &err) ==
            WX_BAD_INPUT);
+    ENSURE_CAUSE(err, BAD_MAP);
     ENSURE(ensure_contains(err.message, impact_path));
     ENSURE(ensure_contains(err.message, "no channel G (has: R)"));
     ENSURE(all_null(&maps));
     ENSURE(wx_maps_load(&maps, WX_MAPS_DIRT, NULL, NULL, NULL, dirt_path, &err) == WX_BAD_INPUT);
+    ENSURE_CAUSE(err, BAD_MAP);
     ENSURE(ensure_contains(err.message, dirt_path));
     ENSURE(ensure_contains(err.message, "no channel B (has: G, R)"));
     ENSURE(all_null(&maps));
     ENSURE(wx_maps_load(&maps, WX_MAPS_DEPTH, depth_path, NULL, NULL, NULL, &err) == WX_BAD_INPUT);
+    ENSURE_CAUSE(err, BAD_MAP);
     ENSURE(ensure_contains(err.message, "no channel R or Z (has: G)"));
 }
 
@@ -199,11 +204,13 @@ TEST(a_bad_file_frees_the_maps_already_loaded)
     wx_error err = { 0 };
     ENSURE(wx_maps_load(&maps, WX_MAPS_DEPTH | WX_MAPS_DIRT, depth_path, NULL, NULL, dirt_path,
                         &err) == WX_BAD_INPUT);
+    ENSURE_CAUSE(err, BAD_MAP);
     ENSURE(ensure_contains(err.message, dirt_path));
     ENSURE(ensure_contains(err.message, "not an OpenEXR file"));
     ENSURE(all_null(&maps));
     ENSURE(wx_maps_load(&maps, WX_MAPS_DEPTH, path_in("none.exr"), NULL, NULL, NULL, &err) ==
            WX_BAD_INPUT);
+    ENSURE_CAUSE(err, FILE_MISSING);
     ENSURE(ensure_contains(err.message, "none.exr: cannot open"));
 }
 

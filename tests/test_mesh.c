@@ -176,6 +176,7 @@ TEST(missing_file_names_it)
     wx_error err = { 0 };
     const char *path = data_path("bake_no_such_mesh.obj");
     ENSURE(wx_mesh_import(path, &m, &err) == WX_BAD_INPUT);
+    ENSURE_CAUSE(err, FILE_MISSING);
     char want[4200];
     snprintf(want, sizeof want, "%s: not found", path);
     ENSURE(strcmp(err.message, want) == 0);
@@ -188,6 +189,7 @@ TEST(unsupported_file_names_it)
     wx_mesh_data m;
     wx_error err = { 0 };
     ENSURE(wx_mesh_import(data_path("bake_not_a_mesh.txt"), &m, &err) == WX_BAD_INPUT);
+    ENSURE_CAUSE(err, BAD_MESH);
     ENSURE(ensure_contains(err.message, "bake_not_a_mesh.txt"));
     wx_mesh_data_free(&m);
 }
@@ -258,19 +260,19 @@ static const char *write_gltf(const char *dir, const char *name, const char *uri
     return ensure_write_file(dir, name, text);
 }
 
-// Imports `path` and compares the message with "<path>: <rest>" exactly.
-static bool refused_with(const char *path, wx_result code, const char *rest)
+// Imports `path`: it must fail for `cause` with the message "<path>: <rest>" exactly.
+static bool refused_with(const char *path, wx_cause cause, const char *rest)
 {
     wx_mesh_data m;
     wx_error err = { 0 };
     wx_result r = wx_mesh_import(path, &m, &err);
     char want[WX_ERROR_MAX + 8];
     snprintf(want, sizeof want, "%s: %s", path, rest);
-    bool ok = r == code && strcmp(err.message, want) == 0 && m.positions == NULL &&
-              m.triangle_count == 0;
+    bool ok = r == wx_cause_result(cause) && err.cause == cause && strcmp(err.message, want) == 0 &&
+              m.positions == NULL && m.triangle_count == 0;
     if (!ok) {
-        fprintf(stderr, "    expected %d \"%s\"\n    got      %d \"%s\"\n", (int)code, want,
-                (int)r, err.message);
+        fprintf(stderr, "    expected %s \"%s\"\n    got      %s \"%s\"\n", wx_cause_name(cause),
+                want, wx_cause_name(err.cause), err.message);
     }
     wx_mesh_data_free(&m);
     return ok;
@@ -281,6 +283,7 @@ static bool refused_with(const char *path, wx_result code, const char *rest)
 // when > 0). False when the child did not exit normally.
 typedef struct child_result {
     int code;
+    wx_cause cause;
     long long triangles;
     char message[WX_ERROR_MAX];
 } child_result;
@@ -325,6 +328,7 @@ static bool import_in_child(const char *dir, const char *path, long long extra_b
         child_result res = { 0 };
         wx_error err = { 0 };
         res.code = (int)wx_mesh_import(path, &m, &err);
+        res.cause = err.cause;
         res.triangles = m.triangle_count;
         memcpy(res.message, err.message, sizeof res.message);
         ssize_t n = write(fds[1], &res, sizeof res);
@@ -360,16 +364,16 @@ TEST(mesh_file_must_be_a_regular_file)
     alarm(30); // a FIFO opened for reading without O_NONBLOCK would wait here forever
     const char *fifo = join(dir, "fifo.obj");
     ENSURE(mkfifo(fifo, 0666) == 0);
-    ENSURE(refused_with(fifo, WX_BAD_INPUT, "is not a regular file (a FIFO)"));
+    ENSURE(refused_with(fifo, WX_CAUSE_NOT_REGULAR_FILE, "is not a regular file (a FIFO)"));
     alarm(0);
     const char *folder = join(dir, "folder.obj");
     ENSURE(mkdir(folder, 0777) == 0);
-    ENSURE(refused_with(folder, WX_BAD_INPUT, "is not a regular file (a folder)"));
+    ENSURE(refused_with(folder, WX_CAUSE_NOT_REGULAR_FILE, "is not a regular file (a folder)"));
     const char *loop = join(dir, "loop.obj");
     ENSURE(symlink("loop.obj", loop) == 0);
-    ENSURE(refused_with(loop, WX_BAD_INPUT, "is not a regular file (a loop of symbolic links)"));
-    ENSURE(refused_with("/dev/null", WX_BAD_INPUT, "is not a regular file (a device)"));
-    ENSURE(refused_with(join(dir, "nowhere.obj"), WX_BAD_INPUT, "not found"));
+    ENSURE(refused_with(loop, WX_CAUSE_NOT_REGULAR_FILE, "is not a regular file (a loop of symbolic links)"));
+    ENSURE(refused_with("/dev/null", WX_CAUSE_NOT_REGULAR_FILE, "is not a regular file (a device)"));
+    ENSURE(refused_with(join(dir, "nowhere.obj"), WX_CAUSE_FILE_MISSING, "not found"));
     // A symbolic link to a regular file is that file.
     ensure_write_file(dir, "real.obj", TRIANGLE_OBJ);
     ENSURE(symlink("real.obj", join(dir, "link.obj")) == 0);
@@ -390,7 +394,7 @@ TEST(obj_mtllib_fifo_is_refused_without_blocking)
                                         "usemtl Wood\nf 1 2 3\n");
     ENSURE(mkfifo(join(dir, "x.mtl"), 0666) == 0);
     alarm(30);
-    ENSURE(refused_with(obj, WX_BAD_INPUT,
+    ENSURE(refused_with(obj, WX_CAUSE_BAD_MESH,
                         "refers to 'x.mtl', which is not a regular file (a FIFO)"));
     alarm(0);
 }
@@ -403,14 +407,14 @@ TEST(obj_mtllib_outside_or_a_folder_is_refused)
     const char *obj = ensure_write_file(sub, "a.obj",
                                         "mtllib ../shared.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\n"
                                         "usemtl Wood\nf 1 2 3\n");
-    ENSURE(refused_with(obj, WX_BAD_INPUT, "refers to '../shared.mtl', outside the mesh's folder"));
+    ENSURE(refused_with(obj, WX_CAUSE_BAD_MESH, "refers to '../shared.mtl', outside the mesh's folder"));
     // Through a symbolic link inside the folder: realpath sees where it leads.
     ENSURE(symlink("../shared.mtl", join(sub, "link.mtl")) == 0);
     obj = ensure_write_file(sub, "b.obj", "mtllib link.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
-    ENSURE(refused_with(obj, WX_BAD_INPUT, "refers to 'link.mtl', outside the mesh's folder"));
+    ENSURE(refused_with(obj, WX_CAUSE_BAD_MESH, "refers to 'link.mtl', outside the mesh's folder"));
     // The mesh's own folder named as the library.
     obj = ensure_write_file(sub, "c.obj", "mtllib .\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
-    ENSURE(refused_with(obj, WX_BAD_INPUT,
+    ENSURE(refused_with(obj, WX_CAUSE_BAD_MESH,
                         "refers to '.', which is not a regular file (a folder)"));
     // The same library inside the folder (a subfolder) is read: its material name arrives.
     const char *lib = make_dir("mtl_outside/m/lib");
@@ -476,19 +480,19 @@ TEST(gltf_buffer_outside_the_folder_is_refused)
     const char *sub = make_dir("gltf_outside/m");
     ENSURE(write_triangle_bin(join(dir, "outer.bin")));
     const char *gltf = write_gltf(sub, "a.gltf", "../outer.bin");
-    ENSURE(refused_with(gltf, WX_BAD_INPUT, "refers to '../outer.bin', outside the mesh's folder"));
+    ENSURE(refused_with(gltf, WX_CAUSE_BAD_MESH, "refers to '../outer.bin', outside the mesh's folder"));
     ENSURE(symlink("../outer.bin", join(sub, "link.bin")) == 0);
     gltf = write_gltf(sub, "b.gltf", "link.bin");
-    ENSURE(refused_with(gltf, WX_BAD_INPUT, "refers to 'link.bin', outside the mesh's folder"));
+    ENSURE(refused_with(gltf, WX_CAUSE_BAD_MESH, "refers to 'link.bin', outside the mesh's folder"));
     // An absolute URI: Assimp 5.2.5 joins it to the mesh's folder ("m//etc/passwd",
     // that is m/etc/passwd), which is not there: its own message, nothing read.
     gltf = write_gltf(sub, "d.gltf", "/etc/passwd");
-    ENSURE(refused_with(gltf, WX_BAD_INPUT,
+    ENSURE(refused_with(gltf, WX_CAUSE_BAD_MESH,
                         "cannot import mesh: GLTF: could not open referenced file "
                         "\"/etc/passwd\""));
     // A climbing URI that names nothing is only a probe: Assimp's own message.
     gltf = write_gltf(sub, "e.gltf", "../missing.bin");
-    ENSURE(refused_with(gltf, WX_BAD_INPUT,
+    ENSURE(refused_with(gltf, WX_CAUSE_BAD_MESH,
                         "cannot import mesh: GLTF: could not open referenced file "
                         "\"../missing.bin\""));
     // A mesh named without a folder: Assimp then opens an absolute URI as it is
@@ -496,11 +500,11 @@ TEST(gltf_buffer_outside_the_folder_is_refused)
     gltf = write_gltf(sub, "f.gltf", "/etc/passwd");
     child_result res;
     ENSURE(import_in_child(sub, "f.gltf", 0, &res));
-    ENSURE(res.code == WX_BAD_INPUT);
+    ENSURE(res.code == WX_BAD_INPUT && res.cause == WX_CAUSE_BAD_MESH);
     ENSURE(strcmp(res.message, "f.gltf: refers to '/etc/passwd', outside the mesh's folder") == 0);
     gltf = write_gltf(sub, "g.gltf", "../outer.bin");
     ENSURE(import_in_child(sub, "g.gltf", 0, &res));
-    ENSURE(res.code == WX_BAD_INPUT);
+    ENSURE(res.code == WX_BAD_INPUT && res.cause == WX_CAUSE_BAD_MESH);
     ENSURE(strcmp(res.message, "g.gltf: refers to '../outer.bin', outside the mesh's folder") == 0);
 }
 
@@ -512,13 +516,13 @@ TEST(non_finite_vertex_colours_are_refused)
     const char *obj = ensure_write_file(dir, "nan.obj",
                                         "v 0 0 0 0.5 0.5 0.5\nv 1 0 0 nan 0.5 0.5\n"
                                         "v 0 1 0 0.5 0.5 0.5\nf 1 2 3\n");
-    ENSURE(refused_with(obj, WX_BAD_INPUT,
+    ENSURE(refused_with(obj, WX_CAUSE_BAD_MESH,
                         "the vertex at (1, 0, 0) has a colour that is not a finite number "
                         "(nan, 0.5, 0.5, 1)"));
     obj = ensure_write_file(dir, "inf.obj",
                             "v 0 0 0 0.5 0.5 0.5\nv 1 0 0 0.5 0.5 0.5\n"
                             "v 0 2 0 0.5 0.5 inf\nf 1 2 3\n");
-    ENSURE(refused_with(obj, WX_BAD_INPUT,
+    ENSURE(refused_with(obj, WX_CAUSE_BAD_MESH,
                         "the vertex at (0, 2, 0) has a colour that is not a finite number "
                         "(0.5, 0.5, inf, 1)"));
     // Finite colours of an OBJ arrive as they are (alpha 1).
@@ -542,13 +546,13 @@ TEST(non_finite_normals_of_the_file_are_refused)
     const char *obj = ensure_write_file(dir, "nan.obj",
                                         "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nvn nan 0 1\n"
                                         "f 1//1 2//2 3//1\n");
-    ENSURE(refused_with(obj, WX_BAD_INPUT,
+    ENSURE(refused_with(obj, WX_CAUSE_BAD_MESH,
                         "the vertex at (1, 0, 0) has a normal that is not a finite number "
                         "(nan, 0, 1)"));
     obj = ensure_write_file(dir, "inf.obj",
                             "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nvn 0 -inf 0\n"
                             "f 1//1 2//1 3//2\n");
-    ENSURE(refused_with(obj, WX_BAD_INPUT,
+    ENSURE(refused_with(obj, WX_CAUSE_BAD_MESH,
                         "the vertex at (0, 1, 0) has a normal that is not a finite number "
                         "(0, -inf, 0)"));
 }
@@ -590,7 +594,7 @@ TEST(out_of_memory_inside_assimp_is_a_failure_not_bad_input)
              ensure_tests_dir());
     child_result res;
     ENSURE(import_in_child(NULL, bunny, 16LL << 20, &res));
-    ENSURE(res.code == WX_FAIL);
+    ENSURE(res.code == WX_FAIL && res.cause == WX_CAUSE_OUT_OF_MEMORY);
     char want[4400];
     // What Assimp 5.2.5 reports: std::bad_alloc's what(), caught in the importer.
     snprintf(want, sizeof want,
@@ -645,7 +649,7 @@ TEST(fbx_unit_that_is_not_positive_is_refused)
     // mesh_cube_2m.fbx with UnitScaleFactor -1 (tests/bad/mesh/).
     char path[4200];
     snprintf(path, sizeof path, "%s/bad/mesh/fbx_negative_unit.fbx", ensure_tests_dir());
-    ENSURE(refused_with(path, WX_BAD_INPUT,
+    ENSURE(refused_with(path, WX_CAUSE_BAD_MESH,
                         "the FBX unit (UnitScaleFactor -1 centimetres) is not a positive number"));
 }
 

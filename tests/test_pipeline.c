@@ -41,6 +41,7 @@ TEST(output_folder_is_created_with_parents)
     snprintf(opts.out_dir, sizeof opts.out_dir, "%s", file);
     wx_error err;
     ENSURE(wx_output_prepare(&scene, &opts, NULL, &err) == WX_BAD_INPUT);
+    ENSURE_CAUSE(err, OUTPUT_CONFLICT);
     ENSURE(ensure_contains(err.message, "not a folder"));
 }
 
@@ -75,6 +76,7 @@ TEST(an_input_file_is_never_an_output)
     char path[WX_PATH_MAX];
     wx_error err;
     ENSURE(wx_output_path(&scene, &opts, "front_depth.exr", path, &err) == WX_BAD_INPUT);
+    ENSURE_CAUSE(err, OUTPUT_CONFLICT);
     ENSURE(ensure_contains(err.message, "would be overwritten"));
     ENSURE(wx_output_path(&scene, &opts, "s.xml", path, &err) == WX_BAD_INPUT);
     ENSURE(wx_output_path(&scene, &opts, "mask.exr", path, &err) == WX_OK);
@@ -104,6 +106,7 @@ TEST(atomic_write_replaces_whole_and_leaves_no_temporary)
     snprintf(missing, sizeof missing, "%s/none/data.bin", dir);
     wx_error err;
     ENSURE(wx_write_file_atomic(missing, "x", 1, &err) == WX_FAIL);
+    ENSURE_CAUSE(err, IO);
     ENSURE(ensure_contains(err.message, missing));
 }
 

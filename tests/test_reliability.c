@@ -23,6 +23,7 @@
 #include "io/scene_xml.h"
 #include "model/image.h"
 #include "pipeline/outputs.h"
+#include "pipeline/run.h"
 
 static char out[65536];
 
@@ -62,36 +63,32 @@ static void free_names(char **names, int count)
     }
 }
 
-// The same "<!-- expect: LINE: substring -->" first line as test_scene's bad_scenes.
-// LINE 0: the message names no XML line (a map whose pixels are bad is found
-// when the simulation loads it; the message names the map file).
-static bool read_expectation(const char *path, int *line, char *substring, size_t cap)
+// Loads and runs `path` in this process: it must fail for the expected cause
+// (the command line shows only the message and the exit status).
+static bool fails_in_process_for(const char *path, const ensure_expectation *want, int index)
 {
-    char *text = ensure_read_file(path);
-    if (text == NULL) {
-        return false;
+    wx_scene scene;
+    wx_error err = { 0 };
+    wx_result r = wx_scene_load(path, &scene, &err);
+    if (r == WX_OK) {
+        wx_run_def def = wx_default_run_def(&scene);
+        snprintf(def.out_dir, sizeof def.out_dir, "%s/in_process_%d", ensure_tmpdir(), index);
+        def.quiet = true;
+        wx_run_report report;
+        r = wx_run_phases(&scene, &def, WX_PHASE_ALL, &report, &err);
     }
-    const char *prefix = "<!-- expect: ";
-    bool ok = false;
-    if (strncmp(text, prefix, strlen(prefix)) == 0) {
-        char *rest = text + strlen(prefix);
-        char *colon;
-        long n = strtol(rest, &colon, 10);
-        char *end = strstr(rest, " -->");
-        char *newline = strchr(rest, '\n');
-        if (colon != rest && colon[0] == ':' && colon[1] == ' ' && end != NULL &&
-            (newline == NULL || end < newline)) {
-            *line = (int)n;
-            snprintf(substring, cap, "%.*s", (int)(end - (colon + 2)), colon + 2);
-            ok = true;
-        }
+    wx_scene_free(&scene);
+    if (r == WX_BAD_INPUT && err.cause == want->cause) {
+        return true;
     }
-    free(text);
-    return ok;
+    fprintf(stderr, "%s: expected %s, got %d %s: %s\n", path, wx_cause_name(want->cause), (int)r,
+            wx_cause_name(err.cause), err.message);
+    return false;
 }
 
 // Runs `weathering COMMAND` on every bad input of `folder`: exit status 2, one
-// message naming the file (and the line), and no output folder or file made.
+// message naming the file (and the line), and no output folder or file made; and
+// in this process, the cause.
 static int check_bad_folder(const char *folder, const char *command, int *checked)
 {
     char *names[256];
@@ -100,13 +97,16 @@ static int check_bad_folder(const char *folder, const char *command, int *checke
     for (int i = 0; i < count; ++i) {
         char path[4400];
         snprintf(path, sizeof path, "%s/%s", folder, names[i]);
-        int line;
-        char substring[512];
-        if (!read_expectation(path, &line, substring, sizeof substring)) {
-            fprintf(stderr, "%s: no '<!-- expect: LINE: substring -->' first line\n", path);
+        ensure_expectation want;
+        if (!ensure_read_expectation(path, &want)) {
             failures++;
             continue;
         }
+        if (!fails_in_process_for(path, &want, *checked + i)) {
+            failures++;
+        }
+        int line = want.line;
+        const char *substring = want.substring;
         char out_dir[4400];
         snprintf(out_dir, sizeof out_dir, "%s/bad_%d", ensure_tmpdir(), *checked + i);
         int status = ensure_shell(out, sizeof out, "%s/weathering %s %s --out %s -q",

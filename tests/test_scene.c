@@ -416,6 +416,7 @@ TEST(ctw_not_inverse_is_an_error)
     wx_scene s;
     wx_error err;
     ENSURE(wx_scene_load(path, &s, &err) == WX_BAD_INPUT);
+    ENSURE_CAUSE(err, BAD_CAMERA);
     char expected[4200];
     snprintf(expected, sizeof expected, "%s:6: <CTWMatrix> of camera 'top' is not the inverse",
              path);
@@ -432,33 +433,7 @@ static int compare_names(const void *a, const void *b)
     return strcmp(*(const char *const *)a, *(const char *const *)b);
 }
 
-// Reads "<!-- expect: LINE: substring -->" from the first line of a bad scene.
-static bool read_expectation(const char *path, int *line, char *substring, size_t cap)
-{
-    char *text = ensure_read_file(path);
-    if (text == NULL) {
-        return false;
-    }
-    const char *prefix = "<!-- expect: ";
-    bool ok = false;
-    if (strncmp(text, prefix, strlen(prefix)) == 0) {
-        char *rest = text + strlen(prefix);
-        char *colon;
-        long n = strtol(rest, &colon, 10);
-        char *end = strstr(rest, " -->");
-        char *newline = strchr(rest, '\n');
-        if (colon != rest && colon[0] == ':' && colon[1] == ' ' && end != NULL &&
-            (newline == NULL || end < newline)) {
-            *line = (int)n;
-            snprintf(substring, cap, "%.*s", (int)(end - (colon + 2)), colon + 2);
-            ok = true;
-        }
-    }
-    free(text);
-    return ok;
-}
-
-// Every tests/bad/*.xml fails with WX_BAD_INPUT, "path:LINE:" and its substring.
+// Every tests/bad/*.xml fails for its cause with "path:LINE:" and its substring.
 TEST(bad_scenes)
 {
     char dir_path[4096];
@@ -480,10 +455,8 @@ TEST(bad_scenes)
     for (int i = 0; i < count; ++i) {
         char path[4400];
         snprintf(path, sizeof path, "%s/%s", dir_path, names[i]);
-        int line;
-        char substring[512];
-        if (!read_expectation(path, &line, substring, sizeof substring)) {
-            fprintf(stderr, "%s: no '<!-- expect: LINE: substring -->' first line\n", path);
+        ensure_expectation want;
+        if (!ensure_read_expectation(path, &want)) {
             failures++;
             continue;
         }
@@ -492,12 +465,14 @@ TEST(bad_scenes)
         memset(&err, 0, sizeof err);
         wx_result r = wx_scene_load(path, &s, &err);
         char prefix[4500];
-        snprintf(prefix, sizeof prefix, "%s:%d: ", path, line);
-        bool ok = r == WX_BAD_INPUT && strncmp(err.message, prefix, strlen(prefix)) == 0 &&
-                  ensure_contains(err.message, substring);
+        snprintf(prefix, sizeof prefix, "%s:%d: ", path, want.line);
+        bool ok = r == WX_BAD_INPUT && err.cause == want.cause &&
+                  strncmp(err.message, prefix, strlen(prefix)) == 0 &&
+                  ensure_contains(err.message, want.substring);
         if (!ok) {
-            fprintf(stderr, "%s: expected WX_BAD_INPUT with \"%s...%s\", got %d: %s\n", names[i],
-                    prefix, substring, (int)r, err.message);
+            fprintf(stderr, "%s: expected %s with \"%s...%s\", got %d %s: %s\n", names[i],
+                    wx_cause_name(want.cause), prefix, want.substring, (int)r,
+                    wx_cause_name(err.cause), err.message);
             failures++;
         }
         ENSURE(s.cameras == NULL && s.fields == NULL && s.emitters == NULL && s.meshes == NULL);
@@ -545,6 +520,7 @@ TEST(entity_bomb_refused_quickly)
     wx_result r = wx_scene_load(path, &s, &err);
     double elapsed = seconds_now() - t0;
     ENSURE(r == WX_BAD_INPUT);
+    ENSURE_CAUSE(err, XML_CONTENT);
     ENSURE(elapsed < 1.0);
     char expected[4200];
     snprintf(expected, sizeof expected, "%s:3: entity declarations are not allowed", path);
@@ -582,6 +558,7 @@ TEST(external_entity_refused)
         wx_error err;
         memset(&err, 0, sizeof err);
         ENSURE(wx_scene_load(path, &s, &err) == WX_BAD_INPUT);
+        ENSURE_CAUSE(err, XML_CONTENT);
         ENSURE(ensure_contains(err.message, "entity declarations are not allowed"));
         ENSURE(!ensure_contains(err.message, "TOPSECRET"));
         wx_scene_free(&s);
@@ -602,17 +579,20 @@ TEST(missing_scene_file)
     wx_scene s;
     wx_error err;
     ENSURE(wx_scene_load("tests/data/no_such_scene.xml", &s, &err) == WX_BAD_INPUT);
+    ENSURE_CAUSE(err, FILE_MISSING);
     ENSURE(strcmp(err.message,
                   "tests/data/no_such_scene.xml: cannot open (No such file or directory)") == 0);
     ENSURE(s.cameras == NULL);
     wx_scene_free(&s);
     ENSURE(wx_scene_load(ensure_tmpdir(), &s, &err) == WX_BAD_INPUT); // a folder
+    ENSURE_CAUSE(err, NOT_REGULAR_FILE);
     ENSURE(ensure_contains(err.message, "is not a regular file (a folder)"));
     // A FIFO with no writer is refused at once, never waited on (issue 13).
     char fifo[4200];
     snprintf(fifo, sizeof fifo, "%s/scene_fifo.xml", ensure_tmpdir());
     ENSURE(mkfifo(fifo, 0600) == 0);
     ENSURE(wx_scene_load(fifo, &s, &err) == WX_BAD_INPUT);
+    ENSURE_CAUSE(err, NOT_REGULAR_FILE);
     ENSURE(ensure_contains(err.message, "scene_fifo.xml: is not a regular file (a FIFO)"));
 }
 

@@ -35,7 +35,7 @@ wx_result wx_gather_maps(const wx_scene *scene, const wx_run_def *opts, const wx
                          wx_error *err)
 {
     if (scene->output_index < 0 || scene->output_index >= scene->camera_count) {
-        return wx_fail(err, WX_CAUSE_BAD_SCENE, "%s: no output camera (an <Ortho out=\"true\">); gather needs one",
+        return wx_fail(err, WX_CAUSE_MISSING, "%s: no output camera (an <Ortho out=\"true\">); gather needs one",
                             scene->path);
     }
     const wx_scene_camera *out = &scene->cameras[scene->output_index];

@@ -932,7 +932,7 @@ wx_result wx_bake_render(const wx_bake_def *def, wx_bake_stats *stats, wx_error 
     if (scene->mesh_count == 0) {
         for (int c = 0; c < scene->camera_count; ++c) {
             if (b->cams[c].bake) {
-                r = wx_fail(err, WX_CAUSE_BAD_SCENE, "%s:%d: camera '%s' is given by <View> without map files, and "
+                r = wx_fail(err, WX_CAUSE_MISSING, "%s:%d: camera '%s' is given by <View> without map files, and "
                                  "the scene has no <Geometry> meshes to bake them from",
                                  scene->path, scene->cameras[c].line, scene->cameras[c].name);
                 break;

@@ -3,9 +3,11 @@
 // standing on a 6 m square slab, seen by a front and a top camera, and an output
 // camera at the front. The maps are ray-cast analytically, so they are exact.
 //
+//   make build/libweathering.a
 //   cc -std=c11 -O2 -D_POSIX_C_SOURCE=200809L -Isrc -I/usr/include/OpenEXR \
-//      tests/tools/gen_thesis_maps.c src/camera.c src/exr_io.c src/error.c src/atomic_file.c \
-//      -lOpenEXRCore-3_1 -lm -o build/gen_thesis_maps && build/gen_thesis_maps maps
+//      tests/tools/gen_thesis_maps.c build/libweathering.a -lOpenEXRCore-3_1 -lxml2 \
+//      -lassimp -lOSMesa -lpng -lm -lpthread -o build/gen_thesis_maps
+//   build/gen_thesis_maps maps
 // It prints the matrices to paste into the scene.
 #include <math.h>
 #include <stdio.h>

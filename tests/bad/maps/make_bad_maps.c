@@ -1,6 +1,7 @@
 // make_bad_maps.c: writes the bad EXR maps of tests/bad/maps/ (run once; the
 // maps are committed). Each is a 4 x 4 map broken in one way:
 //
+//   make build/libweathering.a
 //   cc -std=c11 -D_POSIX_C_SOURCE=200809L -Isrc -I/usr/include/OpenEXR
 //      tests/bad/maps/make_bad_maps.c build/libweathering.a -lOpenEXRCore-3_1
 //      -lxml2 -lassimp -lOSMesa -lpng -lm -lpthread -o /tmp/make_bad_maps
