@@ -255,7 +255,7 @@ static int command_info(const cli_args *args)
     // would, before it prints anything.
     wx_geometry geometry;
     memset(&geometry, 0, sizeof geometry);
-    bool imported = wx_scene_needs_bake(&scene) && scene.mesh_count > 0;
+    bool imported = wx_scene_needs_bake(&scene);
     if (imported) {
         wx_error err;
         wx_result r = wx_geometry_load(&scene, args->quiet, &geometry, &err);

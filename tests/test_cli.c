@@ -176,6 +176,16 @@ TEST(stale_cleanup_and_default_folder_stay_in_their_place)
     ENSURE(ensure_shell(out, sizeof out, "cd '%s' && '%s/weathering' info ...xml", d,
                         build_dir()) == 0);
     ENSURE(ensure_contains(out, "output folder: out/__\n"));
+    // The --stats file's temporary is ours too when --stats names a file in the
+    // output folder, relative or absolute, through a different spelling.
+    ENSURE(ensure_shell(NULL, 0, "cd '%s' && echo dead > out/s/.notes.json.tmp999999996 && "
+                                 "echo dead > out/s/.abs.json.tmp999999995", d) == 0);
+    ENSURE(ensure_shell(out, sizeof out, "cd '%s' && '%s/weathering' bake s.xml -q "
+                        "--stats out/s/notes.json && '%s/weathering' bake s.xml -q --out out/s "
+                        "--stats \"$PWD/out/./s/abs.json\"", d, build_dir(), build_dir()) == 0);
+    ENSURE(ensure_shell(NULL, 0, "cd '%s/out/s' && [ ! -e .notes.json.tmp999999996 ] && "
+                                 "[ ! -e .abs.json.tmp999999995 ] && [ -e notes.json ] && "
+                                 "[ -e .draft.txt.tmp999999998 ]", d) == 0);
 }
 
 // --out and --stats longer than a path may be are refused, not cut (issue 13).

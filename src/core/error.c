@@ -4,6 +4,7 @@
 #include <stdarg.h>
 #include <stdint.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 // Length of the UTF-8 sequence at s that encodes a printable character (no C1
@@ -66,11 +67,54 @@ void wx_printable(const char *text, char *out, size_t cap)
     out[used] = '\0';
 }
 
+// Copies `text` into out[cap]; a text too long keeps its beginning and its end
+// (where a message says what happened) around " ... ", cut between characters.
+static void fit(const char *text, char *out, size_t cap)
+{
+    size_t len = strlen(text);
+    if (len < cap) {
+        memcpy(out, text, len + 1);
+        return;
+    }
+    static const char gap[] = " ... ";
+    size_t keep = (cap - sizeof gap) / 2;
+    size_t head = keep, tail = len - keep;
+    while (head > 0 && ((unsigned char)text[head] & 0xc0) == 0x80) {
+        head--; // not inside a UTF-8 sequence
+    }
+    while (tail < len && ((unsigned char)text[tail] & 0xc0) == 0x80) {
+        tail++;
+    }
+    snprintf(out, cap, "%.*s%s%s", (int)head, text, gap, text + tail);
+}
+
+// Formats, escapes and fits into out[cap]: a message longer than cap (a path of
+// 4000 characters) keeps the reason at its end.
 static void vformat_printable(char *out, size_t cap, const char *fmt, va_list args)
 {
-    char raw[WX_ERROR_MAX];
-    vsnprintf(raw, sizeof raw, fmt, args);
-    wx_printable(raw, out, cap);
+    char small[WX_ERROR_MAX];
+    char *raw = small;
+    va_list again;
+    va_copy(again, args);
+    int n = vsnprintf(small, sizeof small, fmt, args);
+    if (n >= (int)sizeof small && (raw = malloc((size_t)n + 1)) != NULL) {
+        vsnprintf(raw, (size_t)n + 1, fmt, again);
+    } else if (raw == NULL) {
+        raw = small; // out of memory: the first WX_ERROR_MAX - 1 bytes
+    }
+    va_end(again);
+    size_t len = strlen(raw);
+    char *escaped = len >= sizeof small / 4 ? malloc(4 * len + 1) : NULL;
+    if (escaped != NULL) {
+        wx_printable(raw, escaped, 4 * len + 1);
+        fit(escaped, out, cap);
+        free(escaped);
+    } else {
+        wx_printable(raw, out, cap);
+    }
+    if (raw != small) {
+        free(raw);
+    }
 }
 
 static const wx_result cause_results[WX_CAUSE_COUNT] = {
@@ -119,7 +163,7 @@ void wx_error_prefix(wx_error *err, const char *fmt, ...)
     va_end(args);
     char joined[2 * WX_ERROR_MAX + 2];
     snprintf(joined, sizeof joined, "%s: %s", prefix, err->message);
-    snprintf(err->message, sizeof err->message, "%.*s", WX_ERROR_MAX - 1, joined);
+    fit(joined, err->message, sizeof err->message);
 }
 
 void wx_list_append(char *list, size_t cap, const char *item)

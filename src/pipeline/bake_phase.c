@@ -121,6 +121,15 @@ static wx_result read_given_depths(const wx_scene *scene, const wx_geometry *geo
 wx_result wx_geometry_load(const wx_scene *scene, bool quiet, wx_geometry *out, wx_error *err)
 {
     memset(out, 0, sizeof *out);
+    for (int c = 0; c < scene->camera_count && scene->mesh_count == 0; ++c) {
+        const wx_scene_camera *sc = &scene->cameras[c];
+        if (sc->has_view && !wx_has_path(sc->depth_path)) {
+            return wx_fail(err, WX_CAUSE_MISSING,
+                           "%s:%d: camera '%s' is given by <View> without map files, and the "
+                           "scene has no <Geometry> meshes to bake them from",
+                           scene->path, sc->line, sc->name);
+        }
+    }
     out->meshes = calloc(scene->mesh_count > 0 ? (size_t)scene->mesh_count : 1,
                          sizeof *out->meshes);
     if (out->meshes == NULL) {
@@ -198,7 +207,7 @@ wx_result wx_bake_scene_stats(wx_scene *scene, const wx_run_def *opts, wx_bake_s
     wx_geometry geometry;
     memset(&geometry, 0, sizeof geometry);
     wx_result r = WX_OK;
-    if (wx_scene_needs_bake(scene) && scene->mesh_count > 0) {
+    if (wx_scene_needs_bake(scene)) {
         r = wx_geometry_load(scene, opts->quiet, &geometry, err);
     }
     if (r == WX_OK) {

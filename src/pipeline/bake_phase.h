@@ -15,6 +15,7 @@
 
 /// Imports every mesh of `scene` and matches each of its materials to a
 /// <Surface> (the one naming it, else "*"). WX_BAD_INPUT "scene:LINE: ..." for
+/// a camera to bake in a scene without meshes (WX_CAUSE_MISSING), for
 /// a mesh that cannot be imported, a material no <Surface> matches, or a
 /// <Surface vertexColors> on a material without colours; a mesh without
 /// triangles is a warning (unless quiet). On failure `out` is left empty.

@@ -82,7 +82,7 @@ void wx_memory_estimate(const wx_scene *scene, unsigned phases, wx_memory_need *
     need->phase = "bake";
     if (sim > peak) {
         peak = sim;
-        need->phase = "simulate";
+        need->phase = "simulation";
     }
     if (need->gather_bytes > peak) {
         peak = need->gather_bytes;
@@ -180,7 +180,14 @@ wx_result wx_memory_check(const wx_scene *scene, unsigned phases, wx_error *err)
     if (available < 0.0 || need.total_bytes <= available) {
         return WX_OK;
     }
-    if (strcmp(need.phase, "simulate") == 0 && need.particle_bytes > need.sim_map_bytes) {
+    if (need.baseline_bytes >= available) {
+        return wx_fail(err, WX_CAUSE_MEMORY_LIMIT,
+                       "%s: the program itself needs about %.3g GiB before any map or "
+                       "particle, but only %.3g GiB of memory is available (see "
+                       "docs/reliability.md)",
+                       scene->path, gib(need.baseline_bytes), gib(available));
+    }
+    if (strcmp(need.phase, "simulation") == 0 && need.particle_bytes > need.sim_map_bytes) {
         return wx_fail(err, WX_CAUSE_MEMORY_LIMIT, "%s:%d: the emitters would emit %.4g particles: with the maps that "
                             "needs about %.3g GiB (%.0f bytes per particle, %.3g GiB of maps), "
                             "but only %.3g GiB of memory is available; lower the rate or the "

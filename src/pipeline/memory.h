@@ -21,7 +21,7 @@ typedef struct wx_memory_need {
     double particle_bytes; ///< as if every particle emitted were alive at once
     double gather_bytes;   ///< the gather: the maps it reads, its planes, the files it writes
     double total_bytes;    ///< baseline + the largest phase
-    const char *phase;     ///< the largest phase: "bake", "simulate" or "gather"
+    const char *phase;     ///< the largest phase: "bake", "simulation" or "gather"
     int camera_line;       ///< scene line of the camera with the largest maps
     int emitter_line;      ///< scene line of the emitter with the most particles
     int mesh_line;         ///< scene line of the largest mesh file
@@ -37,8 +37,8 @@ typedef struct wx_memory_need {
 /// Bytes per texel of the bake's float framebuffer (RGBA32F x 2, R32F, depth).
 #define WX_BAKE_FRAMEBUFFER_BYTES_PER_TEXEL 40.0
 /// Bytes per texel of the images of one baked camera (depth 1, normal 3, impact
-/// 3, dirt 3 floats; an output camera only depth and normal). Two cameras' sets
-/// are alive while one is written and the next rendered.
+/// 3, dirt 3 floats; an output camera only depth and normal). One set is alive:
+/// the pipeline writes a camera's files (on_maps) before the next one renders.
 #define WX_BAKE_INPUT_IMAGE_BYTES_PER_TEXEL 40.0
 #define WX_BAKE_OUTPUT_IMAGE_BYTES_PER_TEXEL 16.0
 /// Bytes per input texel in the simulation: the maps (depth, normal, impact,

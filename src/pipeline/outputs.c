@@ -166,14 +166,20 @@ wx_result wx_output_prepare(const wx_scene *scene, const wx_run_def *opts,
         return r;
     }
     temp_owner owner = { .names = &names };
-    char folder[WX_PATH_MAX], stats_folder[WX_PATH_MAX];
+    char folder[WX_PATH_MAX], stats_folder[WX_PATH_MAX], stats_canonical[WX_PATH_MAX];
     if (opts->stats_path != NULL) {
         const char *slash = strrchr(opts->stats_path, '/');
-        int n = slash != NULL ? (int)(slash - opts->stats_path) : 1;
-        snprintf(stats_folder, sizeof stats_folder, "%.*s", n,
-                 slash != NULL ? opts->stats_path : ".");
-        if (canonical_path(opts->out_dir, folder) && canonical_path(stats_folder, stats_folder) &&
-            strcmp(folder, stats_folder) == 0) {
+        if (slash == NULL) {
+            snprintf(stats_folder, sizeof stats_folder, ".");
+        } else if (slash == opts->stats_path) {
+            snprintf(stats_folder, sizeof stats_folder, "/");
+        } else {
+            snprintf(stats_folder, sizeof stats_folder, "%.*s", (int)(slash - opts->stats_path),
+                     opts->stats_path);
+        }
+        if (canonical_path(opts->out_dir, folder) &&
+            canonical_path(stats_folder, stats_canonical) &&
+            strcmp(folder, stats_canonical) == 0) {
             owner.stats_name = slash != NULL ? slash + 1 : opts->stats_path;
         }
     }

@@ -51,7 +51,7 @@ wx_result wx_run_phases(wx_scene *scene, const wx_run_def *opts, unsigned phases
         r = wx_use_baked_maps(scene, opts, err);
     }
     // Everything that can be refused, before any folder or file is made.
-    if (r == WX_OK && bake && scene->mesh_count > 0) {
+    if (r == WX_OK && bake) {
         r = wx_geometry_load(scene, opts->quiet, &geometry, err);
     }
     if (r == WX_OK) {

@@ -1,5 +1,5 @@
 // bake.c: meshes and orthographic cameras to depth, normal, impact and dirt
-// EXR maps, rendered offscreen with OSMesa (thesis 4.9.2, DESIGN sections 1-3).
+// EXR maps, rendered offscreen with OSMesa (thesis 4.9.2, docs/design.md sections 1-3).
 //
 // One GL 4.5 core context renders into a float framebuffer with three colour
 // targets in one pass (shaders/bake_*.glsl). Each mesh is imported, mapped onto
@@ -10,8 +10,9 @@
 // the interpolated position, not from the depth buffer. glReadPixels returns
 // rows bottom-up; read_target() flips them, the only place that does. Initial
 // dirt is given to the input camera that sees each patch most head-on
-// (compute_initial_dirt). The EXR files of one camera are written by worker
-// threads while the next camera renders. docs/cameras.md describes the choices.
+// (compute_initial_dirt). Each camera's maps go to def->on_maps (the pipeline
+// writes them, its files compressed in parallel) before the next camera renders,
+// so one set of images is alive. docs/cameras.md describes the choices.
 #define GL_GLEXT_PROTOTYPES 1
 #include <GL/osmesa.h>
 #include <GL/gl.h>
@@ -929,17 +930,9 @@ wx_result wx_bake_render(const wx_bake_def *def, wx_bake_stats *stats, wx_error 
         baker_free(b);
         return r;
     }
-    if (scene->mesh_count == 0) {
-        for (int c = 0; c < scene->camera_count; ++c) {
-            if (b->cams[c].bake) {
-                r = wx_fail(err, WX_CAUSE_MISSING, "%s:%d: camera '%s' is given by <View> without map files, and "
-                                 "the scene has no <Geometry> meshes to bake them from",
-                                 scene->path, scene->cameras[c].line, scene->cameras[c].name);
-                break;
-            }
-        }
-        baker_free(b);
-        return r;
+    if (geometry == NULL || geometry->count != scene->mesh_count || scene->mesh_count == 0) {
+        baker_free(b); // wx_geometry_load refuses a scene without meshes to bake from
+        return wx_fail(err, WX_CAUSE_BAD_ARGUMENT, "bake: the scene's meshes were not imported");
     }
     double t0 = wx_now_s();
     r = create_context(b, err);

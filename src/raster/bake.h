@@ -62,9 +62,10 @@ typedef struct wx_bake_def {
 wx_bake_def wx_default_bake_def(void);
 
 /// Bakes every camera of def->scene that has a <View> and no map files; does
-/// nothing when there is none. WX_BAD_INPUT (message with file and line) for
-/// cameras to bake and no geometry or no triangles, maps larger than the
-/// renderer allows; WX_FAIL for GL failures or out of memory; or what on_maps
+/// nothing when there is none. def->geometry holds every mesh of the scene,
+/// imported (wx_geometry_load refuses a scene with cameras to bake and no mesh).
+/// WX_BAD_INPUT (message with file and line) for no triangles or maps larger
+/// than the renderer allows; WX_FAIL for GL failures or out of memory; or what on_maps
 /// returns. Warnings (geometry outside a frame or behind an eye) go to stderr
 /// unless quiet. `stats` may be NULL.
 wx_result wx_bake_render(const wx_bake_def *def, wx_bake_stats *stats, wx_error *err);
