@@ -1,4 +1,4 @@
-// cli.c: the `weathering` command line (DESIGN section 6).
+// main.c: the `weathering` command line (docs/design.md section 6).
 //
 //   weathering COMMAND SCENE.xml [--out DIR] [--seed N] [--threads N] [--stats FILE.json] [-q]
 //
@@ -382,8 +382,9 @@ static int run_phases(const cli_args *args, unsigned phases)
     wx_error err;
     wx_result r = WX_OK;
     if ((phases & WX_PHASE_GATHER) && scene.output_index < 0) {
-        r = wx_fail(&err, WX_CAUSE_BAD_SCENE, "%s: has no output camera (<Ortho out=\"true\">); `%s` needs one",
-                         scene.path, args->command);
+        r = wx_fail(&err, WX_CAUSE_BAD_SCENE,
+                    "%s: has no output camera (<Ortho out=\"true\">); `%s` needs one", scene.path,
+                    args->command);
     }
     if (r == WX_OK) {
         r = wx_run_phases(&scene, &opts, phases, &run, &err);

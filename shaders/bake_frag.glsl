@@ -1,4 +1,4 @@
-// bake_frag.glsl: the four maps of DESIGN section 2 in one pass (src/bake.c).
+// bake_frag.glsl: the four maps of docs/design.md section 2 in one pass (src/raster/bake.c).
 //   attachment 0 (RGBA32F): d, world normal x y z (unit, facing the camera)
 //   attachment 1 (RGBA32F): absorption, bounce, deposit, erosion
 //   attachment 2 (R32F):    initial dirt density per square metre

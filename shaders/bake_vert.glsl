@@ -1,5 +1,5 @@
 // bake_vert.glsl: orthographic projection of a mesh into one camera's map
-// (src/bake.c). Positions are relative to the mesh's origin; u_wtc is the
+// (src/raster/bake.c). Positions are relative to the mesh's origin; u_wtc is the
 // camera's WTCMatrix with that origin folded into its translation row. A
 // row-major matrix for row vectors, uploaded as it is, reads in GLSL as the
 // same matrix for column vectors, so u_wtc * p gives (u, v, d, 1).

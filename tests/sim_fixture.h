@@ -171,7 +171,7 @@ typedef struct fx_scene {
     wx_emitter emitters[4];
 } fx_scene;
 
-/// Defaults of DESIGN section 3, no fields, no emitters, no cameras.
+/// Defaults of docs/design.md section 3, no fields, no emitters, no cameras.
 static inline void fx_scene_init(fx_scene *f)
 {
     memset(f, 0, sizeof *f);

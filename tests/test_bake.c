@@ -1,4 +1,4 @@
-// test_bake.c: OSMesa bake of depth, normal, impact and dirt maps (src/bake.c).
+// test_bake.c: OSMesa bake of depth, normal, impact and dirt maps (src/raster/bake.c).
 //
 // Scenes are built by hand (wx_scene structs) so that every expected number can
 // be worked out from the geometry: a unit sphere, a box, flat quads. One test
@@ -279,7 +279,8 @@ static const float UP_Y[3] = { 0, 1, 0 };
 // d = D - sqrt(1 - a^2 - b^2), n = a right + b up - sqrt(1 - a^2 - b^2) forward.
 static void check_sphere_camera(const wx_scene_camera *c, const maps4 *m, float eye_distance)
 {
-    const float right[3] = { c->camera.ctw[0] / c->view.width_ws, c->camera.ctw[1] / c->view.width_ws,
+    const float right[3] = { c->camera.ctw[0] / c->view.width_ws,
+                             c->camera.ctw[1] / c->view.width_ws,
                              c->camera.ctw[2] / c->view.width_ws };
     const float up[3] = { c->camera.ctw[4] / c->view.height_ws,
                           c->camera.ctw[5] / c->view.height_ws,

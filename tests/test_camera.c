@@ -1,4 +1,4 @@
-// test_camera.c: map-space conventions of DESIGN section 2, worked out by hand.
+// test_camera.c: map-space conventions of docs/design.md section 2, worked out by hand.
 #include <math.h>
 #include <string.h>
 

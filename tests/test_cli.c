@@ -141,8 +141,10 @@ TEST(stats_never_overwrites_anything)
         { "nowhere/s.json", "folder" },
     };
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
-        int status = ensure_shell(out, sizeof out, "cd '%s' && timeout 20 '%s/weathering' run s.xml "
-                                  "--out o --stats '%s'", d, build_dir(), cases[k].stats);
+        int status = ensure_shell(out, sizeof out,
+                                  "cd '%s' && timeout 20 '%s/weathering' run s.xml "
+                                  "--out o --stats '%s'",
+                                  d, build_dir(), cases[k].stats);
         if (status != 2 || !ensure_contains(out, cases[k].message)) {
             fprintf(stderr, "        --stats %s: status %d: %s", cases[k].stats, status, out);
         }
@@ -151,9 +153,11 @@ TEST(stats_never_overwrites_anything)
     }
     // Nothing was written: the inputs are unchanged, the folder holds only the
     // user's file, the link still points at /dev/null.
-    ENSURE(ensure_shell(NULL, 0, "cd '%s' && cksum s.xml meshes/teapot.obj | cmp - ../stats.sum && "
-                                 "[ \"$(ls -A o)\" = mask.exr ] && [ \"$(cat o/mask.exr)\" = keep ] && "
-                                 "[ \"$(readlink link.json)\" = /dev/null ]", d) == 0);
+    ENSURE(ensure_shell(NULL, 0,
+                        "cd '%s' && cksum s.xml meshes/teapot.obj | cmp - ../stats.sum && "
+                        "[ \"$(ls -A o)\" = mask.exr ] && [ \"$(cat o/mask.exr)\" = keep ] && "
+                        "[ \"$(readlink link.json)\" = /dev/null ]",
+                        d) == 0);
     // A new file in the output folder (made by the run) is fine.
     ENSURE(ensure_shell(out, sizeof out, "cd '%s' && '%s/weathering' info s.xml --out new "
                         "--stats new/stats.json", d, build_dir()) == 0);
@@ -165,10 +169,12 @@ TEST(stale_cleanup_and_default_folder_stay_in_their_place)
 {
     const char *d = teapot_copy("stale");
     ENSURE(d != NULL);
-    ENSURE(ensure_shell(NULL, 0, "cd '%s' && mkdir -p out/s && "
-                                 "echo draft > out/s/.draft.txt.tmp999999998 && "
-                                 "echo dead > out/s/.mask.exr.tmp999999997 && "
-                                 "sed -e 's/teapot.obj/..\\/meshes\\/teapot.obj/' s.xml > ...xml", d) == 0);
+    ENSURE(ensure_shell(NULL, 0,
+                        "cd '%s' && mkdir -p out/s && "
+                        "echo draft > out/s/.draft.txt.tmp999999998 && "
+                        "echo dead > out/s/.mask.exr.tmp999999997 && "
+                        "sed -e 's/teapot.obj/..\\/meshes\\/teapot.obj/' s.xml > ...xml",
+                        d) == 0);
     ENSURE(ensure_shell(out, sizeof out, "cd '%s' && '%s/weathering' bake s.xml -q", d,
                         build_dir()) == 0);
     ENSURE(ensure_shell(NULL, 0, "cd '%s/out/s' && [ -e .draft.txt.tmp999999998 ] && "
@@ -214,11 +220,13 @@ TEST(control_characters_from_files_are_escaped)
 {
     const char *d = teapot_copy("escape");
     ENSURE(d != NULL);
-    ENSURE(ensure_shell(NULL, 0, "cd '%s' && printf 'newmtl red\\033[31m\\a\\n' > meshes/m.mtl && "
-                                 "(printf 'mtllib m.mtl\\nusemtl red\\033[31m\\a\\n'; "
-                                 "cat meshes/teapot.obj) > meshes/t.obj && "
-                                 "sed -e 's|teapot.obj|t.obj|' -e 's|material=\"\\*\"|material=\"x\"|' "
-                                 "s.xml > esc.xml", d) == 0);
+    ENSURE(ensure_shell(NULL, 0,
+                        "cd '%s' && printf 'newmtl red\\033[31m\\a\\n' > meshes/m.mtl && "
+                        "(printf 'mtllib m.mtl\\nusemtl red\\033[31m\\a\\n'; "
+                        "cat meshes/teapot.obj) > meshes/t.obj && "
+                        "sed -e 's|teapot.obj|t.obj|' -e 's|material=\"\\*\"|material=\"x\"|' "
+                        "s.xml > esc.xml",
+                        d) == 0);
     int status = ensure_shell(out, sizeof out, "cd '%s' && '%s/weathering' info esc.xml", d,
                               build_dir());
     ENSURE(status == 2);

@@ -77,10 +77,11 @@ TEST(box_from_three_sides_point_rule)
     float behind[3] = { 0.0f, 0.0f, -1.5f };   // behind for the front camera, not the back
     float in_front[3] = { 0.0f, 0.0f, 3.0f };  // seen by the front camera only
     float far_away[3] = { 50.0f, 0.0f, 0.0f }; // in no frame: no information
-    bool r[6] = { wx_collider_point_collides(&col, inside), wx_collider_point_collides(&col, beside),
-                  wx_collider_point_collides(&col, above), wx_collider_point_collides(&col, behind),
-                  wx_collider_point_collides(&col, in_front),
-                  wx_collider_point_collides(&col, far_away) };
+    bool r[6] = {
+        wx_collider_point_collides(&col, inside),   wx_collider_point_collides(&col, beside),
+        wx_collider_point_collides(&col, above),    wx_collider_point_collides(&col, behind),
+        wx_collider_point_collides(&col, in_front), wx_collider_point_collides(&col, far_away)
+    };
     release(&col, maps, 3);
     ENSURE(r[0]);
     ENSURE(!r[1]);
@@ -164,7 +165,8 @@ TEST(head_on_camera_gives_the_hit_on_a_steep_face)
     int hits = 0, side = 0;
     double worst = 0.0;
     for (int i = 0; i < 400; ++i) {
-        float x = -0.9f + 1.8f * (float)i / 400.0f, z = -2.0f + 4.0f * (float)((i * 37) % 400) / 400.0f;
+        float x = -0.9f + 1.8f * (float)i / 400.0f,
+              z = -2.0f + 4.0f * (float)((i * 37) % 400) / 400.0f;
         float p0[3] = { x, 2.95f, z }, p1[3] = { x, -2.95f, z };
         wx_hit hit;
         if (!wx_collider_sweep(&col, p0, p1, &hit)) {
@@ -198,7 +200,8 @@ TEST(ground_between_wall_and_slab_edge_goes_to_the_camera_that_sees_it)
     int hits = 0, top = 0;
     double worst = 0.0;
     for (int i = 0; i < 200; ++i) {
-        float x = -1.9f + 3.8f * (float)i / 200.0f, z = 0.3f + 2.4f * (float)((i * 53) % 200) / 200.0f;
+        float x = -1.9f + 3.8f * (float)i / 200.0f,
+              z = 0.3f + 2.4f * (float)((i * 53) % 200) / 200.0f;
         float p0[3] = { x, 0.5f, z }, p1[3] = { x, -0.1f, z };
         wx_hit hit;
         if (!wx_collider_sweep(&col, p0, p1, &hit)) {

@@ -1,4 +1,4 @@
-// test_emitter.c: emission counts and start states (DESIGN section 3).
+// test_emitter.c: emission counts and start states (docs/design.md section 3).
 #include <math.h>
 #include <string.h>
 

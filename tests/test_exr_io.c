@@ -588,7 +588,8 @@ TEST(missing_channel_lists_what_the_file_has)
 
 TEST(missing_file_is_bad_input)
 {
-    ENSURE(read_fails(path_in("does_not_exist.exr"), WX_CAUSE_FILE_MISSING, "cannot open (No such file or directory)"));
+    ENSURE(read_fails(path_in("does_not_exist.exr"), WX_CAUSE_FILE_MISSING,
+                      "cannot open (No such file or directory)"));
     wx_image image;
     wx_error err = { 0 };
     const char *path = path_in("does_not_exist_either.exr");
@@ -738,7 +739,8 @@ TEST(absurd_size_is_bad_input)
     const char *path = path_in("huge.exr");
     ENSURE(write_noisy_file(path));
     ENSURE(patch_data_window(path, 99999, 99999));
-    ENSURE(read_fails(path, WX_CAUSE_MAP_SIZE, "100000 x 100000 exceeds the largest map size 16384 x 16384"));
+    ENSURE(read_fails(path, WX_CAUSE_MAP_SIZE,
+                      "100000 x 100000 exceeds the largest map size 16384 x 16384"));
     wx_image image;
     wx_error err = { 0 };
     ENSURE(wx_exr_read_header(path, &image, &err) == WX_BAD_INPUT);

@@ -1,4 +1,4 @@
-// test_gather.c: the gather and the mask file (DESIGN section 5), on scenes of
+// test_gather.c: the gather and the mask file (docs/design.md section 5), on scenes of
 // flat quads rendered here by a tiny orthographic ray caster; expected values
 // are worked out by hand in the comments.
 #include <math.h>
@@ -76,7 +76,7 @@ static void texel_ray(const wx_camera *cam, int i, int j, double o[3], double di
 }
 
 // Renders depth and normal of the quads; dirt = density(point) * head-on texel
-// area / max(|N.view|, 1e-3), the amount `bake` stores (DESIGN section 3).
+// area / max(|N.view|, 1e-3), the amount `bake` stores (docs/design.md section 3).
 typedef double (*density_fn)(const double p[3], int quad_index);
 
 static test_maps render(wx_camera cam, const quad *quads, int count, density_fn density)
@@ -107,7 +107,8 @@ static test_maps render(wx_camera cam, const quad *quads, int count, density_fn 
                 }
                 double oc[3] = { quads[q].c[0] - o[0], quads[q].c[1] - o[1], quads[q].c[2] - o[2] };
                 double tt = dot3(oc, quads[q].n) / denom;
-                double p[3] = { o[0] + tt * dir[0] - quads[q].c[0], o[1] + tt * dir[1] - quads[q].c[1],
+                double p[3] = { o[0] + tt * dir[0] - quads[q].c[0],
+                                o[1] + tt * dir[1] - quads[q].c[1],
                                 o[2] + tt * dir[2] - quads[q].c[2] };
                 double s = dot3(p, quads[q].a) / dot3(quads[q].a, quads[q].a);
                 double r = dot3(p, quads[q].b) / dot3(quads[q].b, quads[q].b);
@@ -264,8 +265,9 @@ TEST(oblique_input_camera_recovers_density)
     // texel centre (linear density, bilinear taps: exact up to rounding).
     quad wall = big_wall();
     float a = 40.0f * (float)PI / 180.0f;
-    test_maps in = render(make_camera(10 * sinf(a), 0, 10 * cosf(a), 0, 0, 0, 0, 1, 0, 8, 6, 64, 48),
-                          &wall, 1, slope_density);
+    test_maps in =
+        render(make_camera(10 * sinf(a), 0, 10 * cosf(a), 0, 0, 0, 0, 1, 0, 8, 6, 64, 48), &wall, 1,
+               slope_density);
     test_maps out = render(make_camera(0, 0, 10, 0, 0, 0, 0, 1, 0, 4, 2, 16, 8), &wall, 1, NULL);
     float *mask = run_gather(&out, &in, 1, 0.0f, WX_SECOND_PASS_MEAN, WX_GATHER_BILINEAR, 1);
     ENSURE(mask != NULL);
@@ -454,9 +456,11 @@ TEST(constant_field_stays_constant)
     double a = 25.0 * PI / 180.0;
     quad plane = make_quad(0, 0, 0, 30, 0, 0, 0, 30 * cos(a), -30 * sin(a), 0, sin(a), cos(a));
     float b = 35.0f * (float)PI / 180.0f;
-    test_maps in = render(make_camera(0, 10 * sinf(b), 10 * cosf(b), 0, 0, 0, 0, 1, 0, 12, 12, 96, 96),
-                          &plane, 1, density_five);
-    test_maps out = render(make_camera(1, 0.5f, 10, 1, 0.5f, 0, 0, 1, 0, 4, 3, 40, 30), &plane, 1, NULL);
+    test_maps in =
+        render(make_camera(0, 10 * sinf(b), 10 * cosf(b), 0, 0, 0, 0, 1, 0, 12, 12, 96, 96), &plane,
+               1, density_five);
+    test_maps out =
+        render(make_camera(1, 0.5f, 10, 1, 0.5f, 0, 0, 1, 0, 4, 3, 40, 30), &plane, 1, NULL);
     for (int mode = 0; mode < 2; ++mode) {
         wx_gather_sampling sampling = mode == 0 ? WX_GATHER_BILINEAR : WX_GATHER_NEAREST;
         float *mask = run_gather(&out, &in, 1, 0.35f, WX_SECOND_PASS_MEAN, sampling, 2);
@@ -496,7 +500,8 @@ TEST(thesis_sum_and_mean_of_a_spike)
     // Its neighbours within 2.5 texels, columns 3..7 and rows 0..3 in frame (row
     // -1 is not): self 1; (+-1, 0), (0, +-1): 4 x 0.6; diagonals 4 x 0.434315;
     // (+-2, 0), (0, +2): 3 x 0.2; (+-2, +-1), (+-1, +2): 6 x 0.105573.
-    double w_sum = 1 + 1.2 + 1.2 + 4 * (1 - sqrt(0.5) / 1.25) + 0.4 + 0.2 + 6 * (1 - sqrt(1.25) / 1.25);
+    double w_sum =
+        1 + 1.2 + 1.2 + 4 * (1 - sqrt(0.5) / 1.25) + 0.4 + 0.2 + 6 * (1 - sqrt(1.25) / 1.25);
     ENSURE_NEAR(mean[1 * 8 + 5], 0.2 / w_sum, 1e-6);
     free(sum);
     free(mean);

@@ -126,7 +126,8 @@ TEST(every_layer_includes_only_the_layers_below_it)
         struct dirent *e;
         while ((e = readdir(dir)) != NULL) {
             size_t n = strlen(e->d_name);
-            if (n < 3 || e->d_name[n - 2] != '.' || (e->d_name[n - 1] != 'c' && e->d_name[n - 1] != 'h')) {
+            if (n < 3 || e->d_name[n - 2] != '.' ||
+                (e->d_name[n - 1] != 'c' && e->d_name[n - 1] != 'h')) {
                 continue;
             }
             char path[4500], rel[300];

@@ -1,4 +1,4 @@
-// test_mesh.c: Assimp import into flat arrays (src/mesh.c): the file system
+// test_mesh.c: Assimp import into flat arrays (src/io/mesh_import.c): the file system
 // Assimp reads through (regular files inside the mesh's folder only), values
 // refused at import, out of memory inside Assimp, and the FBX unit.
 #include <signal.h>
@@ -371,8 +371,10 @@ TEST(mesh_file_must_be_a_regular_file)
     ENSURE(refused_with(folder, WX_CAUSE_NOT_REGULAR_FILE, "is not a regular file (a folder)"));
     const char *loop = join(dir, "loop.obj");
     ENSURE(symlink("loop.obj", loop) == 0);
-    ENSURE(refused_with(loop, WX_CAUSE_NOT_REGULAR_FILE, "is not a regular file (a loop of symbolic links)"));
-    ENSURE(refused_with("/dev/null", WX_CAUSE_NOT_REGULAR_FILE, "is not a regular file (a device)"));
+    ENSURE(refused_with(loop, WX_CAUSE_NOT_REGULAR_FILE,
+                        "is not a regular file (a loop of symbolic links)"));
+    ENSURE(
+        refused_with("/dev/null", WX_CAUSE_NOT_REGULAR_FILE, "is not a regular file (a device)"));
     ENSURE(refused_with(join(dir, "nowhere.obj"), WX_CAUSE_FILE_MISSING, "not found"));
     // A symbolic link to a regular file is that file.
     ensure_write_file(dir, "real.obj", TRIANGLE_OBJ);
@@ -407,7 +409,8 @@ TEST(obj_mtllib_outside_or_a_folder_is_refused)
     const char *obj = ensure_write_file(sub, "a.obj",
                                         "mtllib ../shared.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\n"
                                         "usemtl Wood\nf 1 2 3\n");
-    ENSURE(refused_with(obj, WX_CAUSE_BAD_MESH, "refers to '../shared.mtl', outside the mesh's folder"));
+    ENSURE(refused_with(obj, WX_CAUSE_BAD_MESH,
+                        "refers to '../shared.mtl', outside the mesh's folder"));
     // Through a symbolic link inside the folder: realpath sees where it leads.
     ENSURE(symlink("../shared.mtl", join(sub, "link.mtl")) == 0);
     obj = ensure_write_file(sub, "b.obj", "mtllib link.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
@@ -480,10 +483,12 @@ TEST(gltf_buffer_outside_the_folder_is_refused)
     const char *sub = make_dir("gltf_outside/m");
     ENSURE(write_triangle_bin(join(dir, "outer.bin")));
     const char *gltf = write_gltf(sub, "a.gltf", "../outer.bin");
-    ENSURE(refused_with(gltf, WX_CAUSE_BAD_MESH, "refers to '../outer.bin', outside the mesh's folder"));
+    ENSURE(refused_with(gltf, WX_CAUSE_BAD_MESH,
+                        "refers to '../outer.bin', outside the mesh's folder"));
     ENSURE(symlink("../outer.bin", join(sub, "link.bin")) == 0);
     gltf = write_gltf(sub, "b.gltf", "link.bin");
-    ENSURE(refused_with(gltf, WX_CAUSE_BAD_MESH, "refers to 'link.bin', outside the mesh's folder"));
+    ENSURE(
+        refused_with(gltf, WX_CAUSE_BAD_MESH, "refers to 'link.bin', outside the mesh's folder"));
     // An absolute URI: Assimp 5.2.5 joins it to the mesh's folder ("m//etc/passwd",
     // that is m/etc/passwd), which is not there: its own message, nothing read.
     gltf = write_gltf(sub, "d.gltf", "/etc/passwd");

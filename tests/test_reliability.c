@@ -122,7 +122,8 @@ static int check_bad_folder(const char *folder, const char *command, int *checke
                   ensure_contains(out, substring) && stat(out_dir, &st) != 0 &&
                   strchr(out, '\n') == out + strlen(out) - 1; // one line
         if (!ok) {
-            fprintf(stderr, "%s: expected `%s` to exit 2 with \"%s...%s\" and no output, got %d: %s\n",
+            fprintf(stderr,
+                    "%s: expected `%s` to exit 2 with \"%s...%s\" and no output, got %d: %s\n",
                     path, command, prefix, substring, status, out);
             failures++;
         }
@@ -173,9 +174,9 @@ TEST(memory_estimate_over_the_limit_is_refused_with_the_numbers)
     ENSURE(status == 0);
     ENSURE(ensure_contains(out, "a run would be refused"));
     // With enough memory the same scene is accepted.
-    status = ensure_shell(out, sizeof out,
-                          "WX_MEMORY_AVAILABLE_MB=1000 %s/weathering info xml_scenes/thesis_box.xml",
-                          ensure_build_dir());
+    status = ensure_shell(
+        out, sizeof out, "WX_MEMORY_AVAILABLE_MB=1000 %s/weathering info xml_scenes/thesis_box.xml",
+        ensure_build_dir());
     ENSURE(status == 0);
     ENSURE(!ensure_contains(out, "refused"));
 }
@@ -539,8 +540,9 @@ TEST(an_input_is_never_overwritten)
         "cksum * > ../inputs.sum",
         dir, dir);
     ENSURE(status == 0);
-    status = ensure_shell(out, sizeof out, "%s/weathering run %s/inputs/scene.xml --out %s/inputs -q",
-                          ensure_build_dir(), dir, dir);
+    status =
+        ensure_shell(out, sizeof out, "%s/weathering run %s/inputs/scene.xml --out %s/inputs -q",
+                     ensure_build_dir(), dir, dir);
     ENSURE(status == 2);
     ENSURE(ensure_contains(out, "front_dirt.exr: is an input of scene"));
     ENSURE(ensure_shell(out, sizeof out, "cd %s/inputs && cksum * | cmp - ../inputs.sum", dir) ==
@@ -563,12 +565,13 @@ TEST(out_of_memory_in_the_bake_is_exit_1)
     return;
 #endif
     const char *dir = ensure_tmpdir();
-    ENSURE(ensure_shell(out, sizeof out,
-                        "mkdir -p %s/oom/meshes && cp xml_scenes/meshes/teapot.obj %s/oom/meshes/ && "
-                        "sed -e 's/resolution=\"[0-9]*\"/resolution=\"4096\"/' "
-                        "-e 's/width=\"1024\" height=\"1024\"/width=\"4096\" height=\"4096\"/' "
-                        "xml_scenes/teapot.xml > %s/oom/big.xml",
-                        dir, dir, dir) == 0);
+    ENSURE(
+        ensure_shell(out, sizeof out,
+                     "mkdir -p %s/oom/meshes && cp xml_scenes/meshes/teapot.obj %s/oom/meshes/ && "
+                     "sed -e 's/resolution=\"[0-9]*\"/resolution=\"4096\"/' "
+                     "-e 's/width=\"1024\" height=\"1024\"/width=\"4096\" height=\"4096\"/' "
+                     "xml_scenes/teapot.xml > %s/oom/big.xml",
+                     dir, dir, dir) == 0);
     int failed = 0;
     const int limits_mb[] = { 900, 1200, 1500, 1800 };
     for (int k = 0; k < 4; ++k) {

@@ -234,8 +234,9 @@ static bool building_regions(bool dusty_sills, double *band, double *exposed, do
     free(c);
     free(d);
     if (status == 0) {
-        status = ensure_shell(log, sizeof log, "'%s/weathering' run '%s/building.xml' --out '%s/out' -q",
-                              ensure_build_dir(), dir, dir);
+        status =
+            ensure_shell(log, sizeof log, "'%s/weathering' run '%s/building.xml' --out '%s/out' -q",
+                         ensure_build_dir(), dir, dir);
     }
     if (status != 0) {
         fprintf(stderr, "        building (%s): status %d\n%s\n", name, status, log);
@@ -249,8 +250,10 @@ static bool building_regions(bool dusty_sills, double *band, double *exposed, do
         free(mask);
         return false;
     }
-    *band = (facade_mean(mask, -2.5, -0.9, 10.5, 11.6) + facade_mean(mask, 0.9, 2.5, 10.5, 11.6)) / 2;
-    *exposed = (facade_mean(mask, -2.5, -0.9, 4.5, 8.5) + facade_mean(mask, 0.9, 2.5, 4.5, 8.5)) / 2;
+    *band =
+        (facade_mean(mask, -2.5, -0.9, 10.5, 11.6) + facade_mean(mask, 0.9, 2.5, 10.5, 11.6)) / 2;
+    *exposed =
+        (facade_mean(mask, -2.5, -0.9, 4.5, 8.5) + facade_mean(mask, 0.9, 2.5, 4.5, 8.5)) / 2;
     *below = 0.0;
     for (int floor = 1; floor < 4; ++floor) {
         double sill = 3.0 * floor + 0.9; // top of the sill at the wall
@@ -336,7 +339,8 @@ static double run_peak_mib(const char *scene, const char *dir)
 static double estimate_mib(const char *scene)
 {
     static char log[16384];
-    if (ensure_shell(log, sizeof log, "'%s/weathering' info '%s'", ensure_build_dir(), scene) != 0) {
+    if (ensure_shell(log, sizeof log, "'%s/weathering' info '%s'", ensure_build_dir(), scene) !=
+        0) {
         return -1.0;
     }
     const char *at = strstr(log, "memory: about ");
@@ -490,8 +494,9 @@ TEST(failures_leave_nothing_behind)
         dir, dir);
     ENSURE(status == 0);
     double t0 = (double)time(NULL);
-    status = ensure_shell(log, sizeof log, "'%s/weathering' run '%s/inputs/scene.xml' --out '%s/inputs'",
-                          ensure_build_dir(), dir, dir);
+    status =
+        ensure_shell(log, sizeof log, "'%s/weathering' run '%s/inputs/scene.xml' --out '%s/inputs'",
+                     ensure_build_dir(), dir, dir);
     ENSURE(status == 2);
     ENSURE(ensure_contains(log, "front_dirt.exr: is an input of scene"));
     ENSURE((double)time(NULL) - t0 < 5.0); // 100000 steps were never flown

@@ -1,4 +1,4 @@
-// test_scene.c: the scene file (DESIGN section 3): defaults, every attribute,
+// test_scene.c: the scene file (docs/design.md section 3): defaults, every attribute,
 // camera matrices, the bad scenes of tests/bad/, entity attacks, and the schema.
 #include <dirent.h>
 #include <errno.h>
@@ -131,7 +131,7 @@ TEST(thesis_minimal_defaults)
     ENSURE(s.cameras == NULL && s.camera_count == 0);
 }
 
-// Each element with no optional attribute takes the defaults of DESIGN section 3.
+// Each element with no optional attribute takes the defaults of docs/design.md section 3.
 TEST(element_defaults)
 {
     wx_scene s;

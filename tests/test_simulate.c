@@ -631,17 +631,18 @@ TEST(thesis_format_scene_runs_with_defaults)
                  names[c], ctw, wtc, names[c], names[c], names[c], names[c]);
     }
     char xml[8192];
-    snprintf(xml, sizeof xml,
-             "<Weathering>\n"
-             "  <ForceFields><Gravity/></ForceFields>\n"
-             "  <Emitters>\n"
-             "    <PointEmitter name=\"p\" centerX=\"0.3\" centerY=\"4\" centerZ=\"0.2\" rate=\"50\"/>\n"
-             "  </Emitters>\n"
-             "  <Collider>\n"
-             "    <ProjectedMaps>\n%s%s    </ProjectedMaps>\n"
-             "  </Collider>\n"
-             "</Weathering>\n",
-             xml_cams[0], xml_cams[1]);
+    snprintf(
+        xml, sizeof xml,
+        "<Weathering>\n"
+        "  <ForceFields><Gravity/></ForceFields>\n"
+        "  <Emitters>\n"
+        "    <PointEmitter name=\"p\" centerX=\"0.3\" centerY=\"4\" centerZ=\"0.2\" rate=\"50\"/>\n"
+        "  </Emitters>\n"
+        "  <Collider>\n"
+        "    <ProjectedMaps>\n%s%s    </ProjectedMaps>\n"
+        "  </Collider>\n"
+        "</Weathering>\n",
+        xml_cams[0], xml_cams[1]);
     const char *scene_path = ensure_write_file(dir, "thesis.xml", xml);
     wx_scene scene;
     wx_error err;

@@ -44,9 +44,10 @@ wx_result vw_bake_start(vw_bake_child *child, const char *exe_dir, const char *s
     char program[WX_PATH_MAX + 16];
     int n = snprintf(program, sizeof program, "%s/weathering", exe_dir);
     if (n < 0 || n >= (int)sizeof program || access(program, X_OK) != 0) {
-        return wx_fail(err, WX_CAUSE_IO, "%s: the scene has maps to bake, and %s is missing; run `weathering "
-                            "bake %s --out %s` first",
-                            scene_path, program, scene_path, out_dir);
+        return wx_fail(err, WX_CAUSE_IO,
+                       "%s: the scene has maps to bake, and %s is missing; run `weathering "
+                       "bake %s --out %s` first",
+                       scene_path, program, scene_path, out_dir);
     }
     int fds[2];
     if (pipe(fds) != 0) {

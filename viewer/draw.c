@@ -320,7 +320,8 @@ wx_result vw_draw_update(vw_draw *draw, const vw_world *world, const vw_show *sh
                          const float mvp[16], int fb_width, int fb_height, wx_error *err)
 {
     if (!reserve_staging(draw, fb_width, fb_height)) {
-        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (%dx%d window)", fb_width, fb_height);
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (%dx%d window)", fb_width,
+                       fb_height);
     }
     wx_result r = WX_OK;
     if (show->depth_samples) {

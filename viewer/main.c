@@ -1,5 +1,5 @@
 // main.c: weathering-viewer, the live view of a simulation (thesis 4.8.5,
-// DESIGN sections 1 and 6; docs/viewer.md is the user's guide).
+// docs/design.md sections 1 and 6; docs/viewer.md is the user's guide).
 //
 //   weathering-viewer SCENE.xml [--out DIR] [--threads N] [--size WxH]
 //                     [--screenshot FILE.png] [--frames N] [--steps-per-frame K] [-v]

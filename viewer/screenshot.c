@@ -112,7 +112,7 @@ wx_result vw_screenshot_write(const char *path, int width, int height, wx_error 
     glPixelStorei(GL_PACK_ALIGNMENT, 1);
     glReadBuffer(GL_BACK);
     glReadPixels(0, 0, width, height, GL_RGB, GL_UNSIGNED_BYTE, bottom_up);
-    // glReadPixels returns rows bottom-up: the one flip (DESIGN section 2).
+    // glReadPixels returns rows bottom-up: the one flip (docs/design.md section 2).
     for (int j = 0; j < height; ++j) {
         memcpy(top_down + (size_t)j * row, bottom_up + (size_t)(height - 1 - j) * row, row);
     }

@@ -1,5 +1,5 @@
 // screenshot.h: the framebuffer as a PNG (--screenshot), written to a temporary
-// name beginning with '.' and renamed (DESIGN section 7).
+// name beginning with '.' and renamed (docs/design.md section 7).
 #ifndef VW_SCREENSHOT_H
 #define VW_SCREENSHOT_H
 

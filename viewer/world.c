@@ -37,7 +37,8 @@ wx_result vw_world_parse(vw_world *world, const vw_settings *settings, wx_error 
                          settings->out_dir);
         if (n < 0 || n >= (int)sizeof world->opts.out_dir) {
             wx_scene_free(&world->scene);
-            return wx_fail(err, WX_CAUSE_PATH_TOO_LONG, "--out %s: path too long", settings->out_dir);
+            return wx_fail(err, WX_CAUSE_PATH_TOO_LONG, "--out %s: path too long",
+                           settings->out_dir);
         }
     }
     if (settings->threads > 0) {
@@ -437,8 +438,9 @@ static wx_result load_maps(vw_world *world, wx_error *err)
     for (int c = 0; c < n; ++c) {
         const wx_scene_camera *cam = &scene->cameras[c];
         if (!wx_has_path(cam->depth_path)) {
-            return wx_fail(err, WX_CAUSE_MISSING_PHASE, "%s: camera '%s' has no maps; run `weathering bake %s` first",
-                                scene->path, cam->name, scene->path);
+            return wx_fail(err, WX_CAUSE_MISSING_PHASE,
+                           "%s: camera '%s' has no maps; run `weathering bake %s` first",
+                           scene->path, cam->name, scene->path);
         }
         unsigned which = WX_MAPS_DEPTH | WX_MAPS_NORMAL;
         if (!cam->is_output) {

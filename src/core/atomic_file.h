@@ -1,5 +1,5 @@
 // atomic_file.h: outputs are written to a temporary name beginning with '.' in
-// the same folder and renamed over the final name only when complete (DESIGN
+// the same folder and renamed over the final name only when complete (docs/design.md
 // section 7), so an interrupted run never leaves a torn file under a final name.
 //
 // Every temporary name handed out is remembered until it is committed, so that

@@ -1,4 +1,4 @@
-// matrix.h: 4x4 matrices as the program stores them (DESIGN section 2, in
+// matrix.h: 4x4 matrices as the program stores them (docs/design.md section 2, in
 // docs/design.md): 16 numbers row by row, applied to row vectors,
 // [x y z 1] * M = [u v d w]. The one orthographic test, the products and
 // inverses the modules need, in double where precision matters.

@@ -1,9 +1,9 @@
 // gather.c: the output mask (docs/design.md section 5, thesis 4.8.4.4 with its visibility
 // test added and its second pass made a weighted mean).
 //
-// Both passes run on the thread pool (core/parallel.h), whose workers take work items (first pass: 64 x 64
-// tiles, which keep the input maps' footprint in cache; second pass: bands of
-// rows) from a shared counter. Every texel is computed from the inputs alone, so
+// Both passes run on the thread pool (core/parallel.h), whose workers take work
+// items (first pass: 64 x 64 tiles, which keep the input maps' footprint in
+// cache; second pass: bands of rows) from a shared counter. Every texel is computed from the inputs alone, so
 // the result does not depend on the thread count. The second pass visits a
 // precomputed list of neighbour offsets, x innermost over chunks of 64 texels of
 // padded planes, in a loop the compiler vectorises. docs/mask.md has the details.
@@ -309,7 +309,7 @@ static void accumulate(const float *restrict dp, const float *restrict nxp,
     }
 }
 
-// Second pass over one row (DESIGN section 5; thesis 4.8.4.4 reads the cone
+// Second pass over one row (docs/design.md section 5; thesis 4.8.4.4 reads the cone
 // filter (1 - r_pq)/r as 1 - r_pq/r). The texel itself has weight 1.
 static void second_pass_row(const gather_job *job, int j)
 {
@@ -432,9 +432,9 @@ static wx_result check_view(const wx_gather_view *view, bool needs_dirt, const c
     }
     if ((view->camera->width != 0 && view->camera->width != view->width) ||
         (view->camera->height != 0 && view->camera->height != view->height)) {
-        return wx_fail(err, WX_CAUSE_MAP_SIZE, "gather: %s %d: maps are %d x %d but the camera is %d x %d", what,
-                            index, view->width, view->height, view->camera->width,
-                            view->camera->height);
+        return wx_fail(err, WX_CAUSE_MAP_SIZE,
+                       "gather: %s %d: maps are %d x %d but the camera is %d x %d", what, index,
+                       view->width, view->height, view->camera->width, view->camera->height);
     }
     return WX_OK;
 }
@@ -445,9 +445,10 @@ static wx_result prepare_input(const wx_target *out, const double out_ctw[16],
 {
     double wtc[16], ctw[16];
     if (!wx_matrix_to_affine(in->camera->wtc, wtc) || !wx_matrix_to_affine(in->camera->ctw, ctw)) {
-        return wx_fail(err, WX_CAUSE_BAD_CAMERA, "gather: input camera %d is not orthographic (its matrices must "
-                            "have the last column 0 0 0 1)",
-                            index);
+        return wx_fail(err, WX_CAUSE_BAD_CAMERA,
+                       "gather: input camera %d is not orthographic (its matrices must "
+                       "have the last column 0 0 0 1)",
+                       index);
     }
     const double wo = out->width, ho = out->height, wi = in->width, hi = in->height;
     // [i j d 1] -> [u v d 1] of the output map: u = (i + 1/2)/W, v = 1 - (j + 1/2)/H.
@@ -526,16 +527,18 @@ static wx_result build_offsets(const wx_target *out, const double ctw[16], float
     double gxx = wx_dot3(px, px), gxy = wx_dot3(px, py), gyy = wx_dot3(py, py);
     double det = gxx * gyy - gxy * gxy;
     if (!(z2 > 0.0) || !(det > 0.0) || !isfinite(det)) {
-        return wx_fail(err, WX_CAUSE_BAD_CAMERA, "gather: the output camera has a degenerate frame");
+        return wx_fail(err, WX_CAUSE_BAD_CAMERA,
+                       "gather: the output camera has a degenerate frame");
     }
     double r2 = (double)radius * (double)radius;
     // Extent of the ellipse q(di, dj) < r^2 along each axis.
     double span_i = ceil((double)radius * sqrt(gyy / det));
     double span_j = ceil((double)radius * sqrt(gxx / det));
     if (!((2.0 * span_i + 1.0) * (2.0 * span_j + 1.0) <= 4.0 * MAX_OFFSETS)) {
-        return wx_fail(err, WX_CAUSE_BAD_VALUE, "gather: second-pass radius %g covers more than %d output texels; "
-                            "use a smaller radius",
-                            (double)radius, MAX_OFFSETS);
+        return wx_fail(err, WX_CAUSE_BAD_VALUE,
+                       "gather: second-pass radius %g covers more than %d output texels; "
+                       "use a smaller radius",
+                       (double)radius, MAX_OFFSETS);
     }
     int si = (int)span_i, sj = (int)span_j;
     size_t cap = (size_t)(2 * si + 1) * (size_t)(2 * sj + 1);
@@ -566,9 +569,10 @@ static wx_result build_offsets(const wx_target *out, const double ctw[16], float
     }
     if (count > MAX_OFFSETS) {
         free(offsets);
-        return wx_fail(err, WX_CAUSE_BAD_VALUE, "gather: second-pass radius %g covers more than %d output texels; "
-                            "use a smaller radius",
-                            (double)radius, MAX_OFFSETS);
+        return wx_fail(err, WX_CAUSE_BAD_VALUE,
+                       "gather: second-pass radius %g covers more than %d output texels; "
+                       "use a smaller radius",
+                       (double)radius, MAX_OFFSETS);
     }
     *out_offsets = offsets;
     *out_count = count;
@@ -594,9 +598,11 @@ wx_result wx_gather_compute(const wx_gather_def *def, float *mask_out, wx_gather
     }
     const wx_target *out = &def->target;
     double out_ctw[16], out_wtc[16];
-    if (!wx_matrix_to_affine(out->camera->ctw, out_ctw) || !wx_matrix_to_affine(out->camera->wtc, out_wtc)) {
-        return wx_fail(err, WX_CAUSE_BAD_CAMERA, "gather: the output camera is not orthographic (its matrices must "
-                            "have the last column 0 0 0 1)");
+    if (!wx_matrix_to_affine(out->camera->ctw, out_ctw) ||
+        !wx_matrix_to_affine(out->camera->wtc, out_wtc)) {
+        return wx_fail(err, WX_CAUSE_BAD_CAMERA,
+                       "gather: the output camera is not orthographic (its matrices must "
+                       "have the last column 0 0 0 1)");
     }
 
     const size_t texels = (size_t)out->width * (size_t)out->height;
@@ -630,7 +636,8 @@ wx_result wx_gather_compute(const wx_gather_def *def, float *mask_out, wx_gather
             // Zeroed: margins have normal 0 (weight 0) and value 0.
             scratch = calloc(5 * plane, sizeof *scratch);
             if (scratch == NULL) {
-                result = wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "gather: out of memory (%zu texels)", texels);
+                result = wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "gather: out of memory (%zu texels)",
+                                 texels);
             }
         }
     }

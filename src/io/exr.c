@@ -1,4 +1,4 @@
-// exr_io.c: float maps in and out of OpenEXR files with the OpenEXR Core C API.
+// exr.c: float maps in and out of OpenEXR files with the OpenEXR Core C API.
 //
 // The library does the file I/O through our own read/write callbacks on a file
 // descriptor we opened: that gives clear "cannot open" messages, an fsync before
@@ -78,7 +78,8 @@ static int64_t stream_transfer(exr_stream *s, uint8_t *bytes, uint64_t size, uin
     while (done < size) {
         size_t want = (size_t)(size - done);
         off_t at = (off_t)(offset + done);
-        ssize_t n = write ? pwrite(s->fd, bytes + done, want, at) : pread(s->fd, bytes + done, want, at);
+        ssize_t n =
+            write ? pwrite(s->fd, bytes + done, want, at) : pread(s->fd, bytes + done, want, at);
         if (n < 0 && errno == EINTR) {
             continue;
         }
@@ -210,8 +211,9 @@ static wx_result reader_open(exr_reader *r, const char *path, wx_error *err)
     }
     if (storage != EXR_STORAGE_SCANLINE) {
         reader_close(r);
-        return wx_fail(err, WX_CAUSE_BAD_MAP, "%s: %s OpenEXR files are not supported (write scanline files)", path,
-                            storage == EXR_STORAGE_TILED ? "tiled" : "deep");
+        return wx_fail(err, WX_CAUSE_BAD_MAP,
+                       "%s: %s OpenEXR files are not supported (write scanline files)", path,
+                       storage == EXR_STORAGE_TILED ? "tiled" : "deep");
     }
     int64_t width = (int64_t)dw.max.x - (int64_t)dw.min.x + 1;
     int64_t height = (int64_t)dw.max.y - (int64_t)dw.min.y + 1;
@@ -222,8 +224,9 @@ static wx_result reader_open(exr_reader *r, const char *path, wx_error *err)
     }
     if (width > WX_MAP_MAX_SIDE || height > WX_MAP_MAX_SIDE || width * height > WX_MAP_MAX_TEXELS) {
         reader_close(r);
-        return wx_fail(err, WX_CAUSE_MAP_SIZE, "%s: %lld x %lld exceeds the largest map size %d x %d", path,
-                            (long long)width, (long long)height, WX_MAP_MAX_SIDE, WX_MAP_MAX_SIDE);
+        return wx_fail(err, WX_CAUSE_MAP_SIZE,
+                       "%s: %lld x %lld exceeds the largest map size %d x %d", path,
+                       (long long)width, (long long)height, WX_MAP_MAX_SIDE, WX_MAP_MAX_SIDE);
     }
     r->width = (int)width;
     r->height = (int)height;
@@ -324,13 +327,15 @@ static int find_channel(const char *path, const exr_attr_chlist_t *chlist, const
                 continue;
             }
             if (e->pixel_type != EXR_PIXEL_FLOAT && e->pixel_type != EXR_PIXEL_HALF) {
-                wx_fail(err, WX_CAUSE_BAD_MAP, "%s: channel %.*s holds integers (float or half expected)", path,
-                             (int)len, p);
+                wx_fail(err, WX_CAUSE_BAD_MAP,
+                        "%s: channel %.*s holds integers (float or half expected)", path, (int)len,
+                        p);
                 return -1;
             }
             if (e->x_sampling != 1 || e->y_sampling != 1) {
-                wx_fail(err, WX_CAUSE_BAD_MAP, "%s: channel %.*s is subsampled (%d x %d), which is not supported",
-                             path, (int)len, p, e->x_sampling, e->y_sampling);
+                wx_fail(err, WX_CAUSE_BAD_MAP,
+                        "%s: channel %.*s is subsampled (%d x %d), which is not supported", path,
+                        (int)len, p, e->x_sampling, e->y_sampling);
                 return -1;
             }
             return c;
@@ -426,12 +431,13 @@ static wx_result reader_decode(exr_reader *r, const char *path, const read_targe
         }
         if (rv != EXR_ERR_SUCCESS) {
             if (rv == EXR_ERR_OUT_OF_MEMORY) {
-                result =
-                    wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "%s: out of memory (reading scanlines %lld-%lld)",
-                                 path, (long long)row, (long long)last);
+                result = wx_fail(err, WX_CAUSE_OUT_OF_MEMORY,
+                                 "%s: out of memory (reading scanlines %lld-%lld)", path,
+                                 (long long)row, (long long)last);
             } else {
-                result = wx_fail(err, WX_CAUSE_BAD_MAP, "%s: truncated or corrupt (reading scanlines %lld-%lld: %s)",
-                    path, (long long)row, (long long)last, stream_detail(&r->stream, rv));
+                result = wx_fail(err, WX_CAUSE_BAD_MAP,
+                                 "%s: truncated or corrupt (reading scanlines %lld-%lld: %s)", path,
+                                 (long long)row, (long long)last, stream_detail(&r->stream, rv));
             }
             break;
         }
@@ -500,9 +506,10 @@ static wx_result read_channels(const char *path, const char *const *wanted, int 
     stream_reset(&r.stream);
     exr_result_t rv = exr_read_scanline_chunk_info(r.ctx, 0, r.min_y, &first);
     if (rv != EXR_ERR_SUCCESS) {
-        result = wx_fail(err, rv == EXR_ERR_OUT_OF_MEMORY ? WX_CAUSE_OUT_OF_MEMORY : WX_CAUSE_BAD_MAP,
-                              "%s: truncated or corrupt (reading the chunk table: %s)", path,
-                              stream_detail(&r.stream, rv));
+        result =
+            wx_fail(err, rv == EXR_ERR_OUT_OF_MEMORY ? WX_CAUSE_OUT_OF_MEMORY : WX_CAUSE_BAD_MAP,
+                    "%s: truncated or corrupt (reading the chunk table: %s)", path,
+                    stream_detail(&r.stream, rv));
         reader_close(&r);
         return result;
     }
@@ -513,8 +520,8 @@ static wx_result read_channels(const char *path, const char *const *wanted, int 
         for (int i = 0; i < wanted_count; i++) {
             out->channels[i] = malloc(texels * sizeof(float));
             if (out->channels[i] == NULL) {
-                result = wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "%s: out of memory for %d x %d texels", path,
-                                      r.width, r.height);
+                result = wx_fail(err, WX_CAUSE_OUT_OF_MEMORY,
+                                 "%s: out of memory for %d x %d texels", path, r.width, r.height);
                 break;
             }
             targets[i].base = out->channels[i];
@@ -522,8 +529,8 @@ static wx_result read_channels(const char *path, const char *const *wanted, int 
     } else {
         *interleaved = malloc(texels * (size_t)wanted_count * sizeof(float));
         if (*interleaved == NULL) {
-            result = wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "%s: out of memory for %d x %d texels", path,
-                                  r.width, r.height);
+            result = wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "%s: out of memory for %d x %d texels",
+                             path, r.width, r.height);
         }
         for (int i = 0; i < wanted_count && result == WX_OK; i++) {
             targets[i].base = *interleaved + i;

@@ -26,7 +26,9 @@ static wx_result check_size(size_check *check, const char *path, int width, int 
         return WX_OK;
     }
     if (width != check->width || height != check->height) {
-        return wx_fail(err, WX_CAUSE_MAP_SIZE, "%s: %d x %d, but %s is %d x %d (maps of one camera must have the same size)", path,
+        return wx_fail(
+            err, WX_CAUSE_MAP_SIZE,
+            "%s: %d x %d, but %s is %d x %d (maps of one camera must have the same size)", path,
             width, height, check->first_path, check->width, check->height);
     }
     return WX_OK;
@@ -54,10 +56,10 @@ static wx_result check_finite(const char *path, const char *what, const float *v
     for (size_t k = 0; k < count; k++) {
         if (!isfinite(values[k])) {
             size_t texel = k / (size_t)stride;
-            return wx_fail(err, WX_CAUSE_MAP_VALUE, "%s: %s map texel (%d, %d) channel %s is %s (must be finite)",
-                                path, what, (int)(texel % (size_t)width),
-                                (int)(texel / (size_t)width), channels[k % (size_t)stride],
-                                isnan(values[k]) ? "NaN" : "infinite");
+            return wx_fail(err, WX_CAUSE_MAP_VALUE,
+                           "%s: %s map texel (%d, %d) channel %s is %s (must be finite)", path,
+                           what, (int)(texel % (size_t)width), (int)(texel / (size_t)width),
+                           channels[k % (size_t)stride], isnan(values[k]) ? "NaN" : "infinite");
         }
     }
     return WX_OK;

@@ -1,4 +1,4 @@
-// mesh.c: Assimp import into flat arrays (see mesh.h).
+// mesh_import.c: Assimp import into flat arrays (see mesh.h).
 //
 // Assimp reads every file through mesh_io below, which hands it regular files
 // only and, besides the mesh file, only files inside the mesh's folder. Two
@@ -272,15 +272,15 @@ static wx_result import_failure(const mesh_io *io, const char *path, wx_error *e
         return wx_fail(err, io->refusal_cause, "%s: %s", path, io->refusal);
     }
     if (io->out_of_memory) {
-        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "%s: out of memory while opening the files of the mesh",
-                            path);
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY,
+                       "%s: out of memory while opening the files of the mesh", path);
     }
     if (io->mesh_opens == 0) {
         // Assimp gave up before looking for the file: only an allocation fails
         // there (new Importer), and aiGetErrorString then still holds the
         // message of an earlier import.
-        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "%s: out of memory (Assimp could not start the import)",
-                            path);
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY,
+                       "%s: out of memory (Assimp could not start the import)", path);
     }
     const char *why = aiGetErrorString();
     why = why != NULL && why[0] != '\0' ? why : "unknown reason";
@@ -290,13 +290,14 @@ static wx_result import_failure(const mesh_io *io, const char *path, wx_error *e
     // reports "Unknown exception", which only a C++ exception such as
     // bad_alloc gives: parse errors arrive as DeadlyImportError with a message.
     if (strstr(why, "bad_alloc") != NULL) {
-        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "%s: out of memory while importing the mesh (Assimp: %s)",
-                            path, why);
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY,
+                       "%s: out of memory while importing the mesh (Assimp: %s)", path, why);
     }
     if (strcmp(why, "Unknown exception") == 0) {
-        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "%s: out of memory, or another failure inside Assimp, while "
-                            "importing the mesh (Assimp: %s)",
-                            path, why);
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY,
+                       "%s: out of memory, or another failure inside Assimp, while "
+                       "importing the mesh (Assimp: %s)",
+                       path, why);
     }
     return wx_fail(err, WX_CAUSE_BAD_MESH, "%s: cannot import mesh: %s", path, why);
 }
@@ -591,9 +592,10 @@ static wx_result check_file_normals(const char *path, wx_error *err)
         for (unsigned v = 0; mesh->mNormals != NULL && v < mesh->mNumVertices; ++v) {
             const struct aiVector3D *n = &mesh->mNormals[v], *p = &mesh->mVertices[v];
             if (!finite3(n->x, n->y, n->z)) {
-                r = wx_fail(err, WX_CAUSE_BAD_MESH, "%s: the vertex at (%g, %g, %g) has a normal that is not a "
-                                 "finite number (%g, %g, %g)",
-                                 path, p->x, p->y, p->z, n->x, n->y, n->z);
+                r = wx_fail(err, WX_CAUSE_BAD_MESH,
+                            "%s: the vertex at (%g, %g, %g) has a normal that is not a "
+                            "finite number (%g, %g, %g)",
+                            path, p->x, p->y, p->z, n->x, n->y, n->z);
                 break;
             }
         }
@@ -638,9 +640,10 @@ static wx_result file_unit_m(const struct aiScene *scene, const char *path, doub
         return WX_OK;
     }
     if (!(isfinite(cm) && cm > 0.0)) {
-        return wx_fail(err, WX_CAUSE_BAD_MESH, "%s: the FBX unit (UnitScaleFactor %g centimetres) is not a positive "
-                            "number",
-                            path, cm);
+        return wx_fail(err, WX_CAUSE_BAD_MESH,
+                       "%s: the FBX unit (UnitScaleFactor %g centimetres) is not a positive "
+                       "number",
+                       path, cm);
     }
     *unit_m = cm / 100.0;
     return WX_OK;

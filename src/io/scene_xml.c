@@ -1,4 +1,4 @@
-// scene.c: loads and validates a scene file (DESIGN section 3) with libxml2.
+// scene_xml.c: loads and validates a scene file (docs/design.md section 3) with libxml2.
 //
 // The document is parsed without network access, entity substitution or
 // XInclude; any entity declaration stops the parser at once (so an entity bomb
@@ -8,7 +8,7 @@
 // range, where the value goes) and one table of the children it allows, so an
 // unknown element or attribute is an error that names it. Once the whole file is
 // read, the checks that need the whole picture run (emitter end times, map
-// files and their sizes, names that must be unique). Choices where DESIGN.md is
+// files and their sizes, names that must be unique). Choices where docs/design.md is
 // silent are written down in docs/scene-format-notes.md.
 #include "io/scene_xml.h"
 
@@ -293,8 +293,9 @@ static wx_result check_content(parser *p, const xmlNode *element)
     for (const xmlAttr *a = element->properties; a != NULL; a = a->next) {
         for (const xmlNode *c = a->children; c != NULL; c = c->next) {
             if (c->type == XML_ENTITY_REF_NODE) {
-                return fail(p, element, WX_CAUSE_XML_CONTENT, "entity reference '&%s;' in attribute '%s' is not allowed",
-                            name_of(c), (const char *)a->name);
+                return fail(p, element, WX_CAUSE_XML_CONTENT,
+                            "entity reference '&%s;' in attribute '%s' is not allowed", name_of(c),
+                            (const char *)a->name);
             }
         }
     }
@@ -331,13 +332,16 @@ static wx_result check_content(parser *p, const xmlNode *element)
             }
             break;
         case XML_ENTITY_REF_NODE:
-            return fail(p, element, WX_CAUSE_XML_CONTENT, "entity reference '&%s;' in <%s> is not allowed", name_of(n),
+            return fail(p, element, WX_CAUSE_XML_CONTENT,
+                        "entity reference '&%s;' in <%s> is not allowed", name_of(n),
                         name_of(element));
         case XML_PI_NODE:
-            return fail(p, element, WX_CAUSE_XML_CONTENT, "processing instruction '<?%s' in <%s> is not allowed",
-                        name_of(n), name_of(element));
+            return fail(p, element, WX_CAUSE_XML_CONTENT,
+                        "processing instruction '<?%s' in <%s> is not allowed", name_of(n),
+                        name_of(element));
         default:
-            return fail(p, element, WX_CAUSE_XML_CONTENT, "unexpected content in <%s>", name_of(element));
+            return fail(p, element, WX_CAUSE_XML_CONTENT, "unexpected content in <%s>",
+                        name_of(element));
         }
     }
     return WX_OK;
@@ -559,8 +563,8 @@ static wx_result parse_finite_list(parser *p, const xmlNode *node, const attr_sp
         return bad_value(p, node, s, text, "is not a number%s", want == 1 ? "" : " list");
     }
     if (count != want) {
-        return fail(p, node, WX_CAUSE_BAD_VALUE, "<%s> %s has %d numbers, expected %d", name_of(node), s->name, count,
-                    want);
+        return fail(p, node, WX_CAUSE_BAD_VALUE, "<%s> %s has %d numbers, expected %d",
+                    name_of(node), s->name, count, want);
     }
     for (int i = 0; i < want; ++i) {
         if (!isfinite(values[i])) {
@@ -621,7 +625,8 @@ static wx_result parse_integer_value(parser *p, const xmlNode *node, const attr_
         int px[2];
         int count = parse_integers(text, px, 2, s->lo, s->hi);
         if (count < 1 || count > 2) {
-            return bad_value(p, node, s, text, "must be one or two integers in [%lld, %lld]", s->lo, s->hi);
+            return bad_value(p, node, s, text, "must be one or two integers in [%lld, %lld]", s->lo,
+                             s->hi);
         }
         if (count == 1) {
             px[1] = px[0];
@@ -695,8 +700,8 @@ static wx_result parse_text_value(parser *p, const xmlNode *node, const attr_spe
         return fail(p, node, WX_CAUSE_BAD_VALUE, "<%s> %s is empty", name_of(node), s->name);
     }
     if (len >= s->size) {
-        return fail(p, node, WX_CAUSE_BAD_VALUE, "<%s> %s is too long (at most %zu characters)", name_of(node),
-                    s->name, s->size - 1);
+        return fail(p, node, WX_CAUSE_BAD_VALUE, "<%s> %s is too long (at most %zu characters)",
+                    name_of(node), s->name, s->size - 1);
     }
     if (s->type == T_NAME && !is_plain_name(text)) {
         return bad_value(p, node, s, text,
@@ -705,7 +710,8 @@ static wx_result parse_text_value(parser *p, const xmlNode *node, const attr_spe
     }
     for (size_t i = 0; i < len; ++i) {
         if ((unsigned char)text[i] < 0x20) {
-            return fail(p, node, WX_CAUSE_BAD_VALUE, "<%s> %s holds a control character", name_of(node), s->name);
+            return fail(p, node, WX_CAUSE_BAD_VALUE, "<%s> %s holds a control character",
+                        name_of(node), s->name);
         }
     }
     if (s->type == T_STRING) {
@@ -769,8 +775,9 @@ static wx_result parse_attributes(parser *p, const xmlNode *node, const attr_spe
             for (int k = 0; k < count; ++k) {
                 wx_list_append(allowed, sizeof allowed, specs[k].name);
             }
-            return fail(p, node, WX_CAUSE_UNKNOWN_NAME, "unknown attribute '%s' of <%s> (allowed: %s)", name,
-                        name_of(node), count > 0 ? allowed : "none");
+            return fail(p, node, WX_CAUSE_UNKNOWN_NAME,
+                        "unknown attribute '%s' of <%s> (allowed: %s)", name, name_of(node),
+                        count > 0 ? allowed : "none");
         }
         xmlChar *value = xmlNodeListGetString(node->doc, a->children, 1);
         wx_result r = parse_value(p, node, &specs[i], value != NULL ? (const char *)value : "",
@@ -783,7 +790,8 @@ static wx_result parse_attributes(parser *p, const xmlNode *node, const attr_spe
     }
     for (int i = 0; i < count; ++i) {
         if (specs[i].required && !(seen & (1u << i))) {
-            return fail(p, node, WX_CAUSE_MISSING, "<%s> needs attribute '%s'", name_of(node), specs[i].name);
+            return fail(p, node, WX_CAUSE_MISSING, "<%s> needs attribute '%s'", name_of(node),
+                        specs[i].name);
         }
     }
     if (present != NULL) {
@@ -828,14 +836,15 @@ static wx_result parse_children(parser *p, const xmlNode *parent, const child_sp
             for (int k = 0; k < count; ++k) {
                 wx_list_append(allowed, sizeof allowed, specs[k].name);
             }
-            return fail(p, n, WX_CAUSE_UNKNOWN_NAME, "unknown element <%s%s%s> in <%s> (allowed: %s)",
+            return fail(p, n, WX_CAUSE_UNKNOWN_NAME,
+                        "unknown element <%s%s%s> in <%s> (allowed: %s)",
                         n->ns != NULL && n->ns->prefix != NULL ? (const char *)n->ns->prefix : "",
                         n->ns != NULL && n->ns->prefix != NULL ? ":" : "", name_of(n),
                         name_of(parent), count > 0 ? allowed : "none");
         }
         if (first[i] != NULL && !specs[i].repeat) {
-            return fail(p, n, WX_CAUSE_DUPLICATE, "<%s> appears twice in <%s> (first at line %d)", name_of(n),
-                        name_of(parent), line_of(first[i]));
+            return fail(p, n, WX_CAUSE_DUPLICATE, "<%s> appears twice in <%s> (first at line %d)",
+                        name_of(n), name_of(parent), line_of(first[i]));
         }
         if (first[i] == NULL) {
             first[i] = n;
@@ -945,7 +954,7 @@ static wx_result add_field(parser *p, const xmlNode *node, wx_field_kind kind, w
         return r;
     }
     wx_field *f = &s->fields[s->field_count++];
-    // Defaults (DESIGN section 3; the Wind direction is ours: +X).
+    // Defaults (docs/design.md section 3; the Wind direction is ours: +X).
     *f = (wx_field){ .kind = kind, .strength = 0.0f, .frequency = 1.0f, .octaves = 4,
                      .line = line_of(node) };
     if (kind == WX_FIELD_GRAVITY) {
@@ -977,7 +986,8 @@ static wx_result parse_wind(parser *p, const xmlNode *node, void *user)
     double len = sqrt((double)f->dir[0] * f->dir[0] + (double)f->dir[1] * f->dir[1] +
                       (double)f->dir[2] * f->dir[2]);
     if (!(len > 0.0) || !isfinite(len)) {
-        return fail(p, node, WX_CAUSE_BAD_VALUE, "<Wind> direction (dirX, dirY, dirZ) must not be zero");
+        return fail(p, node, WX_CAUSE_BAD_VALUE,
+                    "<Wind> direction (dirX, dirY, dirZ) must not be zero");
     }
     for (int i = 0; i < 3; ++i) {
         f->dir[i] = (float)(f->dir[i] / len);
@@ -1049,7 +1059,8 @@ static wx_result parse_emitter(parser *p, const xmlNode *node, wx_emitter_kind k
     }
     for (int i = 0; e->name[0] != '\0' && i < s->emitter_count - 1; ++i) {
         if (strcmp(s->emitters[i].name, e->name) == 0) {
-            return fail(p, node, WX_CAUSE_DUPLICATE, "emitter name '%s' is used twice (first at line %d)", e->name,
+            return fail(p, node, WX_CAUSE_DUPLICATE,
+                        "emitter name '%s' is used twice (first at line %d)", e->name,
                         s->emitters[i].line);
         }
     }
@@ -1089,10 +1100,10 @@ static wx_result finish_emitters(parser *p)
             e->end = duration;
         }
         if (e->start > e->end) {
-            return fail_line(p, e->line, WX_CAUSE_BAD_VALUE, "emitter%s%s%s start=%g is after its end=%g%s",
-                             e->name[0] != '\0' ? " '" : "", e->name,
-                             e->name[0] != '\0' ? "'" : "", e->start, e->end,
-                             e->end == duration ? " (the end of the simulation)" : "");
+            return fail_line(
+                p, e->line, WX_CAUSE_BAD_VALUE, "emitter%s%s%s start=%g is after its end=%g%s",
+                e->name[0] != '\0' ? " '" : "", e->name, e->name[0] != '\0' ? "'" : "", e->start,
+                e->end, e->end == duration ? " (the end of the simulation)" : "");
         }
     }
     return WX_OK;
@@ -1230,7 +1241,8 @@ static wx_result parse_output_map(parser *p, const xmlNode *node, void *user)
     }
     size_t len = strlen(out.file);
     if (len < 5 || strcasecmp(out.file + len - 4, ".exr") != 0) {
-        return fail(p, node, WX_CAUSE_BAD_VALUE, "<OutputMap> file=\"%s\" must end in .exr", out.file);
+        return fail(p, node, WX_CAUSE_BAD_VALUE, "<OutputMap> file=\"%s\" must end in .exr",
+                    out.file);
     }
     memcpy(cam->output_file, out.file, sizeof out.file);
     cam->output_width = out.width;
@@ -1294,13 +1306,14 @@ static wx_result camera_matrices(parser *p, const xmlNode *node, ortho_def *o)
         }
         wx_error view_err;
         if (wx_camera_from_view(&cam->view, &cam->camera, &view_err) != WX_OK) {
-            return fail(p, o->view_node, WX_CAUSE_BAD_CAMERA, "camera '%s': %s", cam->name, view_err.message);
+            return fail(p, o->view_node, WX_CAUSE_BAD_CAMERA, "camera '%s': %s", cam->name,
+                        view_err.message);
         }
         return check_camera(p, o->view_node, cam);
     }
     if (o->wtc_node == NULL && o->ctw_node == NULL) {
-        return fail(p, node, WX_CAUSE_MISSING, "camera '%s' needs a <WTCMatrix> (and/or <CTWMatrix>) or a <View>",
-                    cam->name);
+        return fail(p, node, WX_CAUSE_MISSING,
+                    "camera '%s' needs a <WTCMatrix> (and/or <CTWMatrix>) or a <View>", cam->name);
     }
     if (o->wtc_node != NULL && o->ctw_node != NULL) {
         float error = wx_matrix_inverse_error(o->wtc, o->ctw);
@@ -1315,12 +1328,14 @@ static wx_result camera_matrices(parser *p, const xmlNode *node, ortho_def *o)
     } else if (o->wtc_node != NULL) {
         memcpy(cam->camera.wtc, o->wtc, sizeof o->wtc);
         if (!wx_matrix_invert(o->wtc, cam->camera.ctw)) {
-            return fail(p, o->wtc_node, WX_CAUSE_BAD_CAMERA, "<WTCMatrix> of camera '%s' is singular", cam->name);
+            return fail(p, o->wtc_node, WX_CAUSE_BAD_CAMERA,
+                        "<WTCMatrix> of camera '%s' is singular", cam->name);
         }
     } else {
         memcpy(cam->camera.ctw, o->ctw, sizeof o->ctw);
         if (!wx_matrix_invert(o->ctw, cam->camera.wtc)) {
-            return fail(p, o->ctw_node, WX_CAUSE_BAD_CAMERA, "<CTWMatrix> of camera '%s' is singular", cam->name);
+            return fail(p, o->ctw_node, WX_CAUSE_BAD_CAMERA,
+                        "<CTWMatrix> of camera '%s' is singular", cam->name);
         }
     }
     return check_camera(p, o->wtc_node != NULL ? o->wtc_node : o->ctw_node, cam);
@@ -1343,8 +1358,9 @@ static wx_result camera_maps(parser *p, const xmlNode *node, ortho_def *o)
             ++k;
         }
         if (o->view_node == NULL) {
-            return fail(p, node, WX_CAUSE_MISSING, "camera '%s' needs a <%s> (or a <View> so that bake makes it)",
-                        cam->name, map_elements[k]);
+            return fail(p, node, WX_CAUSE_MISSING,
+                        "camera '%s' needs a <%s> (or a <View> so that bake makes it)", cam->name,
+                        map_elements[k]);
         }
         return fail(p, node, WX_CAUSE_MISSING,
                     "camera '%s' names some of its maps but not <%s>: with a <View>, name all "
@@ -1414,7 +1430,8 @@ static wx_result camera_output(parser *p, const xmlNode *node, ortho_def *o)
     }
     if (o->output_node == NULL) {
         if (o->view_node == NULL) {
-            return fail(p, node, WX_CAUSE_MISSING, "output camera '%s' needs an <OutputMap>", cam->name);
+            return fail(p, node, WX_CAUSE_MISSING, "output camera '%s' needs an <OutputMap>",
+                        cam->name);
         }
         snprintf(cam->output_file, sizeof cam->output_file, "mask.exr");
         cam->second_pass = WX_SECOND_PASS_MEAN;
@@ -1451,7 +1468,8 @@ static wx_result parse_ortho(parser *p, const xmlNode *node, void *user)
     }
     for (int i = 0; i < s->camera_count; ++i) {
         if (strcmp(s->cameras[i].name, attrs.name) == 0) {
-            return fail(p, node, WX_CAUSE_DUPLICATE, "camera name '%s' is used twice (first at line %d)", attrs.name,
+            return fail(p, node, WX_CAUSE_DUPLICATE,
+                        "camera name '%s' is used twice (first at line %d)", attrs.name,
                         s->cameras[i].line);
         }
     }
@@ -1507,7 +1525,8 @@ static wx_result parse_projected_maps(parser *p, const xmlNode *node, void *user
         return r;
     }
     if (p->scene->input_count == 0) {
-        return fail(p, node, WX_CAUSE_MISSING, "no input camera: at least one <Ortho> must not be out=\"true\"");
+        return fail(p, node, WX_CAUSE_MISSING,
+                    "no input camera: at least one <Ortho> must not be out=\"true\"");
     }
     return WX_OK;
 }
@@ -1525,7 +1544,8 @@ static wx_result parse_collider(parser *p, const xmlNode *node, void *user)
         return r;
     }
     if (seen[0] == NULL) {
-        return fail(p, node, WX_CAUSE_MISSING, "<Collider> needs a <ProjectedMaps> with the cameras");
+        return fail(p, node, WX_CAUSE_MISSING,
+                    "<Collider> needs a <ProjectedMaps> with the cameras");
     }
     return WX_OK;
 }
@@ -1568,8 +1588,9 @@ static wx_result parse_surface(parser *p, const xmlNode *node, void *user)
     }
     for (int i = 0; i < mesh->surface_count; ++i) {
         if (strcmp(mesh->surfaces[i].material, d.material) == 0) {
-            return fail(p, node, WX_CAUSE_DUPLICATE, "material '%s' appears twice in this <Mesh> (first at line %d)",
-                        d.material, mesh->surfaces[i].line);
+            return fail(p, node, WX_CAUSE_DUPLICATE,
+                        "material '%s' appears twice in this <Mesh> (first at line %d)", d.material,
+                        mesh->surfaces[i].line);
         }
     }
     r = grow_list(p, node, (void **)&mesh->surfaces, mesh->surface_count, &m->surface_cap,
@@ -1668,7 +1689,8 @@ static wx_result parse_root(parser *p, const xmlNode *node)
         return wx_fail(p->err, WX_CAUSE_XML_SYNTAX, "%s: no root element", p->path);
     }
     if (node->ns != NULL || strcmp(name_of(node), "Weathering") != 0) {
-        return fail(p, node, WX_CAUSE_UNKNOWN_NAME, "the root element is <%s>, expected <Weathering>", name_of(node));
+        return fail(p, node, WX_CAUSE_UNKNOWN_NAME,
+                    "the root element is <%s>, expected <Weathering>", name_of(node));
     }
     wx_result r = check_content(p, node);
     if (r != WX_OK || (r = NO_ATTRS()) != WX_OK ||

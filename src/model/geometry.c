@@ -34,18 +34,18 @@ wx_result wx_geometry_match(const wx_scene *scene, int mesh_index, wx_geometry_m
             for (int k = 0; k < data->material_count; ++k) {
                 wx_list_append(list, sizeof list, data->material_names[k]);
             }
-            return wx_fail(err, WX_CAUSE_UNMATCHED_MATERIAL, "%s:%d: mesh '%s' has material '%s' that no <Surface> matches "
-                                "(materials in the file: %s)",
-                                scene->path, mesh->line, wx_mesh_display_name(scene, mesh), name,
-                                list);
+            return wx_fail(err, WX_CAUSE_UNMATCHED_MATERIAL,
+                           "%s:%d: mesh '%s' has material '%s' that no <Surface> matches "
+                           "(materials in the file: %s)",
+                           scene->path, mesh->line, wx_mesh_display_name(scene, mesh), name, list);
         }
         const wx_surface *surf = &mesh->surfaces[match];
         if (surf->colors != WX_COLOR_NONE && !data->material_colored[m]) {
-            return wx_fail(err, WX_CAUSE_UNMATCHED_MATERIAL, "%s:%d: <Surface material=\"%s\"> takes its %s values from vertex "
-                                "colours, but mesh '%s' has none for material '%s'",
-                                scene->path, surf->line, surf->material,
-                                color_use_name(surf->colors), wx_mesh_display_name(scene, mesh),
-                                name);
+            return wx_fail(err, WX_CAUSE_UNMATCHED_MATERIAL,
+                           "%s:%d: <Surface material=\"%s\"> takes its %s values from vertex "
+                           "colours, but mesh '%s' has none for material '%s'",
+                           scene->path, surf->line, surf->material, color_use_name(surf->colors),
+                           wx_mesh_display_name(scene, mesh), name);
         }
         if (surf->dirt > 0.0f || surf->colors == WX_COLOR_DIRT) {
             *has_dirt = true;

@@ -30,8 +30,8 @@ wx_result wx_image_alloc(wx_image *image, int width, int height, int channel_cou
         image->channels[c] = calloc(texels, sizeof(float));
         if (image->channels[c] == NULL) {
             wx_image_free(image);
-            return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory for %d x %d x %d floats", width,
-                                height, channel_count);
+            return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory for %d x %d x %d floats",
+                           width, height, channel_count);
         }
         snprintf(image->channel_names[c], sizeof image->channel_names[c], "%s", names[c]);
     }

@@ -1,5 +1,5 @@
 // maps.h: the four maps of one camera, in memory, in the layout the simulation
-// and the gather read (DESIGN section 2).
+// and the gather read (docs/design.md section 2).
 //
 // Row 0 is the top scanline (EXR order): texel (i, j) is at index j*width + i.
 // Depth holds +inf where there is no surface (NaN, d <= 0 and d >= 1e30 in a file

@@ -56,7 +56,7 @@ typedef struct wx_collider_def {
 } wx_collider_def;
 
 typedef enum wx_second_pass {
-    WX_SECOND_PASS_MEAN, ///< weighted mean (DESIGN section 5), the default
+    WX_SECOND_PASS_MEAN, ///< weighted mean (docs/design.md section 5), the default
     WX_SECOND_PASS_SUM,  ///< the thesis' unnormalised weighted sum
 } wx_second_pass;
 

@@ -176,7 +176,8 @@ wx_result wx_bake_geometry(wx_scene *scene, const wx_run_def *opts, wx_geometry 
 {
     wx_maps *given = NULL;
     bake_writer *writer = calloc(1, sizeof *writer); // four paths: off the stack
-    wx_result r = writer != NULL ? WX_OK : wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "bake: out of memory");
+    wx_result r =
+        writer != NULL ? WX_OK : wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "bake: out of memory");
     if (r == WX_OK && wx_scene_needs_bake(scene)) {
         r = read_given_depths(scene, geometry, &given, err);
     }

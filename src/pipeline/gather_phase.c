@@ -35,8 +35,9 @@ wx_result wx_gather_maps(const wx_scene *scene, const wx_run_def *opts, const wx
                          wx_error *err)
 {
     if (scene->output_index < 0 || scene->output_index >= scene->camera_count) {
-        return wx_fail(err, WX_CAUSE_MISSING, "%s: no output camera (an <Ortho out=\"true\">); gather needs one",
-                            scene->path);
+        return wx_fail(err, WX_CAUSE_MISSING,
+                       "%s: no output camera (an <Ortho out=\"true\">); gather needs one",
+                       scene->path);
     }
     const wx_scene_camera *out = &scene->cameras[scene->output_index];
     char mask_path[WX_PATH_MAX], png_path[WX_PATH_MAX], png_name[WX_OUTPUT_NAME_MAX];
@@ -65,10 +66,11 @@ wx_result wx_gather_maps(const wx_scene *scene, const wx_run_def *opts, const wx
     if (result != WX_OK) {
         wx_error_prefix(err, "output camera '%s'", out->name);
     } else if (out_maps.width != out->output_width || out_maps.height != out->output_height) {
-        result = wx_fail(err, WX_CAUSE_MAP_SIZE, "%s: output camera '%s': its maps are %d x %d but <OutputMap> "
-                              "asks for %d x %d",
-                              scene->path, out->name, out_maps.width, out_maps.height,
-                              out->output_width, out->output_height);
+        result = wx_fail(err, WX_CAUSE_MAP_SIZE,
+                         "%s: output camera '%s': its maps are %d x %d but <OutputMap> "
+                         "asks for %d x %d",
+                         scene->path, out->name, out_maps.width, out_maps.height, out->output_width,
+                         out->output_height);
     }
     int k = 0;
     for (int c = 0; c < scene->camera_count && result == WX_OK; ++c) {

@@ -21,8 +21,9 @@ wx_result wx_load_simulation_maps(const wx_scene *scene, wx_maps *maps, wx_error
             continue;
         }
         if (!wx_has_path(cam->depth_path)) {
-            return wx_fail(err, WX_CAUSE_MISSING_PHASE, "%s: camera '%s' has no maps yet; run `weathering bake` first",
-                                scene->path, cam->name);
+            return wx_fail(err, WX_CAUSE_MISSING_PHASE,
+                           "%s: camera '%s' has no maps yet; run `weathering bake` first",
+                           scene->path, cam->name);
         }
         unsigned which = WX_MAPS_DEPTH | WX_MAPS_NORMAL | WX_MAPS_IMPACT;
         if (wx_has_path(cam->dirt_path)) {

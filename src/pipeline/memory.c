@@ -188,12 +188,13 @@ wx_result wx_memory_check(const wx_scene *scene, unsigned phases, wx_error *err)
                        scene->path, gib(need.baseline_bytes), gib(available));
     }
     if (strcmp(need.phase, "simulation") == 0 && need.particle_bytes > need.sim_map_bytes) {
-        return wx_fail(err, WX_CAUSE_MEMORY_LIMIT, "%s:%d: the emitters would emit %.4g particles: with the maps that "
-                            "needs about %.3g GiB (%.0f bytes per particle, %.3g GiB of maps), "
-                            "but only %.3g GiB of memory is available; lower the rate or the "
-                            "duration (see docs/reliability.md)",
-                            scene->path, need.emitter_line, need.particles, gib(need.total_bytes),
-                            WX_BYTES_PER_PARTICLE, gib(need.sim_map_bytes), gib(available));
+        return wx_fail(err, WX_CAUSE_MEMORY_LIMIT,
+                       "%s:%d: the emitters would emit %.4g particles: with the maps that "
+                       "needs about %.3g GiB (%.0f bytes per particle, %.3g GiB of maps), "
+                       "but only %.3g GiB of memory is available; lower the rate or the "
+                       "duration (see docs/reliability.md)",
+                       scene->path, need.emitter_line, need.particles, gib(need.total_bytes),
+                       WX_BYTES_PER_PARTICLE, gib(need.sim_map_bytes), gib(available));
     }
     if (strcmp(need.phase, "bake") == 0 && need.mesh_bytes > need.bake_bytes - need.mesh_bytes) {
         return wx_fail(err, WX_CAUSE_MEMORY_LIMIT,
@@ -205,9 +206,10 @@ wx_result wx_memory_check(const wx_scene *scene, unsigned phases, wx_error *err)
                             need.mesh_bytes / WX_MESH_BYTES_PER_FILE_BYTE / (1024.0 * 1024.0),
                             gib(available));
     }
-    return wx_fail(err, WX_CAUSE_MEMORY_LIMIT, "%s:%d: the maps need about %.3g GiB at the peak (the %s), but only %.3g "
-                        "GiB of memory is available; use smaller maps (see docs/reliability.md)",
-                        scene->path, need.camera_line, gib(need.total_bytes), need.phase,
-                        gib(available));
+    return wx_fail(err, WX_CAUSE_MEMORY_LIMIT,
+                   "%s:%d: the maps need about %.3g GiB at the peak (the %s), but only %.3g "
+                   "GiB of memory is available; use smaller maps (see docs/reliability.md)",
+                   scene->path, need.camera_line, gib(need.total_bytes), need.phase,
+                   gib(available));
 }
 

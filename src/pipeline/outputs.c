@@ -257,9 +257,10 @@ wx_result wx_output_path(const wx_scene *scene, const wx_run_def *opts, const ch
     }
     struct stat st;
     if (stat(path, &st) == 0 && is_scene_input(scene, &st)) {
-        return wx_fail(err, WX_CAUSE_OUTPUT_CONFLICT, "%s: is an input of scene %s and would be overwritten; choose "
-                            "another --out folder",
-                            path, scene->path);
+        return wx_fail(err, WX_CAUSE_OUTPUT_CONFLICT,
+                       "%s: is an input of scene %s and would be overwritten; choose "
+                       "another --out folder",
+                       path, scene->path);
     }
     return WX_OK;
 }
@@ -330,7 +331,7 @@ static bool canonical_path(const char *path, char out[WX_PATH_MAX])
     return true;
 }
 
-// The --stats file (DESIGN section 6): never an input, an output of the run or an
+// The --stats file (docs/design.md section 6): never an input, an output of the run or an
 // existing non-regular file; its folder exists or is the output folder.
 static wx_result check_stats_path(const wx_scene *scene, const wx_run_def *opts,
                                   const wx_output_names *outputs, wx_error *err)
@@ -339,13 +340,15 @@ static wx_result check_stats_path(const wx_scene *scene, const wx_run_def *opts,
     struct stat st;
     if (lstat(path, &st) == 0) {
         if (!S_ISREG(st.st_mode)) {
-            return wx_fail(err, WX_CAUSE_OUTPUT_CONFLICT, "--stats %s: exists and is %s; the statistics are written only "
-                                "to a new or a regular file",
-                                path, file_kind(st.st_mode));
+            return wx_fail(err, WX_CAUSE_OUTPUT_CONFLICT,
+                           "--stats %s: exists and is %s; the statistics are written only "
+                           "to a new or a regular file",
+                           path, file_kind(st.st_mode));
         }
         if (is_scene_input(scene, &st)) {
-            return wx_fail(err, WX_CAUSE_OUTPUT_CONFLICT, "--stats %s: is an input of scene %s and would be overwritten",
-                                path, scene->path);
+            return wx_fail(err, WX_CAUSE_OUTPUT_CONFLICT,
+                           "--stats %s: is an input of scene %s and would be overwritten", path,
+                           scene->path);
         }
     }
     char stats[WX_PATH_MAX], out_dir[WX_PATH_MAX], output[WX_PATH_MAX];
@@ -355,8 +358,9 @@ static wx_result check_stats_path(const wx_scene *scene, const wx_run_def *opts,
     for (int k = 0; k < outputs->count; ++k) {
         int n = snprintf(output, sizeof output, "%s/%s", out_dir, outputs->names[k]);
         if (n > 0 && n < (int)sizeof output && strcmp(output, stats) == 0) {
-            return wx_fail(err, WX_CAUSE_OUTPUT_CONFLICT, "--stats %s: is the run's output %s; choose another file name",
-                                path, outputs->names[k]);
+            return wx_fail(err, WX_CAUSE_OUTPUT_CONFLICT,
+                           "--stats %s: is the run's output %s; choose another file name", path,
+                           outputs->names[k]);
         }
     }
     char folder[WX_PATH_MAX];
@@ -365,9 +369,10 @@ static wx_result check_stats_path(const wx_scene *scene, const wx_run_def *opts,
     struct stat dir;
     bool exists = stat(folder[0] != '\0' ? folder : "/", &dir) == 0 && S_ISDIR(dir.st_mode);
     if (!exists && strcmp(folder, out_dir) != 0) {
-        return wx_fail(err, WX_CAUSE_FILE_MISSING, "--stats %s: folder %s does not exist (only the output folder is "
-                            "made by the run)",
-                            path, folder);
+        return wx_fail(err, WX_CAUSE_FILE_MISSING,
+                       "--stats %s: folder %s does not exist (only the output folder is "
+                       "made by the run)",
+                       path, folder);
     }
     return WX_OK;
 }
@@ -382,9 +387,10 @@ wx_result wx_check_outputs(const wx_scene *scene, const wx_run_def *opts, unsign
         r = wx_output_path(scene, opts, names.names[k], path, err);
         struct stat st;
         if (r == WX_OK && lstat(path, &st) == 0 && !S_ISREG(st.st_mode)) {
-            r = wx_fail(err, WX_CAUSE_OUTPUT_CONFLICT, "%s: exists and is %s, where the run writes its output %s; remove "
-                             "it or choose another --out folder",
-                             path, file_kind(st.st_mode), names.names[k]);
+            r = wx_fail(err, WX_CAUSE_OUTPUT_CONFLICT,
+                        "%s: exists and is %s, where the run writes its output %s; remove "
+                        "it or choose another --out folder",
+                        path, file_kind(st.st_mode), names.names[k]);
         }
     }
     if (r == WX_OK && opts->stats_path != NULL) {
@@ -426,16 +432,18 @@ wx_result wx_use_baked_maps(wx_scene *scene, const wx_run_def *opts, wx_error *e
             int n = snprintf(path, sizeof path, "%s/%s_%s.exr", opts->out_dir, cam->name,
                              kinds[k]);
             if (n < 0 || n >= (int)sizeof path) {
-                return wx_fail(err, WX_CAUSE_PATH_TOO_LONG, "%s: output path too long", opts->out_dir);
+                return wx_fail(err, WX_CAUSE_PATH_TOO_LONG, "%s: output path too long",
+                               opts->out_dir);
             }
             if (!wx_scene_set_path(paths[k], path)) {
                 return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (paths)");
             }
             if (access(path, R_OK) != 0) {
-                return wx_fail(err, WX_CAUSE_MISSING_PHASE, "%s: camera '%s' has no baked %s map in %s; run `weathering "
-                                    "bake %s --out %s` first",
-                                    scene->path, cam->name, kinds[k], opts->out_dir, scene->path,
-                                    opts->out_dir);
+                return wx_fail(err, WX_CAUSE_MISSING_PHASE,
+                               "%s: camera '%s' has no baked %s map in %s; run `weathering "
+                               "bake %s --out %s` first",
+                               scene->path, cam->name, kinds[k], opts->out_dir, scene->path,
+                               opts->out_dir);
             }
         }
     }

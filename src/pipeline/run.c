@@ -22,7 +22,8 @@ static bool mark_baked_cameras(wx_scene *scene)
     bool any = wx_scene_needs_bake(scene);
     for (int c = 0; c < scene->camera_count; ++c) {
         wx_scene_camera *cam = &scene->cameras[c];
-        cam->maps_in_output = cam->maps_in_output || (cam->has_view && !wx_has_path(cam->depth_path));
+        cam->maps_in_output =
+            cam->maps_in_output || (cam->has_view && !wx_has_path(cam->depth_path));
     }
     return any;
 }
@@ -96,7 +97,8 @@ wx_result wx_run_phases(wx_scene *scene, const wx_run_def *opts, unsigned phases
     }
     if (r == WX_OK && (phases & WX_PHASE_GATHER)) {
         double t0 = wx_now_s();
-        r = maps != NULL ? wx_gather_maps(scene, opts, maps, err) : wx_gather_scene(scene, opts, err);
+        r = maps != NULL ? wx_gather_maps(scene, opts, maps, err)
+                         : wx_gather_scene(scene, opts, err);
         report->times.gather = wx_now_s() - t0;
     }
     free_maps(maps, scene->input_count);

@@ -195,8 +195,9 @@ static wx_result create_context(baker *b, wx_error *err)
                             0 };
     b->context = OSMesaCreateContextAttribs(attribs, NULL);
     if (b->context == NULL) {
-        return wx_fail(err, WX_CAUSE_RENDERER, "bake: cannot create an OSMesa OpenGL 4.5 core context (is Mesa's "
-                            "llvmpipe available? try GALLIUM_DRIVER=llvmpipe)");
+        return wx_fail(err, WX_CAUSE_RENDERER,
+                       "bake: cannot create an OSMesa OpenGL 4.5 core context (is Mesa's "
+                       "llvmpipe available? try GALLIUM_DRIVER=llvmpipe)");
     }
     if (!OSMesaMakeCurrent(b->context, b->context_buffer, GL_UNSIGNED_BYTE, 16, 16)) {
         return wx_fail(err, WX_CAUSE_RENDERER, "bake: cannot make the OSMesa context current");
@@ -262,9 +263,10 @@ static wx_result ensure_framebuffer(baker *b, int width, int height, wx_error *e
         // attachment, not as GL_OUT_OF_MEMORY: every format here is renderable.
         b->fb_width = b->fb_height = 0;
         double mib = (double)width * (double)height * 40.0 / (1024.0 * 1024.0);
-        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "bake: out of memory for the %d x %d float framebuffer (about %.0f "
-                            "MiB; OpenGL status 0x%04x)",
-                            width, height, mib, (unsigned)status);
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY,
+                       "bake: out of memory for the %d x %d float framebuffer (about %.0f "
+                       "MiB; OpenGL status 0x%04x)",
+                       width, height, mib, (unsigned)status);
     }
     b->fb_width = width;
     b->fb_height = height;
@@ -311,8 +313,9 @@ static wx_result upload_mesh(baker *b, wx_mesh_data *mesh, const float *props, g
 {
     size_t nv = (size_t)mesh->vertex_count, nt = (size_t)mesh->triangle_count;
     if (nt * 3 > (size_t)INT32_MAX) {
-        return wx_fail(err, WX_CAUSE_BAD_MESH, "%lld triangles are more than one draw takes (%d); split the mesh",
-                            (long long)nt, INT32_MAX / 3);
+        return wx_fail(err, WX_CAUSE_BAD_MESH,
+                       "%lld triangles are more than one draw takes (%d); split the mesh",
+                       (long long)nt, INT32_MAX / 3);
     }
     if ((size_t)mesh->material_count * 2 > (size_t)b->max_texture_buffer) {
         return wx_fail(err, WX_CAUSE_BAD_MESH, "%d materials are more than the renderer takes",
@@ -477,9 +480,10 @@ static wx_result load_meshes(baker *b, wx_geometry *geometry, wx_error *err)
         }
     }
     if (b->stats->triangles == 0) {
-        return wx_fail(err, WX_CAUSE_BAD_MESH, "%s: the meshes of <Geometry> hold no triangles to bake the cameras "
-                            "given by <View> from",
-                            scene->path);
+        return wx_fail(err, WX_CAUSE_BAD_MESH,
+                       "%s: the meshes of <Geometry> hold no triangles to bake the cameras "
+                       "given by <View> from",
+                       scene->path);
     }
     b->has_dirt = geometry->has_dirt;
     return WX_OK;
@@ -587,7 +591,7 @@ static wx_result read_target(baker *b, int target, int channels, const plane_out
 }
 
 // ---------------------------------------------------------------------------
-// Initial dirt (DESIGN section 3): stored once, in the input camera that sees the
+// Initial dirt (docs/design.md section 3): stored once, in the input camera that sees the
 // patch most head-on.
 
 // The depth map of an input camera that the scene gives as files (read by the
@@ -884,10 +888,11 @@ static wx_result check_sizes(baker *b, wx_error *err)
             continue;
         }
         if (sc->camera.width > b->max_side || sc->camera.height > b->max_side) {
-            return wx_fail(err, WX_CAUSE_MAP_SIZE, "%s:%d: camera '%s' asks for %d x %d maps; the renderer bakes at "
-                                "most %d x %d",
-                                scene->path, sc->line, sc->name, sc->camera.width,
-                                sc->camera.height, (int)b->max_side, (int)b->max_side);
+            return wx_fail(err, WX_CAUSE_MAP_SIZE,
+                           "%s:%d: camera '%s' asks for %d x %d maps; the renderer bakes at "
+                           "most %d x %d",
+                           scene->path, sc->line, sc->name, sc->camera.width, sc->camera.height,
+                           (int)b->max_side, (int)b->max_side);
         }
     }
     return WX_OK;

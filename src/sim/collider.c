@@ -1,4 +1,4 @@
-// collider.c: the projected-maps collider (thesis 4.8.4.1, DESIGN section 4):
+// collider.c: the projected-maps collider (thesis 4.8.4.1, docs/design.md section 4):
 // coarse test, swept test, point rule.
 #include "sim/collider.h"
 
@@ -18,9 +18,10 @@ static wx_result setup_matrices(wx_collider_camera *cam, const float wtc[16], in
     // [x y z 1] * wtc = [u v d w]; the collider needs w constant (orthographic).
     double w = wtc[15];
     if (!wx_matrix_is_orthographic(wtc)) {
-        return wx_fail(err, WX_CAUSE_BAD_CAMERA, "input camera %d: projective (perspective) matrices are not "
-                            "supported by the collider; use orthographic cameras",
-                            index);
+        return wx_fail(err, WX_CAUSE_BAD_CAMERA,
+                       "input camera %d: projective (perspective) matrices are not "
+                       "supported by the collider; use orthographic cameras",
+                       index);
     }
     double W = cam->width, H = cam->height;
     for (int r = 0; r < 4; ++r) {
@@ -151,15 +152,17 @@ wx_result wx_collider_init(wx_collider *collider, const wx_camera *cameras, cons
         if (m->depth == NULL || m->normal == NULL || m->impact == NULL || m->width < 1 ||
             m->height < 1) {
             wx_collider_free(collider);
-            return wx_fail(err, WX_CAUSE_BAD_ARGUMENT, "input camera %d: the collider needs depth, normal and impact "
-                                "maps",
-                                c);
+            return wx_fail(err, WX_CAUSE_BAD_ARGUMENT,
+                           "input camera %d: the collider needs depth, normal and impact "
+                           "maps",
+                           c);
         }
         if ((cameras[c].width != 0 && cameras[c].width != m->width) ||
             (cameras[c].height != 0 && cameras[c].height != m->height)) {
             wx_collider_free(collider);
-            return wx_fail(err, WX_CAUSE_MAP_SIZE, "input camera %d: maps are %d x %d, the camera is %d x %d", c,
-                                m->width, m->height, cameras[c].width, cameras[c].height);
+            return wx_fail(err, WX_CAUSE_MAP_SIZE,
+                           "input camera %d: maps are %d x %d, the camera is %d x %d", c, m->width,
+                           m->height, cameras[c].width, cameras[c].height);
         }
         cam->width = m->width;
         cam->height = m->height;
@@ -492,7 +495,7 @@ static double march_entry(const wx_collider *collider, march *m, double s)
     return 2.0;
 }
 
-// The camera that gives the hit at parameter s: DESIGN section 4's "smallest
+// The camera that gives the hit at parameter s: docs/design.md section 4's "smallest
 // d - depth", read to each map's precision. Across one texel, the depth of a
 // surface seen at angle theta changes by texel * tan(theta), so a camera that
 // sees the surface at a grazing angle has d - depth near 0 over a wide band and
@@ -615,7 +618,7 @@ bool wx_collider_sweep(const wx_collider *collider, const float p0[3], const flo
         march_init(&m[c], &collider->cameras[c], a, d);
     }
     // Leapfrog: raise s until every camera agrees that P(s) may collide and at
-    // least one camera sees it (DESIGN section 4, thesis 4.8.4.1).
+    // least one camera sees it (docs/design.md section 4, thesis 4.8.4.1).
     double s = 0.0;
     bool agreed = false;
     for (int round = 0; round < 1 << 20 && !agreed; ++round) {

@@ -1,4 +1,4 @@
-// collider.h: the projected-maps collider (thesis 4.8.4.1, DESIGN section 4).
+// collider.h: the projected-maps collider (thesis 4.8.4.1, docs/design.md section 4).
 //
 // The geometry is known only through the depth maps of the input cameras. A
 // point collides when at least one camera sees it inside its frame and every
@@ -95,7 +95,7 @@ typedef struct wx_hit {
 bool wx_collider_sweep(const wx_collider *collider, const float p0[3], const float p1[3],
                        wx_hit *hit);
 
-/// The point rule of DESIGN section 4 for one point (no sweep).
+/// The point rule of docs/design.md section 4 for one point (no sweep).
 bool wx_collider_point_collides(const wx_collider *collider, const float p[3]);
 
 /// Coarse test of WX_PARTICLE_BLOCK segments (x0, y0, z0) -> (x1, y1, z1) against

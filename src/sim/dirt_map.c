@@ -1,5 +1,5 @@
 // dirt_map.c: surface dirt, the particle-surface exchange and Bresenham streaks
-// (thesis 3.5, 4.8.4.3, DESIGN section 4).
+// (thesis 3.5, 4.8.4.3, docs/design.md section 4).
 #include "sim/dirt_map.h"
 
 #include <math.h>
@@ -23,7 +23,8 @@ wx_result wx_dirt_map_init(wx_dirt_map *map, int width, int height, const float 
     size_t texels = (size_t)width * (size_t)height;
     map->texels = malloc(texels * sizeof *map->texels);
     if (map->texels == NULL) {
-        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (dirt map %d x %d)", width, height);
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (dirt map %d x %d)", width,
+                       height);
     }
     map->width = width;
     map->height = height;

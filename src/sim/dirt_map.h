@@ -1,6 +1,6 @@
 // dirt_map.h: the dirt on the surface seen by one input camera, and the
-// exchange of dirt between particles and surface (thesis 3.5, 4.8.4.3, DESIGN
-// section 4).
+// exchange of dirt between particles and surface (thesis 3.5, 4.8.4.3,
+// docs/design.md section 4).
 //
 // Surface dirt is kept in double precision during the simulation so that the
 // ledger (initial surface + emitted = final surface + in flight + escaped)
@@ -43,7 +43,7 @@ void wx_dirt_map_free(wx_dirt_map *map);
 double wx_dirt_map_total(const wx_dirt_map *map);
 
 /// One impact at `texel`: dep = deposit*p, ero = erosion*s, then p += ero - dep,
-/// s += dep - ero (thesis 4.8.4.3, as pinned in DESIGN section 4).
+/// s += dep - ero (thesis 4.8.4.3, as pinned in docs/design.md section 4).
 void wx_dirt_map_exchange(wx_dirt_map *map, uint32_t texel, double *load);
 
 /// A slide that follows a slide: the same exchange spread evenly over the

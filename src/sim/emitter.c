@@ -1,4 +1,4 @@
-// emitter.c: point and hemisphere emitters (thesis 4.8.2, DESIGN section 3).
+// emitter.c: point and hemisphere emitters (thesis 4.8.2, docs/design.md section 3).
 #include "sim/emitter.h"
 
 #include <math.h>

@@ -1,4 +1,4 @@
-// emitter.h: particle emitters (thesis 4.8.2, DESIGN section 3): how many
+// emitter.h: particle emitters (thesis 4.8.2, docs/design.md section 3): how many
 // particles an emitter has emitted by a given time, and where and how fast each
 // one starts.
 //

@@ -296,11 +296,13 @@ wx_result wx_forces_init(wx_forces *forces, const wx_field *fields, int count, u
         }
         if (field->kind == WX_FIELD_TURBULENCE) {
             if (field->octaves < 1 || field->octaves > WX_MAX_OCTAVES) {
-                return wx_fail(err, WX_CAUSE_BAD_VALUE, "turbulence field %d: octaves must be 1..%d, not %d", i,
-                                    WX_MAX_OCTAVES, field->octaves);
+                return wx_fail(err, WX_CAUSE_BAD_VALUE,
+                               "turbulence field %d: octaves must be 1..%d, not %d", i,
+                               WX_MAX_OCTAVES, field->octaves);
             }
             if (!isfinite(field->frequency)) {
-                return wx_fail(err, WX_CAUSE_BAD_VALUE, "turbulence field %d: frequency is not finite", i);
+                return wx_fail(err, WX_CAUSE_BAD_VALUE,
+                               "turbulence field %d: frequency is not finite", i);
             }
             turbulence++;
         }

@@ -1,6 +1,6 @@
 // simulate.c: the particle solver (thesis 4.8.2) with the projected-maps
 // collider (4.8.4.1), the mechanical reaction (4.8.4.2) and the dirt exchange
-// (4.8.4.3), as pinned in DESIGN section 4; docs/physics.md explains the
+// (4.8.4.3), as pinned in docs/design.md section 4; docs/physics.md explains the
 // choices.
 //
 // One step:
@@ -178,7 +178,7 @@ static inline bool inside_box(const wx_sim *sim, const float p[3])
            p[1] <= sim->bbox_hi[1] && p[2] >= sim->bbox_lo[2] && p[2] <= sim->bbox_hi[2];
 }
 
-// Forces and the semi-implicit Euler step of one block (DESIGN section 4; the
+// Forces and the semi-implicit Euler step of one block (docs/design.md section 4; the
 // thesis' position formula, 3.2, has a typo): a = g + F/m, v += dt a, x += dt v.
 WX_HOT static void integrate_block(const wx_forces *restrict forces, float t, float dt,
                                    const float *restrict x, const float *restrict y,
@@ -443,7 +443,7 @@ static void record_hit(wx_sim *sim, const sim_event *e)
     }
 }
 
-// Dirt exchange (thesis 4.8.4.3 as pinned in DESIGN section 4) of one chunk's
+// Dirt exchange (thesis 4.8.4.3 as pinned in docs/design.md section 4) of one chunk's
 // events, in particle order.
 static void apply_chunk(wx_sim *sim, const sim_chunk *ch)
 {
@@ -757,9 +757,10 @@ wx_result wx_sim_create(const wx_scene *scene, const wx_sim_def *config, wx_sim 
             sim->slide_base[c] = (uint32_t)total;
             total += (uint64_t)sim->maps[c].width * (uint64_t)sim->maps[c].height;
             if (total >= WX_NO_SLIDE) {
-                r = wx_fail(err, WX_CAUSE_MAP_SIZE, "the input maps hold %llu texels or more in all (the "
-                                 "simulation numbers at most %llu)",
-                                 (unsigned long long)total, (unsigned long long)WX_NO_SLIDE - 1);
+                r = wx_fail(err, WX_CAUSE_MAP_SIZE,
+                            "the input maps hold %llu texels or more in all (the "
+                            "simulation numbers at most %llu)",
+                            (unsigned long long)total, (unsigned long long)WX_NO_SLIDE - 1);
                 break;
             }
         }

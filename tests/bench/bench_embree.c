@@ -272,7 +272,7 @@ typedef struct accuracy {
     int64_t missed_recorded_slow, missed_recorded_fast;
     /// Phantom hits below the geometry's lowest point: particles that passed the
     /// edge of the ground and moved under it, where only the top camera informs
-    /// and says "behind" (DESIGN section 4's rule for uninformed cameras).
+    /// and says "behind" (docs/design.md section 4's rule for uninformed cameras).
     int64_t phantom_below;
     double max_speed_texels;
 } accuracy;
