@@ -21,6 +21,7 @@
 #include "model/geometry.h"
 #include "model/scene.h"
 #include "pipeline/bake_phase.h"
+#include "pipeline/gather_phase.h"
 #include "pipeline/memory.h"
 #include "pipeline/outputs.h"
 #include "pipeline/pipeline.h"
@@ -251,19 +252,24 @@ static int command_info(const cli_args *args)
     if (status != WX_OK) {
         return status;
     }
-    // The meshes are read as bake reads them, so that info refuses what bake
-    // would, before it prints anything.
+    // The gather's limits, the outputs and --stats are checked and the meshes
+    // read as a run does, so that info refuses what a run would (but for the
+    // memory, which it reports), before it prints anything.
     wx_geometry geometry;
     memset(&geometry, 0, sizeof geometry);
     bool imported = wx_scene_needs_bake(&scene);
-    if (imported) {
-        wx_error err;
-        wx_result r = wx_geometry_load(&scene, args->quiet, &geometry, &err);
-        if (r != WX_OK) {
-            fprintf(stderr, "weathering: %s\n", err.message);
-            wx_scene_free(&scene);
-            return r;
-        }
+    wx_error err;
+    wx_result r = wx_gather_check(&scene, &err);
+    if (r == WX_OK) {
+        r = wx_check_outputs(&scene, &opts, WX_PHASE_ALL, &err);
+    }
+    if (r == WX_OK && imported) {
+        r = wx_geometry_load(&scene, args->quiet, &geometry, &err);
+    }
+    if (r != WX_OK) {
+        fprintf(stderr, "weathering: %s\n", err.message);
+        wx_scene_free(&scene);
+        return r;
     }
     printf("scene %s\n", scene.path);
     printf("solver: bounding box %g m centred at (%g, %g, %g); %" PRId64
@@ -351,6 +357,12 @@ static int command_info(const cli_args *args)
     }
     printf("\n");
     printf("output folder: %s\n", opts.out_dir);
+    if (opts.stats_path != NULL) {
+        char shown[WX_ERROR_MAX];
+        wx_printable(opts.stats_path, shown, sizeof shown);
+        printf("statistics: %s (written by bake, simulate, gather and run; info writes nothing)\n",
+               shown);
+    }
     wx_scene_free(&scene);
     return 0;
 }
@@ -382,7 +394,7 @@ static int run_phases(const cli_args *args, unsigned phases)
     wx_error err;
     wx_result r = WX_OK;
     if ((phases & WX_PHASE_GATHER) && scene.output_index < 0) {
-        r = wx_fail(&err, WX_CAUSE_BAD_SCENE,
+        r = wx_fail(&err, WX_CAUSE_MISSING,
                     "%s: has no output camera (<Ortho out=\"true\">); `%s` needs one", scene.path,
                     args->command);
     }

@@ -150,6 +150,11 @@ TEST(stats_never_overwrites_anything)
         }
         ENSURE(status == 2);
         ENSURE(ensure_contains(out, cases[k].message));
+        // info refuses what a run would.
+        status = ensure_shell(out, sizeof out, "cd '%s' && '%s/weathering' info s.xml --out o "
+                              "--stats '%s'", d, build_dir(), cases[k].stats);
+        ENSURE(status == 2);
+        ENSURE(ensure_contains(out, cases[k].message));
     }
     // Nothing was written: the inputs are unchanged, the folder holds only the
     // user's file, the link still points at /dev/null.
@@ -161,6 +166,8 @@ TEST(stats_never_overwrites_anything)
     // A new file in the output folder (made by the run) is fine.
     ENSURE(ensure_shell(out, sizeof out, "cd '%s' && '%s/weathering' info s.xml --out new "
                         "--stats new/stats.json", d, build_dir()) == 0);
+    ENSURE(ensure_contains(out, "statistics: new/stats.json (written by bake, simulate, gather "
+                                "and run; info writes nothing)\n"));
 }
 
 // The cleanup of killed runs' temporaries touches only this program's own

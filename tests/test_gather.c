@@ -584,6 +584,26 @@ TEST(bad_definitions_are_refused)
     ENSURE_CAUSE(err, MAP_SIZE);
 }
 
+// The neighbourhood a scene is checked against before any work: texels of 0.5 m,
+// radius 1.2 m = 2.4 texels, so the offsets (di, dj) != 0 with di^2 + dj^2 < 5.76:
+// 4 at distance 1, 4 at sqrt 2, 4 at 2 and 8 at sqrt 5, 20 in all.
+TEST(radius_check_counts_the_neighbourhood)
+{
+    wx_camera cam = front_camera(); // 4 x 2 m at 8 x 4 texels
+    wx_target target = { .kind = WX_TARGET_CAMERA, .camera = &cam, .width = 8, .height = 4 };
+    int texels = -1;
+    wx_error err = { 0 };
+    ENSURE(wx_gather_check_radius(&target, 1.2f, &texels, &err) == WX_OK);
+    ENSURE(texels == 20);
+    ENSURE(wx_gather_check_radius(&target, 0.0f, &texels, &err) == WX_OK && texels == 0);
+    // pi r^2 / 0.25 > 100000 from r = 89.2 m on.
+    ENSURE(wx_gather_check_radius(&target, 100.0f, &texels, &err) == WX_BAD_INPUT);
+    ENSURE_CAUSE(err, BAD_VALUE);
+    ENSURE(ensure_contains(err.message, "radius 100 covers more than 100000 output texels"));
+    ENSURE(wx_gather_check_radius(&target, 85.0f, &texels, &err) == WX_OK);
+    ENSURE(texels > 90000 && texels <= 100000);
+}
+
 // ---------------------------------------------------------------------------
 // Header matrices.
 
@@ -908,6 +928,7 @@ int main(void)
     RUN(normalize_scales_the_maximum_to_one);
     RUN(thread_count_does_not_change_the_mask);
     RUN(bad_definitions_are_refused);
+    RUN(radius_check_counts_the_neighbourhood);
     RUN(world_to_camera_and_ndc);
     RUN(mask_file_projects_world_points_onto_their_texel);
     RUN(preview_png_decodes_with_the_mask_size);

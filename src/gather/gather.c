@@ -503,6 +503,14 @@ static wx_result prepare_input(const wx_target *out, const double out_ctw[16],
 
 // The second-pass neighbourhood of the output camera: every texel offset whose
 // world distance can be below the radius for some depth difference.
+static wx_result radius_too_large(float radius, wx_error *err)
+{
+    return wx_fail(err, WX_CAUSE_BAD_VALUE,
+                   "the second-pass radius %g covers more than %d output texels around each "
+                   "texel; use a smaller radius",
+                   (double)radius, MAX_OFFSETS);
+}
+
 static wx_result build_offsets(const wx_target *out, const double ctw[16], float radius,
                                offset **out_offsets, int *out_count, float *out_z2,
                                wx_error *err)
@@ -535,10 +543,7 @@ static wx_result build_offsets(const wx_target *out, const double ctw[16], float
     double span_i = ceil((double)radius * sqrt(gyy / det));
     double span_j = ceil((double)radius * sqrt(gxx / det));
     if (!((2.0 * span_i + 1.0) * (2.0 * span_j + 1.0) <= 4.0 * MAX_OFFSETS)) {
-        return wx_fail(err, WX_CAUSE_BAD_VALUE,
-                       "gather: second-pass radius %g covers more than %d output texels; "
-                       "use a smaller radius",
-                       (double)radius, MAX_OFFSETS);
+        return radius_too_large(radius, err);
     }
     int si = (int)span_i, sj = (int)span_j;
     size_t cap = (size_t)(2 * si + 1) * (size_t)(2 * sj + 1);
@@ -569,15 +574,31 @@ static wx_result build_offsets(const wx_target *out, const double ctw[16], float
     }
     if (count > MAX_OFFSETS) {
         free(offsets);
-        return wx_fail(err, WX_CAUSE_BAD_VALUE,
-                       "gather: second-pass radius %g covers more than %d output texels; "
-                       "use a smaller radius",
-                       (double)radius, MAX_OFFSETS);
+        return radius_too_large(radius, err);
     }
     *out_offsets = offsets;
     *out_count = count;
     *out_z2 = (float)z2;
     return WX_OK;
+}
+
+wx_result wx_gather_check_radius(const wx_target *target, float radius, int *texels,
+                                 wx_error *err)
+{
+    *texels = 0;
+    if (!(radius >= 0.0f) || !isfinite(radius)) {
+        return wx_fail(err, WX_CAUSE_BAD_VALUE, "the second-pass radius must be >= 0");
+    }
+    double ctw[16];
+    if (radius > 0.0f && !wx_matrix_to_affine(target->camera->ctw, ctw)) {
+        return wx_fail(err, WX_CAUSE_BAD_CAMERA, "the output camera is not orthographic");
+    }
+    offset *offsets = NULL;
+    float z2 = 0.0f;
+    wx_result r = radius > 0.0f ? build_offsets(target, ctw, radius, &offsets, texels, &z2, err)
+                                : WX_OK;
+    free(offsets);
+    return r;
 }
 
 wx_result wx_gather_compute(const wx_gather_def *def, float *mask_out, wx_gather_stats *stats,

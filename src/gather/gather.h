@@ -76,6 +76,13 @@ wx_gather_def wx_default_gather_def(void);
 /// A view of a camera and its loaded maps (the dirt plane may be NULL).
 wx_gather_view wx_gather_view_from_maps(const wx_camera *camera, const wx_maps *maps);
 
+/// The neighbourhood of the second pass of `radius` over `target` (only its
+/// camera and size are read: depth and normal may be NULL), for checking a scene
+/// before any work: `texels` gets the output texels around each texel it visits.
+/// WX_BAD_VALUE (WX_CAUSE_BAD_VALUE) when that is over the limit the gather takes.
+wx_result wx_gather_check_radius(const wx_target *target, float radius, int *texels,
+                                 wx_error *err);
+
 /// Computes the mask into mask_out (target width*height floats, row 0 = top; 0
 /// where the target has no surface). stats may be NULL. Fails with
 /// WX_BAD_INPUT on a missing map, a size mismatch, a camera that is not

@@ -15,14 +15,14 @@
 typedef enum wx_field_kind {
     WX_FIELD_GRAVITY,    ///< acceleration along -Y
     WX_FIELD_WIND,       ///< force = strength * unit(dir)
-    WX_FIELD_TURBULENCE, ///< force from Perlin turbulence of (position, time)
+    WX_FIELD_TURBULENCE, ///< force from Perlin's simplex noise of (position, time)
 } wx_field_kind;
 
 typedef struct wx_field {
     wx_field_kind kind;
     float strength;  ///< Gravity: acceleration (m/s^2); Wind, Turbulence: force
     float dir[3];    ///< Wind: unit direction (normalised on loading)
-    float frequency; ///< Turbulence: spatial frequency of the first octave (1/m)
+    float frequency; ///< Turbulence: frequency of the first octave, 1/m in space and 1/s in time
     int octaves;     ///< Turbulence: number of octaves, 1..16
     int line;        ///< line in the scene file
 } wx_field;

@@ -31,6 +31,25 @@ wx_result wx_gather_scene(const wx_scene *scene, const wx_run_def *opts, wx_erro
     return result;
 }
 
+wx_result wx_gather_check(const wx_scene *scene, wx_error *err)
+{
+    if (scene->output_index < 0 || scene->output_index >= scene->camera_count) {
+        return WX_OK;
+    }
+    const wx_scene_camera *out = &scene->cameras[scene->output_index];
+    wx_target target = { .kind = WX_TARGET_CAMERA,
+                         .camera = &out->camera,
+                         .width = out->output_width,
+                         .height = out->output_height };
+    int texels = 0;
+    wx_result r = wx_gather_check_radius(&target, out->radius, &texels, err);
+    if (r != WX_OK) {
+        wx_error_prefix(err, "%s:%d: <OutputMap> of camera '%s'", scene->path, out->line,
+                        out->name);
+    }
+    return r;
+}
+
 wx_result wx_gather_maps(const wx_scene *scene, const wx_run_def *opts, const wx_maps *in_maps,
                          wx_error *err)
 {

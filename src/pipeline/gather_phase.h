@@ -9,6 +9,12 @@
 #include "model/scene.h"
 #include "pipeline/pipeline.h"
 
+/// Checks what the gather would refuse about the scene, before any work: the
+/// output camera's second-pass radius must fit the gather's neighbourhood limit
+/// (WX_CAUSE_BAD_VALUE, "scene.xml:LINE: <OutputMap> of camera 'NAME': ...").
+/// A scene without an output camera passes (the command says it needs one).
+wx_result wx_gather_check(const wx_scene *scene, wx_error *err);
+
 /// The `gather` phase: loads the output camera's depth and normal maps and, for
 /// every input camera, its depth and normal maps and the dirt map `simulate`
 /// left in opts->out_dir (<camera>_dirt.exr; when there is none, the camera's

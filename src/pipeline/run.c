@@ -55,6 +55,9 @@ wx_result wx_run_phases(wx_scene *scene, const wx_run_def *opts, unsigned phases
     if (r == WX_OK && bake) {
         r = wx_geometry_load(scene, opts->quiet, &geometry, err);
     }
+    if (r == WX_OK && (phases & WX_PHASE_GATHER)) {
+        r = wx_gather_check(scene, err);
+    }
     if (r == WX_OK) {
         r = wx_memory_check(scene, phases, err);
     }

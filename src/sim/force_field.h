@@ -45,7 +45,7 @@ bool wx_kernels_fuse_multiply_add(void);
 
 typedef struct wx_turbulence {
     float strength;  ///< force scale (N)
-    float frequency; ///< frequency of octave 0 (1/m)
+    float frequency; ///< frequency of octave 0 (1/m in space, 1/s in time)
     int octaves;     ///< 1..WX_MAX_OCTAVES
     uint32_t seed;   ///< hash seed (from the scene seed and the field's index)
     float weight[WX_MAX_OCTAVES]; ///< octave weights, sum 1

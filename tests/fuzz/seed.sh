@@ -6,7 +6,7 @@ target=$1
 corpus=$2
 mkdir -p "$corpus"
 case "$target" in
-    fuzz_scene) seeds="xml_scenes/*.xml tests/data/*.xml tests/bad/*.xml tests/bad/run/*.xml tests/bad/mesh/*.xml" ;;
+    fuzz_scene) seeds="xml_scenes/*.xml tests/data/*.xml tests/bad/*.xml tests/bad/run/*.xml tests/bad/mesh/*.xml tests/bad/gather/*.xml" ;;
     fuzz_exr) seeds="maps/*.exr tests/data/*.exr tests/bad/maps/*.exr" ;;
     *) echo "seed.sh: unknown target $target" >&2; exit 2 ;;
 esac
