@@ -5,7 +5,8 @@
 //
 // and the compute layers (raster, sim, gather) never open a file themselves:
 // they take and return memory, the pipeline reads and writes. Only the scene
-// loader includes libxml2, only the mesh importer Assimp, only io/exr.c OpenEXR.
+// loader includes libxml2, only the mesh importer Assimp, only io/exr.c OpenEXR,
+// only io/png_preview.c libpng.
 #include <dirent.h>
 #include <stdbool.h>
 #include <stdio.h>
@@ -146,6 +147,7 @@ TEST(every_layer_includes_only_the_layers_below_it)
             bad += check_library(rel, text, "<assimp/", "io/mesh_import.c");
             bad += check_library(rel, text, "<openexr.h>", "io/exr.c");
             bad += check_library(rel, text, "<GL/osmesa.h>", "raster/bake.c");
+            bad += check_library(rel, text, "<png.h>", "io/png_preview.c");
             free(text);
             files++;
         }

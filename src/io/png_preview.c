@@ -98,73 +98,57 @@ typedef struct png_writer {
     FILE *file;
     png_structp png;
     png_infop info;
-    uint8_t *row;
+    const uint8_t *pixels; // top-down rows of width * channels bytes
+    int width, height, channels;
     png_failure failure;
 } png_writer;
 
-static bool write_rows(png_writer *w, const float *mask, const float *surface, int width,
-                       int height, float scale)
+static bool write_rows(png_writer *w)
 {
     if (setjmp(w->failure.jump)) {
         return false;
     }
     png_init_io(w->png, w->file);
-    png_set_IHDR(w->png, w->info, (png_uint_32)width, (png_uint_32)height, 8,
-                 PNG_COLOR_TYPE_GRAY_ALPHA, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
-                 PNG_FILTER_TYPE_DEFAULT);
+    png_set_IHDR(w->png, w->info, (png_uint_32)w->width, (png_uint_32)w->height, 8,
+                 w->channels == 2 ? PNG_COLOR_TYPE_GRAY_ALPHA : PNG_COLOR_TYPE_RGB,
+                 PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
     png_write_info(w->png, w->info);
-    const float inv_scale = scale > 0.0f ? 1.0f / scale : 0.0f;
-    for (int j = 0; j < height; ++j) {
-        for (int i = 0; i < width; ++i) {
-            size_t t = (size_t)j * (size_t)width + (size_t)i;
-            float value = mask[t] * inv_scale;
-            value = value > 0.0f ? (value < 1.0f ? powf(value, 1.0f / 2.2f) : 1.0f) : 0.0f;
-            bool has_surface = surface == NULL || !wx_depth_is_empty(surface[t]);
-            w->row[2 * i] = (uint8_t)lrintf(255.0f * value);
-            w->row[2 * i + 1] = has_surface ? 255 : 0;
-        }
-        png_write_row(w->png, w->row);
+    size_t row = (size_t)w->channels * (size_t)w->width;
+    for (int j = 0; j < w->height; ++j) {
+        png_write_row(w->png, (png_const_bytep)(w->pixels + (size_t)j * row));
     }
     png_write_end(w->png, NULL);
     return true;
 }
 
-wx_result wx_preview_write_png(const char *path, const float *mask, const float *surface,
-                               int width, int height, wx_error *err)
+wx_result wx_png_write(const char *path, const uint8_t *pixels, int width, int height,
+                       int channels, wx_error *err)
 {
-    if (width < 1 || height < 1) {
-        return wx_fail(err, WX_CAUSE_BAD_ARGUMENT, "%s: empty preview", path);
-    }
-    float scale = 0.0f;
-    wx_result result =
-        wx_preview_scale(mask, (size_t)width * (size_t)height, &scale, err);
-    if (result != WX_OK) {
-        return result;
+    if (width < 1 || height < 1 || (channels != 2 && channels != 3)) {
+        return wx_fail(err, WX_CAUSE_BAD_ARGUMENT, "%s: a PNG of %d x %d x %d", path, width,
+                       height, channels);
     }
     char tmp[WX_PATH_MAX];
     wx_temp_path(path, tmp);
     png_writer w;
     memset(&w, 0, sizeof w);
-    w.row = malloc(2 * (size_t)width);
-    if (w.row == NULL) {
-        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "%s: out of memory", path);
-    }
+    w.pixels = pixels;
+    w.width = width;
+    w.height = height;
+    w.channels = channels;
     w.file = fopen(tmp, "wb");
     if (w.file == NULL) {
-        result = wx_fail(err, WX_CAUSE_IO, "%s: cannot write (%s)", path, strerror(errno));
-        free(w.row);
-        return result;
+        return wx_fail(err, WX_CAUSE_IO, "%s: cannot write (%s)", path, strerror(errno));
     }
     w.png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &w.failure, on_png_error,
                                     on_png_warning);
     w.info = w.png != NULL ? png_create_info_struct(w.png) : NULL;
-    bool ok = w.info != NULL && write_rows(&w, mask, surface, width, height, scale);
+    bool ok = w.info != NULL && write_rows(&w);
     if (!ok && w.failure.message[0] == '\0') {
         snprintf(w.failure.message, sizeof w.failure.message, "out of memory");
     }
     png_destroy_write_struct(&w.png, &w.info);
     int closed = fclose(w.file);
-    free(w.row);
     if (!ok) {
         unlink(tmp);
         return wx_fail(err, WX_CAUSE_IO, "%s: cannot write PNG (%s)", path, w.failure.message);
@@ -175,4 +159,33 @@ wx_result wx_preview_write_png(const char *path, const float *mask, const float 
         return wx_fail(err, WX_CAUSE_IO, "%s: cannot write (%s)", path, strerror(saved));
     }
     return wx_atomic_commit(tmp, path, err);
+}
+
+wx_result wx_preview_write_png(const char *path, const float *mask, const float *surface,
+                               int width, int height, wx_error *err)
+{
+    if (width < 1 || height < 1) {
+        return wx_fail(err, WX_CAUSE_BAD_ARGUMENT, "%s: empty preview", path);
+    }
+    size_t texels = (size_t)width * (size_t)height;
+    float scale = 0.0f;
+    wx_result result = wx_preview_scale(mask, texels, &scale, err);
+    if (result != WX_OK) {
+        return result;
+    }
+    uint8_t *pixels = malloc(2 * texels);
+    if (pixels == NULL) {
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "%s: out of memory", path);
+    }
+    const float inv_scale = scale > 0.0f ? 1.0f / scale : 0.0f;
+    for (size_t t = 0; t < texels; ++t) {
+        float value = mask[t] * inv_scale;
+        value = value > 0.0f ? (value < 1.0f ? powf(value, 1.0f / 2.2f) : 1.0f) : 0.0f;
+        bool has_surface = surface == NULL || !wx_depth_is_empty(surface[t]);
+        pixels[2 * t] = (uint8_t)lrintf(255.0f * value);
+        pixels[2 * t + 1] = has_surface ? 255 : 0;
+    }
+    result = wx_png_write(path, pixels, width, height, 2, err);
+    free(pixels);
+    return result;
 }

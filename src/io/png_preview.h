@@ -5,6 +5,7 @@
 #define WX_PNG_PREVIEW_H
 
 #include <stddef.h>
+#include <stdint.h>
 
 #include "core/error.h"
 
@@ -12,6 +13,12 @@
 /// (sorted ascending, element floor(0.99 * (n - 1))), or 0 when there are none.
 /// Returns WX_FAIL when out of memory.
 wx_result wx_preview_scale(const float *mask, size_t count, float *scale, wx_error *err);
+
+/// Writes `path` atomically as an 8-bit PNG of `height` top-down rows of
+/// width * channels bytes: 2 channels (grey, alpha) or 3 (RGB). The preview and
+/// the viewer's screenshots are written this way.
+wx_result wx_png_write(const char *path, const uint8_t *pixels, int width, int height,
+                       int channels, wx_error *err);
 
 /// Writes `path` atomically as 8-bit grey + alpha. `surface` (may be NULL: all
 /// opaque) holds width*height depths; texels without a surface (maps.h) get alpha 0.
