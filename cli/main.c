@@ -284,17 +284,38 @@ static int command_info(const cli_args *args)
     double duration = wx_scene_duration(&scene);
     for (int e = 0; e < scene.emitter_count; ++e) {
         const wx_emitter *em = &scene.emitters[e];
-        printf("  %-12s %-10s at (%g, %g, %g)", em->name[0] ? em->name : "(unnamed)",
-               em->kind == WX_EMITTER_POINT ? "point" : "hemisphere", em->center[0],
-               em->center[1], em->center[2]);
+        int64_t count = wx_emitter_count_at(em, duration);
+        if (em->kind == WX_EMITTER_BOX) {
+            printf("  %-12s %-10s (%g, %g, %g) to (%g, %g, %g), direction (%g, %g, %g)",
+                   em->name[0] ? em->name : "(unnamed)", "box", em->box_min[0], em->box_min[1],
+                   em->box_min[2], em->box_max[0], em->box_max[1], em->box_max[2], em->dir[0],
+                   em->dir[1], em->dir[2]);
+            if (em->spread > 0.0f) {
+                printf(" within %g degrees", em->spread);
+            }
+            // The box's shadow on a plane across the flow: with straight parallel
+            // paths, count / shadow particles cross each square metre of it.
+            double shadow = 0.0;
+            for (int k = 0; k < 3; ++k) {
+                double a = (double)em->box_max[(k + 1) % 3] - em->box_min[(k + 1) % 3];
+                double b = (double)em->box_max[(k + 2) % 3] - em->box_min[(k + 2) % 3];
+                shadow += fabs((double)em->dir[k]) * a * b;
+            }
+            if (shadow > 0.0) {
+                printf(" (%.4g particles per square metre across it)", (double)count / shadow);
+            }
+        } else {
+            printf("  %-12s %-10s at (%g, %g, %g)", em->name[0] ? em->name : "(unnamed)",
+                   em->kind == WX_EMITTER_POINT ? "point" : "hemisphere", em->center[0],
+                   em->center[1], em->center[2]);
+        }
         if (em->kind == WX_EMITTER_HEMISPHERE) {
             printf(" radius %g", em->radius);
         }
         printf(", %g/s from %g to %g s (%lld particles), speed %g, mass %g, dirt %g, "
                "max collisions %d\n",
-               em->rate, em->start, em->end, (long long)wx_emitter_count_at(em, duration),
-               em->speed,
-               em->mass, em->dirt, em->max_collisions);
+               em->rate, em->start, em->end, (long long)count, em->speed, em->mass, em->dirt,
+               em->max_collisions);
     }
     printf("force fields (%d):\n", scene.field_count);
     for (int f = 0; f < scene.field_count; ++f) {

@@ -151,8 +151,8 @@ TEST(element_defaults)
     ENSURE(s.fields[2].kind == WX_FIELD_TURBULENCE && s.fields[2].strength == 0.0f);
     ENSURE(s.fields[2].frequency == 1.0f && s.fields[2].octaves == 4);
 
-    ENSURE(s.emitter_count == 2);
-    for (int i = 0; i < 2; ++i) {
+    ENSURE(s.emitter_count == 3);
+    for (int i = 0; i < 3; ++i) {
         const wx_emitter *e = &s.emitters[i];
         ENSURE(e->name[0] == '\0');
         ENSURE(e->center[0] == 0.0f && e->center[1] == 0.0f && e->center[2] == 0.0f);
@@ -163,6 +163,13 @@ TEST(element_defaults)
     }
     ENSURE(s.emitters[0].kind == WX_EMITTER_POINT && s.emitters[0].radius == 0.0f);
     ENSURE(s.emitters[1].kind == WX_EMITTER_HEMISPHERE && s.emitters[1].radius == 1.0f);
+    // A box emitter: straight down, no spread (docs/design.md section 8).
+    const wx_emitter *box = &s.emitters[2];
+    ENSURE(box->kind == WX_EMITTER_BOX);
+    ENSURE(box->box_min[0] == -1.0f && box->box_min[1] == 2.0f && box->box_min[2] == -1.0f);
+    ENSURE(box->box_max[0] == 1.0f && box->box_max[1] == 2.0f && box->box_max[2] == 1.0f);
+    ENSURE(box->dir[0] == 0.0f && box->dir[1] == -1.0f && box->dir[2] == 0.0f);
+    ENSURE(box->spread == 0.0f);
 
     ENSURE(s.camera_count == 2 && s.input_count == 1 && s.output_index == 1);
     const wx_scene_camera *in = &s.cameras[0];
@@ -216,7 +223,7 @@ TEST(full_scene)
     ENSURE(s.fields[2].frequency == 0.25f && s.fields[2].octaves == 6);
     ENSURE(s.fields[3].kind == WX_FIELD_WIND && s.fields[3].dir[2] == -1.0f);
 
-    ENSURE(s.emitter_count == 2);
+    ENSURE(s.emitter_count == 3);
     const wx_emitter *p1 = &s.emitters[0];
     ENSURE(p1->kind == WX_EMITTER_POINT && strcmp(p1->name, "p1") == 0);
     ENSURE(p1->center[0] == 1.0f && p1->center[1] == 5.0f && p1->center[2] == -2.0f);
@@ -229,6 +236,16 @@ TEST(full_scene)
     ENSURE(sky->rate == 5000.0 && sky->start == 1.0 && sky->end == 9.5);
     ENSURE(sky->speed == 2.0f && sky->mass == 0.5f && sky->dirt == 1.5f);
     ENSURE(sky->max_collisions == 50);
+    const wx_emitter *rain = &s.emitters[2];
+    ENSURE(rain->kind == WX_EMITTER_BOX && strcmp(rain->name, "rain") == 0);
+    ENSURE(rain->box_min[0] == -2.0f && rain->box_min[1] == 6.0f && rain->box_min[2] == -3.0f);
+    ENSURE(rain->box_max[0] == 2.0f && rain->box_max[1] == 6.0f && rain->box_max[2] == 3.0f);
+    ENSURE_NEAR(rain->dir[0], 1.0 / 3.0, 1e-7); // (1, -2, 2) made unit
+    ENSURE_NEAR(rain->dir[1], -2.0 / 3.0, 1e-7);
+    ENSURE_NEAR(rain->dir[2], 2.0 / 3.0, 1e-7);
+    ENSURE(rain->spread == 15.0f && rain->rate == 8000.0 && rain->start == 0.25);
+    ENSURE(rain->end == 3.0 && rain->speed == 6.0f && rain->mass == 0.25f);
+    ENSURE(rain->dirt == 2.0f && rain->max_collisions == 3);
 
     ENSURE(s.camera_count == 4 && s.input_count == 3 && s.output_index == 3);
     const wx_scene_camera *front = &s.cameras[0];
@@ -724,7 +741,8 @@ TEST(schema_rejects_bad_values)
         "duplicate_camera",   "output_file_folder",     "resolution_too_large",
         "duplicate_material", "duplicate_emitter_name", "mass_zero",
         "wrong_root",         "missing_required_attribute",
-        "collider_friction_above_one",
+        "collider_friction_above_one", "box_emitter_spread_90",
+        "box_emitter_without_a_corner", "box_emitter_has_no_center",
     };
     int failures = 0;
     for (size_t i = 0; i < sizeof invalid / sizeof invalid[0]; ++i) {

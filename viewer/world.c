@@ -305,9 +305,37 @@ static void add_box(vertex_list *lines, const float lo[3], const float hi[3], co
 }
 
 // Point emitter: a small wire box with a cross inside (the thesis' "box with a
-// large point inside"); hemisphere: its base circle and two arcs over the top.
+// large point inside"); hemisphere: its base circle and two arcs over the top;
+// box: the box (a rectangle when flat) and arrows along its direction from its
+// centre and its corners on the min side.
 static void add_emitter(vertex_list *lines, const wx_emitter *e, float size, const float color[3])
 {
+    if (e->kind == WX_EMITTER_BOX) {
+        add_box(lines, e->box_min, e->box_max, color);
+        // Arrows along the direction from the centre and from four points
+        // halfway to the corners of the box's two widest axes.
+        float ext[3], mid[3];
+        int thin = 0;
+        for (int a = 0; a < 3; ++a) {
+            ext[a] = e->box_max[a] - e->box_min[a];
+            mid[a] = 0.5f * (e->box_min[a] + e->box_max[a]);
+            thin = ext[a] < ext[thin] ? a : thin;
+        }
+        int a1 = (thin + 1) % 3, a2 = (thin + 2) % 3;
+        float len = fmaxf(4.0f * size, 0.25f * fmaxf(ext[a1], ext[a2]));
+        for (int k = 0; k < 5; ++k) {
+            float p[3] = { mid[0], mid[1], mid[2] }, q[3];
+            if (k > 0) {
+                p[a1] += ((k - 1) & 1 ? 0.25f : -0.25f) * ext[a1];
+                p[a2] += ((k - 1) & 2 ? 0.25f : -0.25f) * ext[a2];
+            }
+            for (int a = 0; a < 3; ++a) {
+                q[a] = p[a] + len * e->dir[a];
+            }
+            push_line(lines, p, q, color);
+        }
+        return;
+    }
     const float *c = e->center;
     if (e->kind == WX_EMITTER_POINT) {
         float lo[3], hi[3];

@@ -1018,11 +1018,18 @@ static wx_result parse_force_fields(parser *p, const xmlNode *node, void *user)
 // ---------------------------------------------------------------------------
 // <Emitters>
 
+#define EMITTER_NAME                                                                         \
+    { "name", T_TEXT, offsetof(wx_emitter, name), .size = sizeof(((wx_emitter *)0)->name) }
+
 #define EMITTER_ATTRS                                                                        \
-    { "name", T_TEXT, offsetof(wx_emitter, name), .size = sizeof(((wx_emitter *)0)->name) }, \
+    EMITTER_NAME,                                                                            \
     { "centerX", T_FLOAT, offsetof(wx_emitter, center[0]), .range = R_FINITE },              \
     { "centerY", T_FLOAT, offsetof(wx_emitter, center[1]), .range = R_FINITE },              \
     { "centerZ", T_FLOAT, offsetof(wx_emitter, center[2]), .range = R_FINITE },              \
+    EMITTER_FLIGHT
+
+// What every emitter has besides its place: rate, times, speed, load.
+#define EMITTER_FLIGHT                                                                       \
     { "rate", T_DOUBLE, offsetof(wx_emitter, rate), .range = R_NONNEG },                     \
     { "start", T_DOUBLE, offsetof(wx_emitter, start), .range = R_NONNEG },                   \
     { "end", T_DOUBLE, offsetof(wx_emitter, end), .range = R_NONNEG },                       \
@@ -1039,6 +1046,51 @@ static const attr_spec hemisphere_emitter_attrs[] = {
     { "radius", T_FLOAT, offsetof(wx_emitter, radius), .range = R_POSITIVE },
 };
 
+// docs/design.md section 8: the box's corners are required (a box has no
+// natural default), the direction defaults to straight down.
+static const attr_spec box_emitter_attrs[] = {
+    EMITTER_NAME,
+    { "minX", T_FLOAT, offsetof(wx_emitter, box_min[0]), .range = R_FINITE, .required = true },
+    { "minY", T_FLOAT, offsetof(wx_emitter, box_min[1]), .range = R_FINITE, .required = true },
+    { "minZ", T_FLOAT, offsetof(wx_emitter, box_min[2]), .range = R_FINITE, .required = true },
+    { "maxX", T_FLOAT, offsetof(wx_emitter, box_max[0]), .range = R_FINITE, .required = true },
+    { "maxY", T_FLOAT, offsetof(wx_emitter, box_max[1]), .range = R_FINITE, .required = true },
+    { "maxZ", T_FLOAT, offsetof(wx_emitter, box_max[2]), .range = R_FINITE, .required = true },
+    { "dirX", T_FLOAT, offsetof(wx_emitter, dir[0]), .range = R_FINITE },
+    { "dirY", T_FLOAT, offsetof(wx_emitter, dir[1]), .range = R_FINITE },
+    { "dirZ", T_FLOAT, offsetof(wx_emitter, dir[2]), .range = R_FINITE },
+    { "spread", T_FLOAT, offsetof(wx_emitter, spread), .range = R_NONNEG },
+    EMITTER_FLIGHT,
+};
+
+// A box emitter's corners in order on every axis, its direction not zero (made
+// unit) and its spread below 90 degrees.
+static wx_result check_box_emitter(parser *p, const xmlNode *node, wx_emitter *e)
+{
+    static const char axes[] = "XYZ";
+    for (int k = 0; k < 3; ++k) {
+        if (!(e->box_min[k] <= e->box_max[k])) {
+            return fail(p, node, WX_CAUSE_BAD_VALUE,
+                        "<BoxEmitter> min%c=%g is above max%c=%g (min <= max on every axis)",
+                        axes[k], (double)e->box_min[k], axes[k], (double)e->box_max[k]);
+        }
+    }
+    double len = sqrt((double)e->dir[0] * e->dir[0] + (double)e->dir[1] * e->dir[1] +
+                      (double)e->dir[2] * e->dir[2]);
+    if (!(len > 0.0) || !isfinite(len)) {
+        return fail(p, node, WX_CAUSE_BAD_VALUE,
+                    "<BoxEmitter> direction (dirX, dirY, dirZ) must not be zero");
+    }
+    for (int k = 0; k < 3; ++k) {
+        e->dir[k] = (float)(e->dir[k] / len);
+    }
+    if (!(e->spread < 90.0f)) {
+        return fail(p, node, WX_CAUSE_BAD_VALUE,
+                    "<BoxEmitter> spread=\"%g\" must be in [0, 90) degrees", (double)e->spread);
+    }
+    return WX_OK;
+}
+
 static wx_result parse_emitter(parser *p, const xmlNode *node, wx_emitter_kind kind)
 {
     wx_scene *s = p->scene;
@@ -1050,10 +1102,23 @@ static wx_result parse_emitter(parser *p, const xmlNode *node, wx_emitter_kind k
     wx_emitter *e = &s->emitters[s->emitter_count++];
     // end = NAN until the simulation's duration is known (finish_emitters).
     *e = (wx_emitter){ .kind = kind, .radius = kind == WX_EMITTER_HEMISPHERE ? 1.0f : 0.0f,
-                       .rate = 1000.0, .start = 0.0, .end = NAN, .speed = 1.0f, .mass = 1.0f,
-                       .dirt = 1.0f, .max_collisions = 100, .line = line_of(node) };
-    r = kind == WX_EMITTER_POINT ? ATTRS(point_emitter_attrs, e, NULL)
-                                 : ATTRS(hemisphere_emitter_attrs, e, NULL);
+                       .dir = { 0.0f, -1.0f, 0.0f }, .rate = 1000.0, .start = 0.0, .end = NAN,
+                       .speed = 1.0f, .mass = 1.0f, .dirt = 1.0f, .max_collisions = 100,
+                       .line = line_of(node) };
+    switch (kind) {
+    case WX_EMITTER_POINT:
+        r = ATTRS(point_emitter_attrs, e, NULL);
+        break;
+    case WX_EMITTER_HEMISPHERE:
+        r = ATTRS(hemisphere_emitter_attrs, e, NULL);
+        break;
+    case WX_EMITTER_BOX:
+        r = ATTRS(box_emitter_attrs, e, NULL);
+        if (r == WX_OK) {
+            r = check_box_emitter(p, node, e);
+        }
+        break;
+    }
     if (r != WX_OK) {
         return r;
     }
@@ -1079,9 +1144,16 @@ static wx_result parse_hemisphere_emitter(parser *p, const xmlNode *node, void *
     return parse_emitter(p, node, WX_EMITTER_HEMISPHERE);
 }
 
+static wx_result parse_box_emitter(parser *p, const xmlNode *node, void *user)
+{
+    (void)user;
+    return parse_emitter(p, node, WX_EMITTER_BOX);
+}
+
 static const child_spec emitter_children[] = {
     { "PointEmitter", parse_point_emitter, true },
     { "HemisphereEmitter", parse_hemisphere_emitter, true },
+    { "BoxEmitter", parse_box_emitter, true },
 };
 
 static wx_result parse_emitters(parser *p, const xmlNode *node, void *user)

@@ -30,13 +30,18 @@ typedef struct wx_field {
 typedef enum wx_emitter_kind {
     WX_EMITTER_POINT,
     WX_EMITTER_HEMISPHERE,
+    WX_EMITTER_BOX, ///< docs/design.md section 8
 } wx_emitter_kind;
 
 typedef struct wx_emitter {
     wx_emitter_kind kind;
     char name[64];       ///< "" when not given
-    float center[3];
+    float center[3];     ///< point and hemisphere emitters
     float radius;        ///< hemisphere radius (default 1); 0 for a point emitter
+    float box_min[3];    ///< box emitter: start points uniform in [box_min, box_max]
+    float box_max[3];
+    float dir[3];        ///< box emitter: unit direction (default 0 -1 0)
+    float spread;        ///< box emitter: cone half-angle in degrees, [0, 90) (default 0)
     double rate;         ///< particles per simulated second (default 1000)
     double start;        ///< seconds (default 0)
     double end;          ///< seconds (default: end of the simulation, steps*timeStep)

@@ -1,4 +1,5 @@
-// emitter.c: point and hemisphere emitters (thesis 4.8.2, docs/design.md section 3).
+// emitter.c: point, hemisphere and box emitters (thesis 4.8.2, docs/design.md sections 3
+// and 8).
 #include "sim/emitter.h"
 
 #include <math.h>
@@ -38,9 +39,48 @@ void wx_uniform_hemisphere(float u1, float u2, float d[3])
     d[2] = r * sinf(phi);
 }
 
+void wx_uniform_cone(const float axis[3], float spread, float u1, float u2, float d[3])
+{
+    if (!(spread > 0.0f)) {
+        d[0] = axis[0];
+        d[1] = axis[1];
+        d[2] = axis[2];
+        return;
+    }
+    // Solid angle is uniform in cos(theta) (Archimedes again).
+    float cos_t = 1.0f - u1 * (1.0f - cosf(spread));
+    float sin_t = sqrtf(fmaxf(0.0f, 1.0f - cos_t * cos_t));
+    float phi = 6.2831853071795865f * u2;
+    // An orthonormal basis around the axis without a branch on its direction
+    // (Duff et al. 2017, "Building an orthonormal basis, revisited").
+    float sign = copysignf(1.0f, axis[2]);
+    float a = -1.0f / (sign + axis[2]);
+    float b = axis[0] * axis[1] * a;
+    float t[3] = { 1.0f + sign * axis[0] * axis[0] * a, sign * b, -sign * axis[0] };
+    float s[3] = { b, sign + axis[1] * axis[1] * a, -axis[1] };
+    float x = sin_t * cosf(phi), y = sin_t * sinf(phi);
+    for (int k = 0; k < 3; ++k) {
+        d[k] = x * t[k] + y * s[k] + cos_t * axis[k];
+    }
+}
+
 void wx_emitter_sample(const wx_emitter *e, uint64_t seed, uint64_t id, float pos[3],
                        float vel[3])
 {
+    if (e->kind == WX_EMITTER_BOX) {
+        float d[3];
+        for (int k = 0; k < 3; ++k) {
+            float u = wx_particle_random(seed, id, WX_RANDOM_EMIT_BOX + (uint64_t)k);
+            pos[k] = e->box_min[k] + u * (e->box_max[k] - e->box_min[k]);
+        }
+        float u1 = wx_particle_random(seed, id, WX_RANDOM_EMIT_BOX + 3);
+        float u2 = wx_particle_random(seed, id, WX_RANDOM_EMIT_BOX + 4);
+        wx_uniform_cone(e->dir, e->spread * 0.017453292519943295f, u1, u2, d);
+        for (int k = 0; k < 3; ++k) {
+            vel[k] = e->speed * d[k];
+        }
+        return;
+    }
     float u1 = wx_particle_random(seed, id, WX_RANDOM_EMIT_0);
     float u2 = wx_particle_random(seed, id, WX_RANDOM_EMIT_1);
     float d[3];

@@ -24,9 +24,17 @@ void wx_uniform_sphere(float u1, float u2, float d[3]);
 /// A unit direction uniform over the upper (+Y) hemisphere, from two uniforms.
 void wx_uniform_hemisphere(float u1, float u2, float d[3]);
 
+/// A unit direction uniform over the solid angle of the cone of half-angle
+/// `spread` radians around the unit vector `axis` (the axis itself for 0),
+/// from two uniforms: cos(theta) uniform in [cos(spread), 1], phi in [0, 2 pi).
+void wx_uniform_cone(const float axis[3], float spread, float u1, float u2, float d[3]);
+
 /// Start position and velocity of the particle with id `id` (see wx_particle_id):
 /// PointEmitter: the centre, speed times a uniform direction; HemisphereEmitter:
-/// c + radius*d with d uniform on the upper hemisphere, velocity -speed*d.
+/// c + radius*d with d uniform on the upper hemisphere, velocity -speed*d;
+/// BoxEmitter (docs/design.md section 8): a point uniform in [min, max],
+/// velocity speed times a direction uniform in the cone of `spread` degrees
+/// around `dir`.
 void wx_emitter_sample(const wx_emitter *e, uint64_t seed, uint64_t id, float pos[3],
                        float vel[3]);
 

@@ -104,4 +104,8 @@ enum {
     WX_RANDOM_COLLISION = 2, ///< + 2 * collision number (+ 0 absorption, + 1 bounce)
 };
 
+/// Counters of a box emitter's start (three for the position, two for the
+/// direction), far above every collision's.
+#define WX_RANDOM_EMIT_BOX (UINT64_C(1) << 40)
+
 #endif
