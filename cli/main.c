@@ -236,7 +236,14 @@ static void print_camera(const wx_scene_camera *sc)
            center[0], center[1], center[2], dir[0], dir[1], dir[2],
            cam->width > 0 ? w_ws / (float)cam->width : 0.0f,
            sc->has_view && !wx_has_path(sc->depth_path) ? ", maps baked from geometry" : "");
-    if (sc->is_output) {
+    if (sc->is_output && sc->adaptive) {
+        float texel = cam->width > 0 ? w_ws / (float)cam->width : 0.0f;
+        printf("  %-12s        mask '%s' %d x %d, adaptive smoothing: noise %g%%, radius up to "
+               "%g m (%.3g texels)%s\n",
+               "", sc->output_file, sc->output_width, sc->output_height, 100.0 * sc->noise,
+               sc->max_radius, texel > 0.0f ? sc->max_radius / texel : 0.0,
+               sc->normalize ? ", normalised to [0,1]" : "");
+    } else if (sc->is_output) {
         printf("  %-12s        mask '%s' %d x %d, radius %g m, %s%s\n", "", sc->output_file,
                sc->output_width, sc->output_height, sc->radius,
                sc->second_pass == WX_SECOND_PASS_SUM ? "thesis sum" : "weighted mean",

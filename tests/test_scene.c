@@ -180,8 +180,10 @@ TEST(element_defaults)
     ENSURE(out->camera.width == 8 && out->camera.height == 8);
     ENSURE(strcmp(out->output_file, "mask.exr") == 0);
     ENSURE(out->output_width == 8 && out->output_height == 8);
-    // 2 output texels: the frame is 4 m wide over 8 texels.
-    ENSURE_NEAR(out->radius, 1.0, 1e-6);
+    // No radius: the adaptive smoothing, noise 4%, radii up to 24 output texels
+    // (the frame is 4 m wide over 8 texels: 12 m).
+    ENSURE(out->adaptive && out->noise == WX_DEFAULT_NOISE && WX_DEFAULT_NOISE == 0.04f);
+    ENSURE_NEAR(out->max_radius, 12.0, 1e-5);
     ENSURE(out->second_pass == WX_SECOND_PASS_MEAN && !out->normalize);
     ENSURE(!wx_has_path(out->impact_path) && !wx_has_path(out->dirt_path));
 
@@ -271,7 +273,7 @@ TEST(full_scene)
     const wx_scene_camera *out = &s.cameras[3];
     ENSURE(out->is_output && strcmp(out->output_file, "dirt_mask.exr") == 0);
     ENSURE(out->output_width == 8 && out->output_height == 8);
-    ENSURE(out->radius == 0.25f && out->second_pass == WX_SECOND_PASS_SUM && out->normalize);
+    ENSURE(!out->adaptive && out->radius == 0.25f && out->second_pass == WX_SECOND_PASS_SUM && out->normalize);
     ENSURE(out->camera.width == 8 && out->camera.height == 8);
 
     ENSURE(s.mesh_count == 2);
@@ -332,10 +334,12 @@ TEST(view_camera_matrices)
     ENSURE_NEAR(uvd[0], 0.75, 1e-6);
     ENSURE_NEAR(uvd[1], 0.75, 1e-6);
     ENSURE_NEAR(uvd[2], 7.0, 1e-5);
-    // No <OutputMap>: mask.exr at the View's resolution, radius 2 texels = 2 * 4/8 m.
+    // No <OutputMap>: mask.exr at the View's resolution, adaptive smoothing with
+    // radii up to 24 texels = 24 * 4/8 m.
     ENSURE(out->is_output && strcmp(out->output_file, "mask.exr") == 0);
     ENSURE(out->output_width == 8 && out->output_height == 4);
-    ENSURE_NEAR(out->radius, 1.0, 1e-6);
+    ENSURE(out->adaptive && out->noise == 0.04f);
+    ENSURE_NEAR(out->max_radius, 12.0, 1e-5);
     ENSURE(!wx_has_path(out->depth_path));
     wx_scene_free(&s);
 }

@@ -8,7 +8,6 @@
 // precomputed list of neighbour offsets, x innermost over chunks of 64 texels of
 // padded planes, in a loop the compiler vectorises. docs/mask.md has the details.
 #include "gather/gather.h"
-
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -16,6 +15,7 @@
 #include <string.h>
 
 #include "core/limits.h"
+#include "gather/adaptive.h"
 #include "core/matrix.h"
 #include "core/parallel.h"
 #include "core/progress.h"
@@ -91,6 +91,10 @@ typedef struct input_cam {
     const float *depth;
     const float *normal;
     const float *dirt;
+    // The adaptive pass also gathers the initial dirt (the dirt itself for a map
+    // no simulation wrote) and the impacts (NULL: none).
+    const float *initial;
+    const float *hits;
     float ray[3];        // unit projection direction (ctw row 2)
     float tol_world;     // WX_GATHER_DEPTH_TOL_TEXELS * the texel's larger side
     float inv_head_area; // 1 / area of a texel seen head-on
@@ -111,6 +115,10 @@ typedef struct gather_job {
     int cam_count;
     bool bilinear;
     float *mask; // final values, width*height
+    // Adaptive: the first pass also writes the initial dirt and the impacts per
+    // unit area (unpadded, width*height).
+    bool adaptive;
+    float *first_initial, *first_hits;
 
     // First-pass values go to first[first_base + j*first_stride + i]: the mask
     // itself without a second pass, else the padded plane below.
@@ -155,11 +163,17 @@ static float clean_dirt(float dirt)
     return dirt > 0.0f && dirt < INFINITY ? dirt : 0.0f; // negative or NaN counts as 0
 }
 
+// The sums of one camera's taps: the weights, and the weighted dirt, initial
+// dirt and impacts per unit area (the last two for the adaptive pass only).
+typedef struct tap_sums {
+    float den, dirt, initial, hits;
+} tap_sums;
+
 // One texel of an input camera: when it sees the surface point (at depth dp in
-// this camera, unit normal n), adds weight * agreement to *den and that times
-// the texel's dirt per unit area to *num.
+// this camera, unit normal n), adds weight * agreement to den and that times
+// the texel's values per unit area to the sums.
 static inline void add_tap(const input_cam *c, size_t t, float weight, float dp, const float n[3],
-                           float *num, float *den)
+                           bool adaptive, tap_sums *s)
 {
     float depth = c->depth[t];
     if (wx_depth_is_empty(depth)) {
@@ -183,63 +197,87 @@ static inline void add_tap(const input_cam *c, size_t t, float weight, float dp,
     float w = weight * agree;
     // Dirt per unit area: the texel covers head_area / |N.view| of surface.
     float cos_area = cos_view > WX_GATHER_AREA_MIN_COS ? cos_view : WX_GATHER_AREA_MIN_COS;
-    *num += w * clean_dirt(c->dirt[t]) * cos_area * c->inv_head_area;
-    *den += w;
+    float per_area = w * cos_area * c->inv_head_area;
+    s->dirt += per_area * clean_dirt(c->dirt[t]);
+    if (adaptive) {
+        s->initial += per_area * clean_dirt(c->initial[t]);
+        s->hits += c->hits != NULL ? per_area * clean_dirt(c->hits[t]) : 0.0f;
+    }
+    s->den += w;
 }
 
-// Dirt per unit area that camera `c` holds for the surface point seen by output
-// texel (i, j) at depth d with unit normal n; 0 when the camera does not see it.
-static float sample_camera(const input_cam *c, double i, double j, double d, const float n[3],
-                           bool bilinear)
+// Whether texel t of camera c holds anything to gather.
+static inline bool holds_something(const input_cam *c, size_t t, bool adaptive)
 {
-    double x = c->cx[0] * i + c->cx[1] * j + c->cx[2] * d + c->cx[3];
-    double y = c->cy[0] * i + c->cy[1] * j + c->cy[2] * d + c->cy[3];
-    // In frame (0 <= u < 1, 0 < v <= 1) in texel coordinates.
-    if (!(x >= -0.5 && x < (double)c->width - 0.5 && y >= -0.5 && y < (double)c->height - 0.5)) {
-        return 0.0f;
-    }
-    const float dp = (float)(c->cd[0] * i + c->cd[1] * j + c->cd[2] * d + c->cd[3]);
+    return c->dirt[t] > 0.0f || (adaptive && c->hits != NULL && c->hits[t] > 0.0f);
+}
+
+// The four texels around continuous texel coordinates (x, y), each tested.
+static void sample_bilinear(const input_cam *c, double x, double y, float dp, const float n[3],
+                            bool adaptive, tap_sums *s)
+{
     const int width = c->width, height = c->height;
-    float num = 0.0f, den = 0.0f;
-    if (!bilinear) {
-        // x + 0.5 >= 0: truncation is floor.
-        size_t t = (size_t)(int)(y + 0.5) * (size_t)width + (size_t)(int)(x + 0.5);
-        if (!(c->dirt[t] > 0.0f)) {
-            return 0.0f;
-        }
-        add_tap(c, t, 1.0f, dp, n, &num, &den);
-        return den > 0.0f ? num / den : 0.0f;
-    }
-    // The four texels around (x, y); x + 1 > 0, so truncation is floor.
+    // x + 1 > 0, so truncation is floor.
     const int i0 = (int)(x + 1.0) - 1, j0 = (int)(y + 1.0) - 1;
     const float fx = (float)(x - i0), fy = (float)(y - j0);
     const float w00 = (1.0f - fx) * (1.0f - fy), w10 = fx * (1.0f - fy);
     const float w01 = (1.0f - fx) * fy, w11 = fx * fy;
     if (i0 >= 0 && j0 >= 0 && i0 + 1 < width && j0 + 1 < height) {
         const size_t t = (size_t)j0 * (size_t)width + (size_t)i0;
-        const float *dirt = c->dirt + t;
-        // No dirt in any of them: 0 whatever the visibility.
-        if (!((dirt[0] > 0.0f) | (dirt[1] > 0.0f) | (dirt[width] > 0.0f) |
-              (dirt[width + 1] > 0.0f))) {
-            return 0.0f;
+        // Nothing in any of them: nothing whatever the visibility.
+        if (!(holds_something(c, t, adaptive) | holds_something(c, t + 1, adaptive) |
+              holds_something(c, t + (size_t)width, adaptive) |
+              holds_something(c, t + (size_t)width + 1, adaptive))) {
+            return;
         }
-        add_tap(c, t, w00, dp, n, &num, &den);
-        add_tap(c, t + 1, w10, dp, n, &num, &den);
-        add_tap(c, t + (size_t)width, w01, dp, n, &num, &den);
-        add_tap(c, t + (size_t)width + 1, w11, dp, n, &num, &den);
+        add_tap(c, t, w00, dp, n, adaptive, s);
+        add_tap(c, t + 1, w10, dp, n, adaptive, s);
+        add_tap(c, t + (size_t)width, w01, dp, n, adaptive, s);
+        add_tap(c, t + (size_t)width + 1, w11, dp, n, adaptive, s);
     } else {
         // At the border of the map: only the taps inside it.
         const float weights[4] = { w00, w10, w01, w11 };
         for (int k = 0; k < 4; ++k) {
             int ti = i0 + (k & 1), tj = j0 + (k >> 1);
             if (ti >= 0 && ti < width && tj >= 0 && tj < height) {
-                add_tap(c, (size_t)tj * (size_t)width + (size_t)ti, weights[k], dp, n, &num, &den);
+                add_tap(c, (size_t)tj * (size_t)width + (size_t)ti, weights[k], dp, n, adaptive,
+                        s);
             }
         }
     }
-    return den > 0.0f ? num / den : 0.0f;
 }
 
+// What camera `c` holds per unit area (dirt, and for the adaptive pass the
+// initial dirt and the impacts) for the surface point seen by output texel
+// (i, j) at depth d with unit normal n, added to *out; nothing when the camera
+// does not see it.
+static void sample_camera(const input_cam *c, double i, double j, double d, const float n[3],
+                          bool bilinear, bool adaptive, tap_sums *out)
+{
+    double x = c->cx[0] * i + c->cx[1] * j + c->cx[2] * d + c->cx[3];
+    double y = c->cy[0] * i + c->cy[1] * j + c->cy[2] * d + c->cy[3];
+    // In frame (0 <= u < 1, 0 < v <= 1) in texel coordinates.
+    if (!(x >= -0.5 && x < (double)c->width - 0.5 && y >= -0.5 && y < (double)c->height - 0.5)) {
+        return;
+    }
+    const float dp = (float)(c->cd[0] * i + c->cd[1] * j + c->cd[2] * d + c->cd[3]);
+    tap_sums s = { 0.0f, 0.0f, 0.0f, 0.0f };
+    if (!bilinear) {
+        // x + 0.5 >= 0: truncation is floor.
+        size_t t = (size_t)(int)(y + 0.5) * (size_t)c->width + (size_t)(int)(x + 0.5);
+        if (!holds_something(c, t, adaptive)) {
+            return;
+        }
+        add_tap(c, t, 1.0f, dp, n, adaptive, &s);
+    } else {
+        sample_bilinear(c, x, y, dp, n, adaptive, &s);
+    }
+    if (s.den > 0.0f) {
+        out->dirt += s.dirt / s.den;
+        out->initial += s.initial / s.den;
+        out->hits += s.hits / s.den;
+    }
+}
 // First pass over one TILE x TILE block of output texels (tiles keep the input
 // maps' footprint in cache when the cameras look from different directions).
 static void first_pass_tile(const gather_job *job, int tile)
@@ -252,17 +290,21 @@ static void first_pass_tile(const gather_job *job, int tile)
             size_t q = (size_t)j * (size_t)job->width + (size_t)i;
             float d = job->depth[q];
             float n[3] = { 0.0f, 0.0f, 0.0f };
-            float sum = 0.0f;
+            tap_sums sum = { 0.0f, 0.0f, 0.0f, 0.0f };
             if (!wx_depth_is_empty(d) && unit_normal(&job->normal[3 * q], n)) {
                 for (int k = 0; k < job->cam_count; ++k) {
                     // Every deposit is in exactly one camera's map: add them up.
-                    sum += sample_camera(&job->cams[k], i, j, d, n, job->bilinear);
+                    sample_camera(&job->cams[k], i, j, d, n, job->bilinear, job->adaptive, &sum);
                 }
             } else {
                 d = 0.0f; // no surface: normal 0 (weight 0), depth finite
                 n[0] = n[1] = n[2] = 0.0f;
             }
-            job->first[job->first_base + (size_t)j * job->first_stride + (size_t)i] = sum;
+            job->first[job->first_base + (size_t)j * job->first_stride + (size_t)i] = sum.dirt;
+            if (job->adaptive) {
+                job->first_initial[q] = sum.initial;
+                job->first_hits[q] = sum.hits;
+            }
             if (job->second) {
                 size_t p = job->base + (size_t)j * job->stride + (size_t)i;
                 job->pd[p] = d;
@@ -398,7 +440,8 @@ wx_gather_def wx_default_gather_def(void)
 wx_gather_view wx_gather_view_from_maps(const wx_camera *camera, const wx_maps *maps)
 {
     wx_gather_view view = { .camera = camera, .width = maps->width, .height = maps->height,
-                            .depth = maps->depth, .normal = maps->normal, .dirt = maps->dirt };
+                            .depth = maps->depth, .normal = maps->normal, .dirt = maps->dirt,
+                            .initial = maps->initial_dirt, .hits = maps->hits };
     return view;
 }
 
@@ -475,6 +518,10 @@ static wx_result prepare_input(const wx_target *out, const double out_ctw[16],
     cam->depth = in->depth;
     cam->normal = in->normal;
     cam->dirt = in->dirt;
+    // A map no simulation wrote is exact: its dirt counts as initial, unsmoothed.
+    bool simulated = in->initial != NULL && in->hits != NULL;
+    cam->initial = simulated ? in->initial : in->dirt;
+    cam->hits = simulated ? in->hits : NULL;
 
     double ex[3], ey[3], ray[3], cross[3];
     wx_matrix_row3(ctw, 0, ex);
@@ -627,7 +674,20 @@ wx_result wx_gather_compute(const wx_gather_def *def, float *mask_out, wx_gather
     }
 
     const size_t texels = (size_t)out->width * (size_t)out->height;
-    const bool second = def->radius > 0.0f;
+    const bool adaptive = def->adaptive;
+    const bool second = !adaptive && def->radius > 0.0f;
+    if (adaptive && (!(def->noise > 0.0f) || !(def->max_radius >= 0.0f))) {
+        return wx_fail(err, WX_CAUSE_BAD_VALUE,
+                       "gather: adaptive smoothing needs noise > 0 and max_radius >= 0");
+    }
+    float *adaptive_planes = NULL;
+    if (adaptive) {
+        adaptive_planes = malloc(3 * texels * sizeof *adaptive_planes);
+        if (adaptive_planes == NULL) {
+            return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "gather: out of memory (%zu texels)",
+                           texels);
+        }
+    }
     input_cam *cams = NULL;
     offset *offsets = NULL;
     float *scratch = NULL;
@@ -665,6 +725,7 @@ wx_result wx_gather_compute(const wx_gather_def *def, float *mask_out, wx_gather
     if (result != WX_OK) {
         free(cams);
         free(offsets);
+        free(adaptive_planes);
         return result;
     }
 
@@ -682,6 +743,12 @@ wx_result wx_gather_compute(const wx_gather_def *def, float *mask_out, wx_gather
     job.first_stride = (size_t)out->width;
     job.tiles_x = (out->width + TILE - 1) / TILE;
     job.tiles_y = (out->height + TILE - 1) / TILE;
+    if (adaptive) {
+        job.adaptive = true;
+        job.first = adaptive_planes;
+        job.first_initial = adaptive_planes + texels;
+        job.first_hits = adaptive_planes + 2 * texels;
+    }
     if (second) {
         job.second = true;
         job.stride = stride;
@@ -717,6 +784,37 @@ wx_result wx_gather_compute(const wx_gather_def *def, float *mask_out, wx_gather
         job.progress_base = tiles;
         run_pass(&job, 2, bands, pool);
     }
+    wx_adaptive_stats smoothing;
+    memset(&smoothing, 0, sizeof smoothing);
+    if (adaptive) {
+        wx_adaptive_def ad;
+        memset(&ad, 0, sizeof ad);
+        ad.width = out->width;
+        ad.height = out->height;
+        ad.depth = out->depth;
+        ad.normal = out->normal;
+        ad.total = job.first;
+        ad.initial = job.first_initial;
+        ad.hits = job.first_hits;
+        wx_matrix_row3(out_ctw, 0, ad.step_i);
+        wx_matrix_row3(out_ctw, 1, ad.step_j);
+        wx_matrix_row3(out_ctw, 2, ad.step_d);
+        for (int k = 0; k < 3; ++k) {
+            ad.step_i[k] /= out->width;
+            ad.step_j[k] /= -out->height; // j grows downwards, v upwards
+        }
+        ad.noise = def->noise;
+        ad.max_radius = def->max_radius;
+        ad.pool = pool;
+        result = wx_adaptive_smooth(&ad, mask_out, &smoothing, err);
+        free(adaptive_planes);
+        if (result != WX_OK) {
+            wx_progress_end(&progress);
+            wx_pool_destroy(pool);
+            free(cams);
+            return result;
+        }
+    }
     double t2 = wx_now_s();
     wx_progress_end(&progress);
 
@@ -739,6 +837,10 @@ wx_result wx_gather_compute(const wx_gather_def *def, float *mask_out, wx_gather
         stats->max_value = max_value;
         stats->first_pass_s = t1 - t0;
         stats->second_pass_s = t2 - t1;
+        stats->target_hits = smoothing.target_hits;
+        stats->median_radius = smoothing.median_radius;
+        stats->largest_radius = smoothing.max_radius_used;
+        stats->capped_texels = smoothing.capped;
     }
     wx_pool_destroy(pool);
     free(scratch);

@@ -45,6 +45,11 @@ typedef struct wx_gather_view {
     const float *depth;  ///< width*height; +inf, NaN, <= 0 or >= 1e30: no surface
     const float *normal; ///< 3*width*height, interleaved, world-space unit normals
     const float *dirt;   ///< width*height dirt amounts (input cameras; unused for the output)
+    /// What a simulation adds (both NULL for a dirt map no simulation wrote: its
+    /// dirt is then exact, never smoothed by the adaptive pass): the dirt it
+    /// started from and the impacts at each texel (maps.h).
+    const float *initial;
+    const float *hits;
 } wx_gather_view;
 
 /// Everything the gather needs, in memory. Zero-initialise or start from
@@ -54,6 +59,11 @@ typedef struct wx_gather_def {
     const wx_gather_view *inputs; ///< input cameras with their dirt
     int input_count;
     float radius;                 ///< second-pass radius in world units; 0 = no second pass
+    /// Instead of the radius: smoothing that follows the density of impacts
+    /// (gather/adaptive.h), aiming at relative noise `noise` within max_radius.
+    bool adaptive;
+    float noise;
+    float max_radius;
     wx_second_pass second_pass;   ///< weighted mean (default) or the thesis' weighted sum
     bool normalize;               ///< divide the final mask by its maximum (when > 0)
     wx_gather_sampling sampling;
@@ -68,6 +78,13 @@ typedef struct wx_gather_stats {
     double max_value;       ///< largest mask value before normalisation
     double first_pass_s;    ///< wall-clock seconds of the first pass
     double second_pass_s;   ///< wall-clock seconds of the second pass
+    /// Adaptive smoothing only: the impacts aimed at, the median and the largest
+    /// radius given (world units), and the texels whose impacts lay beyond
+    /// max_radius (their noise stays above the aim).
+    double target_hits;
+    double median_radius;
+    double largest_radius;
+    int64_t capped_texels;
 } wx_gather_stats;
 
 /// Defaults: no cameras, radius 0, weighted mean, bilinear, 1 thread, quiet.

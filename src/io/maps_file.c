@@ -130,8 +130,10 @@ wx_result wx_maps_load(wx_maps *maps, unsigned which, const char *depth_path,
         // A dirt map that `simulate` wrote keeps the dirt it started from in
         // "initialDirt": a new simulation starts from that, not from its result.
         const char *const channels[] = {
-            wanted(which, WX_MAPS_INITIAL_DIRT) ? "initialDirt|R" : "R", "G", "B"
+            wanted(which, WX_MAPS_INITIAL_DIRT) ? "initialDirt|R" : "R", "G", "B",
+            WX_INITIAL_DIRT_CHANNEL, WX_HITS_CHANNEL
         };
+        const int channel_count = wanted(which, WX_MAPS_SIMULATED) ? 5 : 3;
         result = need_path(dirt_path, "dirt", err);
         wx_image *image = NULL;
         if (result == WX_OK) {
@@ -141,13 +143,15 @@ wx_result wx_maps_load(wx_maps *maps, unsigned which, const char *depth_path,
             }
         }
         if (result == WX_OK) {
-            result = wx_exr_read(dirt_path, channels, 3, image, err);
+            result = wx_exr_read(dirt_path, channels, channel_count, image, err);
             if (result == WX_OK) {
                 // Take the planes over from the image.
-                maps->dirt = image->channels[0];
-                maps->deposit = image->channels[1];
-                maps->erosion = image->channels[2];
-                image->channels[0] = image->channels[1] = image->channels[2] = NULL;
+                float **planes[5] = { &maps->dirt, &maps->deposit, &maps->erosion,
+                                      &maps->initial_dirt, &maps->hits };
+                for (int c = 0; c < channel_count; ++c) {
+                    *planes[c] = image->channels[c];
+                    image->channels[c] = NULL;
+                }
                 result = check_size(&check, dirt_path, image->width, image->height, err);
             }
             if (result == WX_OK && image->attr_count > 0) {
@@ -160,10 +164,11 @@ wx_result wx_maps_load(wx_maps *maps, unsigned which, const char *depth_path,
                     maps->dirt_attr_count = image->attr_count;
                 }
             }
-            for (int c = 0; c < 3 && result == WX_OK; c++) {
+            const float *checked[5] = { maps->dirt, maps->deposit, maps->erosion,
+                                        maps->initial_dirt, maps->hits };
+            for (int c = 0; c < channel_count && result == WX_OK; c++) {
                 const char *name[1] = { image->channel_names[c] };
-                result = check_finite(dirt_path, "dirt",
-                                      c == 0 ? maps->dirt : c == 1 ? maps->deposit : maps->erosion,
+                result = check_finite(dirt_path, "dirt", checked[c],
                                       (size_t)check.width * (size_t)check.height, check.width, 1,
                                       name, err);
             }

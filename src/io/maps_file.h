@@ -17,10 +17,16 @@ enum {
     /// With WX_MAPS_DIRT: read the dirt plane from channel "initialDirt" when the
     /// file has it (a dirt map written by `simulate`), else from R.
     WX_MAPS_INITIAL_DIRT = 1 << 4,
+    /// With WX_MAPS_DIRT: also read the channels a simulated dirt map adds,
+    /// "initialDirt" and "hits", into initial_dirt and hits (for the gather).
+    WX_MAPS_SIMULATED = 1 << 5,
 };
 
 /// Name of the channel in which a simulated dirt map keeps its initial dirt.
 #define WX_INITIAL_DIRT_CHANNEL "initialDirt"
+
+/// Name of the channel in which a simulated dirt map counts each texel's hits.
+#define WX_HITS_CHANNEL "hits"
 
 /// Loads the maps selected by `which` from the given paths (NULL or "" for a map
 /// not wanted). Depth reads channel R or Z, normal R G B, impact R G, dirt R G B.

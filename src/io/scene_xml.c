@@ -1225,11 +1225,13 @@ typedef struct output_def {
     float radius;
     int second_pass;
     bool normalize;
+    float noise, max_radius;
 } output_def;
 
 static const char *const second_pass_names[] = { "mean", "sum", NULL };
 
-enum { OUT_FILE, OUT_WIDTH, OUT_HEIGHT, OUT_RADIUS }; // bits of `present`
+enum { OUT_FILE, OUT_WIDTH, OUT_HEIGHT, OUT_RADIUS, OUT_SECOND_PASS, OUT_NORMALIZE, OUT_NOISE,
+       OUT_MAX_RADIUS }; // bits of `present`
 
 static const attr_spec output_attrs[] = {
     [OUT_FILE] = { "file", T_NAME, offsetof(output_def, file),
@@ -1238,8 +1240,12 @@ static const attr_spec output_attrs[] = {
     [OUT_HEIGHT] = { "height", T_INT, offsetof(output_def, height), .lo = 1,
                      .hi = WX_MAP_MAX_SIDE },
     [OUT_RADIUS] = { "radius", T_FLOAT, offsetof(output_def, radius), .range = R_NONNEG },
-    { "secondPass", T_ENUM, offsetof(output_def, second_pass), .choices = second_pass_names },
-    { "normalize", T_BOOL, offsetof(output_def, normalize) },
+    [OUT_SECOND_PASS] = { "secondPass", T_ENUM, offsetof(output_def, second_pass),
+                          .choices = second_pass_names },
+    [OUT_NORMALIZE] = { "normalize", T_BOOL, offsetof(output_def, normalize) },
+    [OUT_NOISE] = { "noise", T_FLOAT, offsetof(output_def, noise), .range = R_POSITIVE },
+    [OUT_MAX_RADIUS] = { "maxRadius", T_FLOAT, offsetof(output_def, max_radius),
+                         .range = R_POSITIVE },
 };
 
 typedef struct view_def {
@@ -1305,7 +1311,7 @@ static wx_result parse_output_map(parser *p, const xmlNode *node, void *user)
 {
     ortho_def *o = user;
     wx_scene_camera *cam = o->cam;
-    output_def out = { .second_pass = WX_SECOND_PASS_MEAN };
+    output_def out = { .second_pass = WX_SECOND_PASS_MEAN, .noise = WX_DEFAULT_NOISE };
     snprintf(out.file, sizeof out.file, "mask.exr");
     wx_result r = ATTRS(output_attrs, &out, &o->output_present);
     if (r != WX_OK) {
@@ -1320,6 +1326,8 @@ static wx_result parse_output_map(parser *p, const xmlNode *node, void *user)
     cam->output_width = out.width;
     cam->output_height = out.height;
     cam->radius = out.radius;
+    cam->noise = out.noise;
+    cam->max_radius = out.max_radius;
     cam->second_pass = out.second_pass == 1 ? WX_SECOND_PASS_SUM : WX_SECOND_PASS_MEAN;
     cam->normalize = out.normalize;
     o->output_node = node;
@@ -1507,6 +1515,7 @@ static wx_result camera_output(parser *p, const xmlNode *node, ortho_def *o)
         }
         snprintf(cam->output_file, sizeof cam->output_file, "mask.exr");
         cam->second_pass = WX_SECOND_PASS_MEAN;
+        cam->noise = WX_DEFAULT_NOISE;
     }
     unsigned given = o->output_present;
     int w = cam->camera.width, h = cam->camera.height;
@@ -1521,10 +1530,24 @@ static wx_result camera_output(parser *p, const xmlNode *node, ortho_def *o)
                     "<OutputMap> size %dx%d differs from the %dx%d maps of output camera '%s'",
                     cam->output_width, cam->output_height, w, h, cam->name);
     }
-    if (!(given & (1u << OUT_RADIUS))) {
+    // No radius: the adaptive smoothing, which noise and maxRadius tune.
+    cam->adaptive = !(given & (1u << OUT_RADIUS));
+    if (!cam->adaptive && (given & ((1u << OUT_NOISE) | (1u << OUT_MAX_RADIUS)))) {
+        return fail(p, o->output_node, WX_CAUSE_BAD_SCENE,
+                    "<OutputMap> gives a radius and %s: %s tunes the adaptive smoothing, which a "
+                    "radius replaces; give one or the other",
+                    given & (1u << OUT_NOISE) ? "noise" : "maxRadius",
+                    given & (1u << OUT_NOISE) ? "noise" : "maxRadius");
+    }
+    if (cam->adaptive && cam->second_pass == WX_SECOND_PASS_SUM) {
+        return fail(p, o->output_node, WX_CAUSE_BAD_SCENE,
+                    "<OutputMap> secondPass=\"sum\" needs a radius (the thesis' unnormalised "
+                    "sum is defined over a fixed radius)");
+    }
+    if (cam->adaptive && !(given & (1u << OUT_MAX_RADIUS))) {
         float frame_w, frame_h;
         wx_camera_frame_size(&cam->camera, &frame_w, &frame_h);
-        cam->radius = 2.0f * frame_w / (float)cam->output_width; // 2 output texels
+        cam->max_radius = WX_DEFAULT_MAX_RADIUS_TEXELS * frame_w / (float)cam->output_width;
     }
     return WX_OK;
 }

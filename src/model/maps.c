@@ -12,6 +12,8 @@ void wx_maps_free(wx_maps *maps)
     free(maps->dirt);
     free(maps->deposit);
     free(maps->erosion);
+    free(maps->initial_dirt);
+    free(maps->hits);
     free(maps->dirt_attrs);
     memset(maps, 0, sizeof *maps);
 }

@@ -21,6 +21,11 @@ typedef struct wx_maps {
     float *dirt;    ///< width*height, dirt amount on the texel's surface patch
     float *deposit; ///< width*height, deposit fraction
     float *erosion; ///< width*height, erosion fraction
+    /// What a simulation adds, for the gather (NULL when the dirt map holds no
+    /// simulation: a baked or given map): the dirt it started from, and the
+    /// impacts that exchanged dirt at each texel.
+    float *initial_dirt; ///< width*height
+    float *hits;         ///< width*height
     /// The dirt map file's header attributes (camera matrices, name), kept so
     /// that the simulated dirt map is written with them without reading the
     /// file again.

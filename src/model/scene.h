@@ -65,6 +65,11 @@ typedef enum wx_second_pass {
     WX_SECOND_PASS_SUM,  ///< the thesis' unnormalised weighted sum
 } wx_second_pass;
 
+/// The adaptive smoothing's defaults: the relative noise aimed at, and the
+/// largest radius in output texels.
+#define WX_DEFAULT_NOISE 0.04f
+#define WX_DEFAULT_MAX_RADIUS_TEXELS 24.0f
+
 /// An <Ortho> camera with its maps.
 typedef struct wx_scene_camera {
     char name[64];     ///< cameraName: letters, digits, '_', '-', '.'
@@ -85,7 +90,13 @@ typedef struct wx_scene_camera {
     char output_file[256];   ///< base name in the output folder, default "mask.exr"
     int output_width;
     int output_height;
-    float radius;            ///< second-pass radius, world units; default 2 output texels
+    /// Smoothing: with a radius (world units, 0 = none) today's second pass;
+    /// without one (the default) the adaptive smoothing (docs/mask.md) aiming at
+    /// relative noise `noise` with radii up to max_radius (world units).
+    bool adaptive;
+    float radius;
+    float noise;             ///< default WX_DEFAULT_NOISE
+    float max_radius;        ///< default WX_DEFAULT_MAX_RADIUS_TEXELS output texels
     wx_second_pass second_pass;
     bool normalize;          ///< scale the final mask to [0,1]
     int line;

@@ -42,7 +42,9 @@ wx_result wx_gather_check(const wx_scene *scene, wx_error *err)
                          .width = out->output_width,
                          .height = out->output_height };
     int texels = 0;
-    wx_result r = wx_gather_check_radius(&target, out->radius, &texels, err);
+    // The adaptive smoothing's neighbourhood reaches max_radius.
+    wx_result r = wx_gather_check_radius(&target, out->adaptive ? out->max_radius : out->radius,
+                                         &texels, err);
     if (r != WX_OK) {
         wx_error_prefix(err, "%s:%d: <OutputMap> of camera '%s'", scene->path, out->line,
                         out->name);
@@ -109,6 +111,9 @@ wx_result wx_gather_maps(const wx_scene *scene, const wx_run_def *opts, const wx
         def.inputs = views;
         def.input_count = k;
         def.radius = out->radius;
+        def.adaptive = out->adaptive;
+        def.noise = out->noise;
+        def.max_radius = out->max_radius;
         def.second_pass = out->second_pass;
         def.normalize = out->normalize;
         def.threads = opts->threads;

@@ -71,6 +71,7 @@ wx_result wx_load_gather_maps(const wx_scene *scene, const wx_run_def *opts, wx_
             return wx_fail(err, WX_CAUSE_PATH_TOO_LONG, "%s: output path too long", opts->out_dir);
         }
         const char *dirt_path = simulated;
+        unsigned which = WX_MAPS_DEPTH | WX_MAPS_NORMAL | WX_MAPS_DIRT;
         if (access(simulated, R_OK) != 0) {
             if (!wx_has_path(cam->dirt_path)) {
                 return wx_fail(err, WX_CAUSE_MISSING_PHASE,
@@ -88,9 +89,17 @@ wx_result wx_load_gather_maps(const wx_scene *scene, const wx_run_def *opts, wx_
                     "gather: %s was never simulated (it holds the initial dirt bake wrote); run "
                     "`weathering simulate` first for the particles' dirt",
                     simulated);
+        } else if (!has_channel(simulated, WX_HITS_CHANNEL)) {
+            wx_note(opts->quiet,
+                    "gather: %s has no '%s' channel (a simulation by an earlier version): the "
+                    "mask is not smoothed unless <OutputMap> gives a radius; run `weathering "
+                    "simulate` again",
+                    simulated, WX_HITS_CHANNEL);
+        } else {
+            which |= WX_MAPS_SIMULATED;
         }
-        wx_result r = wx_maps_load(&maps[k], WX_MAPS_DEPTH | WX_MAPS_NORMAL | WX_MAPS_DIRT,
-                                   cam->depth_path, cam->normal_path, NULL, dirt_path, err);
+        wx_result r = wx_maps_load(&maps[k], which, cam->depth_path, cam->normal_path, NULL,
+                                   dirt_path, err);
         if (r != WX_OK) {
             wx_error_prefix(err, "camera '%s'", cam->name);
             return r;

@@ -42,10 +42,11 @@ typedef struct wx_memory_need {
 #define WX_BAKE_INPUT_IMAGE_BYTES_PER_TEXEL 40.0
 #define WX_BAKE_OUTPUT_IMAGE_BYTES_PER_TEXEL 16.0
 /// Bytes per input texel in the simulation: the maps (depth, normal, impact,
-/// dirt: 9 floats), the collider's depth and pyramid (5), the dirt in double (16).
-#define WX_SIM_BYTES_PER_INPUT_TEXEL 57.0
-/// Bytes per texel of the dirt map being written (4 floats).
-#define WX_SIM_WRITE_BYTES_PER_TEXEL 16.0
+/// dirt: 9 floats), the collider's depth and pyramid (5), the dirt texel (dirt
+/// in double, its rates and its hits: 24).
+#define WX_SIM_BYTES_PER_INPUT_TEXEL 65.0
+/// Bytes per texel of the dirt map being written (5 floats).
+#define WX_SIM_WRITE_BYTES_PER_TEXEL 20.0
 /// Bytes per particle: WX_PARTICLE_BYTES with room for the arrays to double as
 /// they grow, plus the per-step events and candidates of the workers.
 #define WX_BYTES_PER_PARTICLE 192.0

@@ -26,9 +26,11 @@ static wx_result write_one(const wx_scene *scene, const wx_run_def *opts, const 
         return r;
     }
     // R G B keep the dirt map layout (R now the simulated dirt); initialDirt is
-    // the dirt the simulation started from, which a later `simulate` reads.
-    static const char *const channels[4] = { "R", "G", "B", WX_INITIAL_DIRT_CHANNEL };
-    r = wx_image_alloc(image, map->width, map->height, 4, channels, err);
+    // the dirt the simulation started from, which a later `simulate` reads;
+    // hits counts the impacts at each texel, which the gather's smoothing reads.
+    static const char *const channels[5] = { "R", "G", "B", WX_INITIAL_DIRT_CHANNEL,
+                                             WX_HITS_CHANNEL };
+    r = wx_image_alloc(image, map->width, map->height, 5, channels, err);
     if (r != WX_OK) {
         return r;
     }
@@ -38,6 +40,7 @@ static wx_result write_one(const wx_scene *scene, const wx_run_def *opts, const 
         image->channels[1][t] = maps->deposit != NULL ? maps->deposit[t] : 0.0f;
         image->channels[2][t] = maps->erosion != NULL ? maps->erosion[t] : 0.0f;
         image->channels[3][t] = maps->dirt != NULL ? maps->dirt[t] : 0.0f;
+        image->channels[4][t] = map->texels[t].hits;
     }
     // The input dirt map's header travels with it (kept when the map was read).
     for (int a = 0; a < maps->dirt_attr_count && image->attr_count < WX_IMAGE_MAX_ATTRS; ++a) {
@@ -103,21 +106,28 @@ wx_result wx_simulate_maps(const wx_scene *scene, const wx_run_def *opts, wx_map
     if (stats != NULL) {
         wx_sim_get_stats(sim, stats);
     }
-    // What the gather reads: the dirt as the written maps hold it (float), the
-    // planes only the simulation needed released.
+    // What the gather reads, as the written maps hold it (float): the dirt, the
+    // dirt the simulation started from and the hits; the planes only the
+    // simulation needed released.
     for (int c = 0; c < wx_sim_input_count(sim) && r == WX_OK; ++c) {
         wx_maps *m = &maps[c];
         size_t texels = (size_t)m->width * (size_t)m->height;
-        if (m->dirt == NULL) {
-            m->dirt = malloc(texels * sizeof *m->dirt);
-            if (m->dirt == NULL) {
-                r = wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (dirt maps)");
-                break;
-            }
+        float *initial = m->dirt != NULL ? m->dirt : calloc(texels, sizeof *initial);
+        float *final = malloc(texels * sizeof *final);
+        float *hits = malloc(texels * sizeof *hits);
+        free(m->initial_dirt);
+        free(m->hits);
+        m->initial_dirt = initial;
+        m->dirt = final;
+        m->hits = hits;
+        if (initial == NULL || final == NULL || hits == NULL) {
+            r = wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (dirt maps)");
+            break;
         }
         const wx_dirt_map *dirt = wx_sim_dirt_map(sim, c);
         for (size_t t = 0; t < texels; ++t) {
-            m->dirt[t] = (float)dirt->texels[t].dirt;
+            final[t] = (float)dirt->texels[t].dirt;
+            hits[t] = dirt->texels[t].hits;
         }
         free(m->impact);
         free(m->deposit);

@@ -34,6 +34,7 @@ wx_result wx_dirt_map_init(wx_dirt_map *map, int width, int height, const float 
         map->texels[t].dirt = isfinite(s) ? s : 0.0;
         map->texels[t].deposit = unit_clamp(D * (deposit != NULL ? deposit[t] : 0.0f));
         map->texels[t].erosion = unit_clamp(E * (erosion != NULL ? erosion[t] : 0.0f));
+        map->texels[t].hits = 0.0f;
     }
     return WX_OK;
 }
@@ -61,6 +62,7 @@ void wx_dirt_map_exchange(wx_dirt_map *map, uint32_t texel, double *load)
     double ero = t->erosion * t->dirt;
     *load += ero - dep;
     t->dirt += dep - ero;
+    t->hits += 1.0f;
 }
 
 void wx_dirt_map_deposit_all(wx_dirt_map *map, uint32_t texel, double *load)
@@ -144,6 +146,7 @@ void wx_dirt_map_exchange_line(wx_dirt_map *map, uint32_t from, uint32_t to, dou
         return;
     }
     double p = *load, share = 1.0 / n, change = 0.0;
+    float hit_share = 1.0f / (float)n;
     line_begin(&w, x0, y0, x1, y1);
     for (line_next(&w); !w.done; line_next(&w)) {
         size_t texel = (size_t)w.y * (size_t)W + (size_t)w.x;
@@ -154,6 +157,7 @@ void wx_dirt_map_exchange_line(wx_dirt_map *map, uint32_t from, uint32_t to, dou
         double dep = t->deposit * p * share;
         double ero = t->erosion * t->dirt * share;
         t->dirt += dep - ero;
+        t->hits += hit_share;
         change += ero - dep;
     }
     *load = p + change;

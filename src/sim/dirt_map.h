@@ -20,6 +20,9 @@ typedef struct wx_dirt_texel {
     double dirt;
     float deposit; ///< clamp(D * kd, 0, 1)
     float erosion; ///< clamp(E * ke, 0, 1)
+    /// Impacts that exchanged dirt here (a streak's share 1/n on each of its n
+    /// texels): what the gather's adaptive smoothing counts (docs/mask.md).
+    float hits;
 } wx_dirt_texel;
 
 typedef struct wx_dirt_map {
@@ -43,14 +46,16 @@ void wx_dirt_map_free(wx_dirt_map *map);
 double wx_dirt_map_total(const wx_dirt_map *map);
 
 /// One impact at `texel`: dep = deposit*p, ero = erosion*s, then p += ero - dep,
-/// s += dep - ero (thesis 4.8.4.3, as pinned in docs/design.md section 4).
+/// s += dep - ero (thesis 4.8.4.3, as pinned in docs/design.md section 4); the
+/// texel counts one hit.
 void wx_dirt_map_exchange(wx_dirt_map *map, uint32_t texel, double *load);
 
 /// A slide that follows a slide: the same exchange spread evenly over the
 /// surface texels of the Bresenham line from `from` to `to`, without `from` (it
 /// took its share at the previous hit): each of the n texels exchanges with
 /// dep_k = deposit_k*p/n and ero_k = erosion_k*s_k/n, p being the load on
-/// arrival. With no surface texel on the line, a plain exchange at `to`.
+/// arrival; each counts 1/n of a hit. With no surface texel on the line, a
+/// plain exchange at `to`.
 void wx_dirt_map_exchange_line(wx_dirt_map *map, uint32_t from, uint32_t to, double *load);
 
 /// Deposits all of *load at `texel` (absorbed and settled particles).

@@ -1,0 +1,540 @@
+// adaptive.c: the gather's adaptive smoothing (adaptive.h, docs/mask.md).
+//
+// Four steps over the target's texels:
+//   1. per texel: the impacts its surface patch holds (hits per unit area times
+//      the area the texel covers) and the change delta = total - initial; two
+//      summed-area tables, of the impacts and of the texels with a surface;
+//   2. per texel (rows on the pool): its radius h by bisection on the impacts
+//      within h (the rectangle around the texel scaled to the disc), and
+//      whether it lies in a clean region (no impact of its own, and an empty
+//      half-rectangle beside it where its density would put CLEAN_EXPECTED);
+//   3. the samples' weights 1 / h^2 and the bounds of the radii per tile;
+//   4. per texel q (rows on the pool): the weighted mean of delta over the
+//      samples p that reach it, added to the initial dirt.
+// Step 4 runs over padded planes in chunks of CHUNK texels of a row, one
+// neighbour offset at a time (offsets sorted by distance across the view,
+// stopping at the largest radius that can reach the chunk), in a loop the
+// compiler vectorises.
+#include "gather/adaptive.h"
+
+#include <math.h>
+#include <stdbool.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "model/maps.h"
+
+enum {
+    CHUNK = 64, // texels of a row processed together
+    TILE = 16,  // texels a side of the tiles that bound the radii
+    BISECTIONS = 24,
+};
+
+// Normals at right angles weigh 0 even a few ulps off (as in gather.c).
+#define NORMAL_EPSILON 1e-6f
+// |N.view| is clamped to this when the area a texel covers is computed (the
+// gather's WX_GATHER_AREA_MIN_COS).
+#define AREA_MIN_COS 1e-3f
+// The tangent-plane test: q lies on p's plane within PLANE_TOL_TEXELS texels
+// plus PLANE_TOL_SLOPE times their distance (a curved surface leaves its
+// tangent plane by r^2 / 2R, well inside this for R above a few radii).
+#define PLANE_TOL_TEXELS 1.5f
+#define PLANE_TOL_SLOPE 0.25f
+// Slopes steeper than this (|N.view|) count as this one when a radius is chosen.
+#define MIN_SLOPE_COS 0.1f
+// A texel is clean (in a shadow, say) when it holds no impact and a
+// half-rectangle beside it holds none either although the texel's density
+// would put CLEAN_EXPECTED impacts there: the chance that this happens in a
+// uniformly hit region is e^-12 per direction, 6e-6.
+#define CLEAN_EXPECTED 12.0
+// Fewer impacts than this leave a texel or a rectangle empty (the first pass
+// spreads an impact bilinearly over up to four texels).
+#define EMPTY_IMPACTS 0.5
+
+// A neighbour (di, dj): its distance across the view, its world offset
+// a = di*step_i + dj*step_j (with a depth difference dd the points are
+// a + dd*step_d apart: r^2 = a2 + dd * (az2 + dd * z2)), and the plane
+// tolerance at that distance.
+typedef struct offset {
+    int di, dj;
+    float r;
+    float ax, ay, az;
+    float a2, az2;
+    float tol;
+} offset;
+
+typedef struct job {
+    const wx_adaptive_def *def;
+    int width, height;
+    size_t stride, base; // padded planes: texel (i, j) at base + j*stride + i
+    // Padded planes. Margins, texels without a surface and clean texels have
+    // normal 0: they neither give nor take.
+    float *pd, *pnx, *pny, *pnz, *pzn; // depth, unit normal, step_d . N
+    float *pinvh;                      // 1 / h of a sample, 0 elsewhere
+    float *pweight;                    // 1 / h^2 of a sample, 0 elsewhere
+    float *pcoef;                      // pweight * delta
+    // Unpadded.
+    float *delta;         // change per unit area
+    float *radius;        // h (world units) of a sample, 0 elsewhere
+    unsigned char *clean; // step 2's verdict
+    double *sat;          // (width + 1) * (height + 1) summed impacts
+    double *sat_surface;  // the same for the texels with a surface
+    float *tile_bound;
+    int tiles_x, tiles_y;
+    const offset *offsets;
+    int offset_count;
+    double target_hits;
+    float texel_i, texel_j; // |step_i|, |step_j| across the view
+    float z2;               // |step_d|^2
+    float inv_z;            // 1 / |step_d|
+    float min_radius, max_radius;
+    float *out;
+    int pass; // 2: radii, 4: gather
+} job;
+
+// v, or 0 when c is negative (sign bit set): a select without a comparison, so
+// that the loop vectorises under the default -ftrapping-math (as in gather.c).
+static inline float keep_if_positive(float v, float c)
+{
+    uint32_t vb, cb;
+    memcpy(&vb, &v, sizeof vb);
+    memcpy(&cb, &c, sizeof cb);
+    vb &= ~(uint32_t)((int32_t)cb >> 31);
+    memcpy(&v, &vb, sizeof v);
+    return v;
+}
+
+// Sum of table `s` over the inclusive texel rectangle, clipped to the map.
+static double rect_sum(const job *jb, const double *s, int i0, int j0, int i1, int j1)
+{
+    i0 = i0 < 0 ? 0 : i0;
+    j0 = j0 < 0 ? 0 : j0;
+    i1 = i1 >= jb->width ? jb->width - 1 : i1;
+    j1 = j1 >= jb->height ? jb->height - 1 : j1;
+    if (i0 > i1 || j0 > j1) {
+        return 0.0;
+    }
+    size_t w = (size_t)jb->width + 1;
+    return s[(size_t)(j1 + 1) * w + (size_t)(i1 + 1)] - s[(size_t)j0 * w + (size_t)(i1 + 1)] -
+           s[(size_t)(j1 + 1) * w + (size_t)i0] + s[(size_t)j0 * w + (size_t)i0];
+}
+
+// Impacts within h of texel (i, j): those of the rectangle of half-sides
+// floor(h / texel) around it, scaled by the disc's area over the rectangle's
+// (near the map's border both are clipped alike).
+static double impacts_within(const job *jb, int i, int j, double h)
+{
+    int kx = (int)(h / jb->texel_i), ky = (int)(h / jb->texel_j);
+    double disc = 3.14159265358979323846 * (h / jb->texel_i) * (h / jb->texel_j);
+    double full = (double)(2 * kx + 1) * (double)(2 * ky + 1);
+    return rect_sum(jb, jb->sat, i - kx, j - ky, i + kx, j + ky) * (disc / full);
+}
+
+// The half-rectangle of size k beside texel (i, j) on side `side` (0: right,
+// 1: left, 2: down, 3: up), the texel's own column or row included.
+static void half_rect(int i, int j, int k, int side, int r[4])
+{
+    r[0] = side == 1 ? i - k : i - (side >= 2 ? k : 0);
+    r[2] = side == 0 ? i + k : i + (side >= 2 ? k : 0);
+    r[1] = side == 3 ? j - k : j - (side < 2 ? k : 0);
+    r[3] = side == 2 ? j + k : j + (side < 2 ? k : 0);
+}
+
+// Whether texel (i, j), holding no impact of its own, lies in a clean region:
+// on some side the largest empty half-rectangle covers enough surface texels
+// that `density` (impacts per texel) would have put CLEAN_EXPECTED there.
+static bool is_clean(const job *jb, int i, int j, double density, int k_max)
+{
+    for (int side = 0; side < 4; ++side) {
+        int r[4];
+        int lo = 0, hi = k_max; // the largest empty k lies in [lo, hi]
+        half_rect(i, j, hi, side, r);
+        if (rect_sum(jb, jb->sat, r[0], r[1], r[2], r[3]) >= EMPTY_IMPACTS) {
+            while (hi - lo > 1) {
+                int mid = (lo + hi) / 2;
+                half_rect(i, j, mid, side, r);
+                if (rect_sum(jb, jb->sat, r[0], r[1], r[2], r[3]) >= EMPTY_IMPACTS) {
+                    hi = mid;
+                } else {
+                    lo = mid;
+                }
+            }
+        } else {
+            lo = hi;
+        }
+        half_rect(i, j, lo, side, r);
+        double surface = rect_sum(jb, jb->sat_surface, r[0], r[1], r[2], r[3]);
+        if (density * surface >= CLEAN_EXPECTED) {
+            return true;
+        }
+    }
+    return false;
+}
+
+// Step 2 for row j: the radius of every texel with a surface, and whether it
+// is clean. The kernel's disc of radius h on the surface covers |N.view| of
+// the image-plane disc's texels: the image-plane disc must hold K / |N.view|
+// impacts (|N.view| at least MIN_SLOPE_COS).
+static void radii_row(const job *jb, int j)
+{
+    const int k_max = (int)ceil(jb->max_radius / fminf(jb->texel_i, jb->texel_j));
+    for (int i = 0; i < jb->width; ++i) {
+        size_t t = (size_t)j * (size_t)jb->width + (size_t)i;
+        size_t p = jb->base + (size_t)j * jb->stride + (size_t)i;
+        jb->radius[t] = 0.0f;
+        jb->clean[t] = 0;
+        if (wx_depth_is_empty(jb->def->depth[t])) {
+            continue;
+        }
+        float cos_view = fabsf(jb->pzn[p]) * jb->inv_z;
+        double want = jb->target_hits / (cos_view > MIN_SLOPE_COS ? cos_view : MIN_SLOPE_COS);
+        double lo = jb->min_radius, hi = jb->max_radius;
+        double h;
+        if (impacts_within(jb, i, j, lo) >= want) {
+            h = lo;
+        } else if (impacts_within(jb, i, j, hi) < want) {
+            h = hi;
+        } else {
+            for (int k = 0; k < BISECTIONS; ++k) {
+                double mid = 0.5 * (lo + hi);
+                if (impacts_within(jb, i, j, mid) >= want) {
+                    hi = mid;
+                } else {
+                    lo = mid;
+                }
+            }
+            h = hi;
+        }
+        jb->radius[t] = (float)h;
+        double own = rect_sum(jb, jb->sat, i, j, i, j);
+        if (own < EMPTY_IMPACTS) {
+            double texels = 3.14159265358979323846 * (h / jb->texel_i) * (h / jb->texel_j);
+            double density = impacts_within(jb, i, j, h) / texels;
+            jb->clean[t] = is_clean(jb, i, j, density, k_max);
+        }
+    }
+}
+
+// The largest sample radius that can reach texels of row j, columns [x0, x1).
+static float chunk_bound(const job *jb, int j, int x0, int x1)
+{
+    int ty = j / TILE, tx0 = x0 / TILE, tx1 = (x1 - 1) / TILE;
+    float bound = 0.0f;
+    for (int tx = tx0; tx <= tx1; ++tx) {
+        float b = jb->tile_bound[(size_t)ty * (size_t)jb->tiles_x + (size_t)tx];
+        bound = b > bound ? b : bound;
+    }
+    return bound;
+}
+
+// Step 4 for a chunk of texels q: the initial dirt plus the weighted mean of
+// the change over the samples that reach it.
+static void gather_chunk(const job *jb, int j, int x0)
+{
+    const int x1 = x0 + CHUNK < jb->width ? x0 + CHUNK : jb->width;
+    const float bound = chunk_bound(jb, j, x0, x1);
+    const size_t q = jb->base + (size_t)j * jb->stride + (size_t)x0;
+    float num[CHUNK], den[CHUNK];
+    for (int x = 0; x < CHUNK; ++x) {
+        num[x] = 0.0f;
+        den[x] = 0.0f;
+    }
+    const float z2 = jb->z2;
+    const float *restrict dq = jb->pd + q, *restrict nxq = jb->pnx + q;
+    const float *restrict nyq = jb->pny + q, *restrict nzq = jb->pnz + q;
+    for (int o = 0; o < jb->offset_count && jb->offsets[o].r < bound; ++o) {
+        const offset off = jb->offsets[o];
+        // The sample is p = q - (di, dj); the offset from p to q is (di, dj).
+        const size_t p = (size_t)((ptrdiff_t)q - (ptrdiff_t)off.dj * (ptrdiff_t)jb->stride - off.di);
+        const float *restrict dp = jb->pd + p, *restrict nxp = jb->pnx + p;
+        const float *restrict nyp = jb->pny + p, *restrict nzp = jb->pnz + p;
+        const float *restrict znp = jb->pzn + p, *restrict ihp = jb->pinvh + p;
+        const float *restrict cp = jb->pcoef + p, *restrict vp = jb->pweight + p;
+        for (int x = 0; x < CHUNK; ++x) {
+            float dd = dq[x] - dp[x];
+            float r2 = off.a2 + dd * (off.az2 + dd * z2);
+            float cone = 1.0f - sqrtf(keep_if_positive(r2, r2)) * ihp[x];
+            float agree = nxp[x] * nxq[x] + nyp[x] * nyq[x] + nzp[x] * nzq[x];
+            float plane = off.ax * nxp[x] + off.ay * nyp[x] + off.az * nzp[x] + dd * znp[x];
+            float w = keep_if_positive(keep_if_positive(cone * agree, cone),
+                                       agree - NORMAL_EPSILON);
+            w = keep_if_positive(w, off.tol - fabsf(plane));
+            num[x] += w * cp[x];
+            den[x] += w * vp[x];
+        }
+    }
+    const wx_adaptive_def *def = jb->def;
+    for (int x = x0; x < x1; ++x) {
+        size_t t = (size_t)j * (size_t)jb->width + (size_t)x;
+        float change = den[x - x0] > 0.0f ? num[x - x0] / den[x - x0] : 0.0f;
+        jb->out[t] = wx_depth_is_empty(def->depth[t]) ? 0.0f : def->initial[t] + change;
+    }
+}
+
+static void run_rows(int64_t begin, int64_t end, int worker, void *context)
+{
+    (void)worker;
+    const job *jb = context;
+    for (int64_t j = begin; j < end; ++j) {
+        if (jb->pass == 2) {
+            radii_row(jb, (int)j);
+            continue;
+        }
+        for (int x0 = 0; x0 < jb->width; x0 += CHUNK) {
+            gather_chunk(jb, (int)j, x0);
+        }
+    }
+}
+
+static int compare_offsets(const void *a, const void *b)
+{
+    const offset *x = a, *y = b;
+    if (x->r != y->r) {
+        return x->r < y->r ? -1 : 1;
+    }
+    if (x->dj != y->dj) {
+        return x->dj < y->dj ? -1 : 1;
+    }
+    return x->di < y->di ? -1 : x->di > y->di;
+}
+
+static int compare_floats(const void *a, const void *b)
+{
+    float x = *(const float *)a, y = *(const float *)b;
+    return x < y ? -1 : x > y;
+}
+
+static double dot3(const double a[3], const double b[3])
+{
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+// The neighbour offsets within max_r across the view, sorted by distance.
+static int build_offsets(const wx_adaptive_def *def, const double px[3], const double py[3],
+                         const double z[3], int span_i, int span_j, double max_r, double texel,
+                         offset *out)
+{
+    int count = 0;
+    for (int dj = -span_j; dj <= span_j; ++dj) {
+        for (int di = -span_i; di <= span_i; ++di) {
+            double d[3];
+            for (int k = 0; k < 3; ++k) {
+                d[k] = di * px[k] + dj * py[k];
+            }
+            double rr = sqrt(dot3(d, d));
+            if (!(rr < max_r)) {
+                continue;
+            }
+            offset *o = &out[count++];
+            double a[3];
+            for (int k = 0; k < 3; ++k) {
+                a[k] = di * def->step_i[k] + dj * def->step_j[k];
+            }
+            o->di = di;
+            o->dj = dj;
+            o->r = (float)rr;
+            o->ax = (float)a[0];
+            o->ay = (float)a[1];
+            o->az = (float)a[2];
+            o->a2 = (float)dot3(a, a);
+            o->az2 = (float)(2.0 * dot3(a, z));
+            o->tol = (float)(PLANE_TOL_TEXELS * texel + PLANE_TOL_SLOPE * rr);
+        }
+    }
+    qsort(out, (size_t)count, sizeof *out, compare_offsets);
+    return count;
+}
+
+// A tile's bound: the largest radius of the samples of the tiles that can
+// reach it.
+static void bound_tiles(job *jb, const float *tile_max)
+{
+    for (int ty = 0; ty < jb->tiles_y; ++ty) {
+        for (int tx = 0; tx < jb->tiles_x; ++tx) {
+            float m = tile_max[(size_t)ty * (size_t)jb->tiles_x + (size_t)tx];
+            if (m <= 0.0f) {
+                continue;
+            }
+            int rx = (int)ceilf(m / jb->texel_i / TILE) + 1;
+            int ry = (int)ceilf(m / jb->texel_j / TILE) + 1;
+            for (int y = ty - ry; y <= ty + ry; ++y) {
+                for (int x = tx - rx; x <= tx + rx; ++x) {
+                    if (x >= 0 && y >= 0 && x < jb->tiles_x && y < jb->tiles_y) {
+                        float *b = &jb->tile_bound[(size_t)y * (size_t)jb->tiles_x + (size_t)x];
+                        *b = m > *b ? m : *b;
+                    }
+                }
+            }
+        }
+    }
+}
+
+wx_result wx_adaptive_smooth(const wx_adaptive_def *def, float *out, wx_adaptive_stats *stats,
+                             wx_error *err)
+{
+    const int W = def->width, H = def->height;
+    const size_t texels = (size_t)W * (size_t)H;
+    // The texel steps across the view.
+    double z[3] = { def->step_d[0], def->step_d[1], def->step_d[2] };
+    double zl = sqrt(dot3(z, z));
+    if (!(zl > 0.0) || !(def->noise > 0.0f)) {
+        return wx_fail(err, WX_CAUSE_BAD_ARGUMENT, "adaptive smoothing: bad definition");
+    }
+    double px[3], py[3];
+    double fi = dot3(def->step_i, z) / (zl * zl), fj = dot3(def->step_j, z) / (zl * zl);
+    for (int k = 0; k < 3; ++k) {
+        px[k] = def->step_i[k] - fi * z[k];
+        py[k] = def->step_j[k] - fj * z[k];
+    }
+    double cross[3] = { px[1] * py[2] - px[2] * py[1], px[2] * py[0] - px[0] * py[2],
+                        px[0] * py[1] - px[1] * py[0] };
+    const double head_area = sqrt(dot3(cross, cross));
+    const double texel_i = sqrt(dot3(px, px)), texel_j = sqrt(dot3(py, py));
+    const double texel = sqrt(head_area);
+    if (!(head_area > 0.0) || !isfinite(head_area)) {
+        return wx_fail(err, WX_CAUSE_BAD_ARGUMENT, "adaptive smoothing: degenerate target");
+    }
+    double max_r = def->max_radius > texel ? def->max_radius : texel;
+
+    job jb;
+    memset(&jb, 0, sizeof jb);
+    jb.def = def;
+    jb.width = W;
+    jb.height = H;
+    jb.out = out;
+    jb.texel_i = (float)texel_i;
+    jb.texel_j = (float)texel_j;
+    jb.min_radius = (float)texel;
+    jb.max_radius = (float)max_r;
+    jb.z2 = (float)(zl * zl);
+    jb.inv_z = (float)(1.0 / zl);
+    jb.target_hits = 1.5 / ((double)def->noise * (double)def->noise);
+    int pad_x = (int)ceil(max_r / texel_i) + 1, pad_y = (int)ceil(max_r / texel_j) + 1;
+    jb.stride = (size_t)pad_x * 2 + ((size_t)W + CHUNK - 1) / CHUNK * CHUNK;
+    size_t plane = jb.stride * ((size_t)H + 2 * (size_t)pad_y);
+    jb.base = (size_t)pad_y * jb.stride + (size_t)pad_x;
+    jb.tiles_x = (W + TILE - 1) / TILE;
+    jb.tiles_y = (H + TILE - 1) / TILE;
+    const size_t tiles = (size_t)jb.tiles_x * (size_t)jb.tiles_y;
+    const size_t sat_size = ((size_t)W + 1) * ((size_t)H + 1);
+
+    size_t cap = (size_t)(2 * pad_x - 1) * (size_t)(2 * pad_y - 1);
+    offset *offsets = malloc(cap * sizeof *offsets);
+    float *scratch = calloc(8 * plane, sizeof *scratch);
+    jb.delta = malloc(texels * sizeof *jb.delta);
+    jb.radius = calloc(texels, sizeof *jb.radius);
+    jb.clean = calloc(texels, 1);
+    jb.sat = calloc(2 * sat_size, sizeof *jb.sat);
+    jb.tile_bound = calloc(tiles, sizeof *jb.tile_bound);
+    float *tile_max = calloc(tiles, sizeof *tile_max);
+    float *sorted = NULL;
+    wx_result r = WX_OK;
+    if (offsets == NULL || scratch == NULL || jb.delta == NULL || jb.radius == NULL ||
+        jb.clean == NULL || jb.sat == NULL || jb.tile_bound == NULL || tile_max == NULL) {
+        r = wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "gather: out of memory (adaptive smoothing)");
+        goto done;
+    }
+    jb.sat_surface = jb.sat + sat_size;
+    jb.offset_count = build_offsets(def, px, py, z, pad_x - 1, pad_y - 1, max_r, texel, offsets);
+    jb.offsets = offsets;
+    jb.pd = scratch;
+    jb.pnx = scratch + plane;
+    jb.pny = scratch + 2 * plane;
+    jb.pnz = scratch + 3 * plane;
+    jb.pzn = scratch + 4 * plane;
+    jb.pinvh = scratch + 5 * plane;
+    jb.pweight = scratch + 6 * plane;
+    jb.pcoef = scratch + 7 * plane;
+
+    // Step 1: impacts, changes, the geometry in the padded planes.
+    const float view[3] = { (float)(z[0] / zl), (float)(z[1] / zl), (float)(z[2] / zl) };
+    const size_t sw = (size_t)W + 1;
+    for (int j = 0; j < H; ++j) {
+        double row = 0.0, row_surface = 0.0;
+        for (int i = 0; i < W; ++i) {
+            size_t t = (size_t)j * (size_t)W + (size_t)i;
+            size_t p = jb.base + (size_t)j * jb.stride + (size_t)i;
+            const float *n = &def->normal[3 * t];
+            jb.delta[t] = 0.0f;
+            if (!wx_depth_is_empty(def->depth[t])) {
+                float cos_view = fabsf(n[0] * view[0] + n[1] * view[1] + n[2] * view[2]);
+                double area = head_area / (cos_view > AREA_MIN_COS ? cos_view : AREA_MIN_COS);
+                jb.pd[p] = def->depth[t];
+                jb.pnx[p] = n[0];
+                jb.pny[p] = n[1];
+                jb.pnz[p] = n[2];
+                jb.pzn[p] = (float)(n[0] * z[0] + n[1] * z[1] + n[2] * z[2]);
+                float hits = def->hits[t];
+                row += hits > 0.0f && hits < INFINITY ? (double)hits * area : 0.0;
+                row_surface += 1.0;
+                float change = def->total[t] - def->initial[t];
+                jb.delta[t] = isfinite(change) ? change : 0.0f;
+            }
+            size_t s = (size_t)(j + 1) * sw + (size_t)(i + 1);
+            jb.sat[s] = jb.sat[s - sw] + row;
+            jb.sat_surface[s] = jb.sat_surface[s - sw] + row_surface;
+        }
+    }
+
+    // Step 2: radii and clean texels.
+    jb.pass = 2;
+    wx_pool_for(def->pool, H, 8, run_rows, &jb);
+
+    // Step 3: the samples.
+    int64_t samples = 0, capped = 0;
+    double largest = 0.0;
+    for (int j = 0; j < H; ++j) {
+        for (int i = 0; i < W; ++i) {
+            size_t t = (size_t)j * (size_t)W + (size_t)i;
+            size_t p = jb.base + (size_t)j * jb.stride + (size_t)i;
+            float h = jb.radius[t];
+            if (jb.clean[t]) {
+                jb.pnx[p] = jb.pny[p] = jb.pnz[p] = 0.0f; // neither gives nor takes
+                jb.radius[t] = h = 0.0f;
+            }
+            if (h > 0.0f) {
+                jb.pinvh[p] = 1.0f / h;
+                jb.pweight[p] = 1.0f / (h * h);
+                jb.pcoef[p] = jb.pweight[p] * jb.delta[t];
+                samples++;
+                capped += h >= jb.max_radius;
+                largest = h > largest ? h : largest;
+                size_t tile = (size_t)(j / TILE) * (size_t)jb.tiles_x + (size_t)(i / TILE);
+                tile_max[tile] = h > tile_max[tile] ? h : tile_max[tile];
+            }
+        }
+    }
+    bound_tiles(&jb, tile_max);
+
+    // Step 4: the mask.
+    jb.pass = 4;
+    wx_pool_for(def->pool, H, 4, run_rows, &jb);
+
+    if (stats != NULL) {
+        memset(stats, 0, sizeof *stats);
+        stats->target_hits = jb.target_hits;
+        stats->max_radius_used = largest;
+        stats->capped = capped;
+        if (samples > 0 && (sorted = malloc((size_t)samples * sizeof *sorted)) != NULL) {
+            int64_t k = 0;
+            for (size_t t = 0; t < texels; ++t) {
+                if (jb.radius[t] > 0.0f) {
+                    sorted[k++] = jb.radius[t];
+                }
+            }
+            qsort(sorted, (size_t)samples, sizeof *sorted, compare_floats);
+            stats->median_radius = sorted[samples / 2];
+        }
+    }
+done:
+    free(sorted);
+    free(tile_max);
+    free(jb.tile_bound);
+    free(jb.sat);
+    free(jb.clean);
+    free(jb.radius);
+    free(jb.delta);
+    free(scratch);
+    free(offsets);
+    return r;
+}

@@ -1,0 +1,65 @@
+// adaptive.h: the gather's smoothing when <OutputMap> gives no radius: a
+// kernel whose radius follows the local density of impacts (docs/mask.md,
+// "Adaptive smoothing"; docs/design.md section 5.2).
+//
+// What it smooths is what the particles changed, never the initial dirt (exact
+// from the bake): delta = first-pass dirt - first-pass initial dirt, per unit
+// area. Every target texel p with a surface is a sample with a radius h_p, the
+// distance within which the target holds K = 1.5 / noise^2 impacts (photon
+// mapping's k-nearest estimate; 1.5 because the cone kernel's effective count
+// is 2/3 of the disc's), between one texel and max_radius. The estimate at q is
+// the mean of the samples whose kernels reach it (a sample-point estimate):
+//
+//     out_q = initial_q + sum_p w_p K_p(q) delta_p / sum_p w_p K_p(q),
+//     K_p(q) = (1 - r_pq / h_p) * max(0, N_p . N_q) * [q lies on p's tangent plane],
+//     w_p = 1 / h_p^2   (each kernel weighs the same in all),
+//
+// r_pq the world distance between the two points. A dense region keeps its
+// detail (small h), a sparse one becomes smooth (large h), a constant change
+// stays constant up to every border, and nothing crosses a crease (the
+// normals), a depth jump (the distance and the plane test) or a shadow edge: a
+// texel with no impact of its own beside an empty half-rectangle where its
+// density would have put 12 impacts is clean, and neither gives nor takes.
+//
+// Computed as a gather over q, in rows on the pool: the same result for any
+// number of threads.
+#ifndef WX_ADAPTIVE_H
+#define WX_ADAPTIVE_H
+
+#include <stdint.h>
+
+#include "core/error.h"
+#include "core/parallel.h"
+
+/// The inputs, views into memory the caller owns. Planes are width*height, row 0
+/// at the top; texels without a surface have depth +inf (model/maps.h).
+typedef struct wx_adaptive_def {
+    int width, height;
+    const float *depth;   ///< the target's depth d
+    const float *normal;  ///< interleaved unit normals
+    const float *total;   ///< first pass: dirt per unit area
+    const float *initial; ///< first pass: initial dirt per unit area
+    const float *hits;    ///< first pass: impacts per unit area
+    /// World offset of one texel step in i (right) and j (down), and of one unit
+    /// of depth (the viewing direction, a unit vector for orthographic targets).
+    double step_i[3], step_j[3], step_d[3];
+    float noise;          ///< relative standard deviation aimed at, > 0
+    float max_radius;     ///< world units, at least one texel
+    wx_pool *pool;        ///< may be NULL: serial
+} wx_adaptive_def;
+
+/// What the smoothing chose, for --stats and the tests.
+typedef struct wx_adaptive_stats {
+    double target_hits;     ///< K
+    double median_radius;   ///< over the texels that hold what the particles changed (world units)
+    double max_radius_used; ///< largest radius given to such a texel
+    int64_t capped;         ///< such texels whose K impacts lie beyond max_radius
+} wx_adaptive_stats;
+
+/// Writes the smoothed mask (dirt per unit area: the initial dirt exactly plus
+/// the smoothed change) into out[width*height]; 0 where there is no surface.
+/// WX_FAIL when out of memory.
+wx_result wx_adaptive_smooth(const wx_adaptive_def *def, float *out, wx_adaptive_stats *stats,
+                             wx_error *err);
+
+#endif
