@@ -22,6 +22,7 @@
 #include "model/scene.h"
 #include "pipeline/bake_phase.h"
 #include "pipeline/gather_phase.h"
+#include "pipeline/pilot.h"
 #include "pipeline/memory.h"
 #include "pipeline/outputs.h"
 #include "pipeline/pipeline.h"
@@ -368,6 +369,10 @@ static int command_info(const cli_args *args)
             }
         }
     }
+    // The pilot uses the geometry up (its arrays go to the renderer).
+    wx_pilot_report pilot;
+    wx_error pilot_err;
+    wx_result pilot_r = wx_pilot_run(&scene, &opts, &geometry, &pilot, &pilot_err);
     wx_geometry_free(&geometry);
     wx_memory_need need;
     wx_memory_estimate(&scene, WX_PHASE_ALL, &need);
@@ -384,6 +389,19 @@ static int command_info(const cli_args *args)
                need.total_bytes > available ? ": too much, a run would be refused" : "");
     }
     printf("\n");
+    if (pilot_r != WX_OK) {
+        printf("pilot: not flown (%s)\n", pilot_err.message);
+    } else if (pilot.particles > 0) {
+        double n = (double)pilot.particles;
+        double wasted = 100.0 * (double)pilot.escaped_without_hit / n;
+        printf("pilot: %lld particles on maps of at most %d texels a side: %.1f%% would leave the "
+               "bounding box without a hit, %.1f%% would still fly at the end (%.2f s)%s\n",
+               (long long)pilot.particles, WX_PILOT_SIDE, wasted,
+               100.0 * (double)pilot.alive / n, pilot.seconds,
+               wasted > 50.0 ? "; over half: aim the emitters at the model (a <BoxEmitter> "
+                               "above or beside it)"
+                             : "");
+    }
     printf("output folder: %s\n", opts.out_dir);
     if (opts.stats_path != NULL) {
         char shown[WX_ERROR_MAX];
@@ -434,8 +452,18 @@ static int run_phases(const cli_args *args, unsigned phases)
         r = wx_write_stats(opts.stats_path, &run.stats, &run.times, opts.threads, opts.seed, &err);
     }
     if (r == WX_OK && !opts.quiet) {
-        fprintf(stderr, "weathering: %s done in %.2f s; outputs in %s\n", args->command,
-                run.times.total, opts.out_dir);
+        const wx_sim_stats *st = &run.stats;
+        char flown[256] = "";
+        if ((phases & WX_PHASE_SIMULATE) && st->particles_emitted > 0) {
+            double n = (double)st->particles_emitted;
+            snprintf(flown, sizeof flown,
+                     " (%lld particles: %lld hits, %.1f%% escaped without a hit, %lld still "
+                     "flying)",
+                     (long long)st->particles_emitted, (long long)st->collisions,
+                     100.0 * (double)st->escaped_without_hit / n, (long long)st->alive);
+        }
+        fprintf(stderr, "weathering: %s done in %.2f s%s; outputs in %s\n", args->command,
+                run.times.total, flown, opts.out_dir);
     }
     wx_scene_free(&scene);
     return report(r, &err);

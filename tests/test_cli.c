@@ -242,6 +242,44 @@ TEST(control_characters_from_files_are_escaped)
     ENSURE(strchr(out, '\n') == out + strlen(out) - 1);
 }
 
+// info's pilot says what share of the particles a run wastes: the teapot's sky
+// dome misses the pot with about 90% of them; the run's --stats agree within
+// two points (the pilot's 20000 particles give a standard error of 0.2).
+TEST(info_pilot_predicts_the_particles_that_miss)
+{
+    const char *d = teapot_copy("pilot");
+    ENSURE(d != NULL);
+    ENSURE(ensure_shell(out, sizeof out, "cd '%s' && '%s/weathering' info s.xml", d,
+                        build_dir()) == 0);
+    const char *line = strstr(out, "pilot: 20000 particles");
+    ENSURE(line != NULL);
+    const char *pct = strstr(line, "a side: ");
+    ENSURE(pct != NULL);
+    double predicted = atof(pct + strlen("a side: "));
+    ENSURE(ensure_contains(line, "over half: aim the emitters at the model"));
+    int status = ensure_shell(out, sizeof out, "cd '%s' && '%s/weathering' run s.xml --stats "
+                              "s.json", d, build_dir());
+    ENSURE(status == 0);
+    ENSURE(ensure_contains(out, "left the bounding box without hitting anything"));
+    char path[4300];
+    snprintf(path, sizeof path, "%s/s.json", d);
+    char *json = ensure_read_file(path);
+    ENSURE(json != NULL);
+    static const char emitted_key[] = "\"particles_emitted\": ";
+    static const char missed_key[] = "\"escaped_without_hit\": ";
+    const char *emitted = strstr(json, emitted_key), *missed = strstr(json, missed_key);
+    bool found = emitted != NULL && missed != NULL;
+    double actual = found ? 100.0 * atof(missed + sizeof missed_key - 1) /
+                                atof(emitted + sizeof emitted_key - 1)
+                          : -1.0;
+    free(json);
+    ENSURE(found);
+    printf("        pilot %.1f%%, run %.1f%% of the particles escaped without a hit\n",
+           predicted, actual);
+    ENSURE(predicted > 50.0);
+    ENSURE_NEAR(predicted, actual, 2.0);
+}
+
 int main(void)
 {
     RUN(help_lists_commands_and_options);
@@ -256,5 +294,6 @@ int main(void)
     RUN(stale_cleanup_and_default_folder_stay_in_their_place);
     RUN(overlong_paths_are_refused);
     RUN(control_characters_from_files_are_escaped);
+    RUN(info_pilot_predicts_the_particles_that_miss);
     return ensure_summary();
 }

@@ -18,6 +18,7 @@ wx_result wx_write_stats(const char *path, const wx_sim_stats *stats, const wx_p
         "  \"absorbed\": %lld,\n"
         "  \"settled\": %lld,\n"
         "  \"escaped\": %lld,\n"
+        "  \"escaped_without_hit\": %lld,\n"
         "  \"alive\": %lld,\n"
         "  \"dirt\": {\n"
         "    \"initial_surface\": %.17g,\n"
@@ -38,7 +39,8 @@ wx_result wx_write_stats(const char *path, const wx_sim_stats *stats, const wx_p
         "}\n",
         (long long)stats->particles_emitted, (long long)stats->particle_steps,
         (long long)stats->collisions, (long long)stats->absorbed, (long long)stats->settled,
-        (long long)stats->escaped, (long long)stats->alive, stats->dirt_initial_surface,
+        (long long)stats->escaped, (long long)stats->escaped_without_hit,
+        (long long)stats->alive, stats->dirt_initial_surface,
         stats->dirt_emitted, stats->dirt_final_surface, stats->dirt_in_flight,
         stats->dirt_escaped, times->load, times->bake, times->simulate, times->gather,
         times->total, threads, (unsigned long long)seed);

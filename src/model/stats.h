@@ -14,6 +14,7 @@ typedef struct wx_sim_stats {
     int64_t absorbed;
     int64_t settled;
     int64_t escaped;
+    int64_t escaped_without_hit; ///< of the emitters' particles, those that never hit
     int64_t alive;
     double dirt_initial_surface;
     double dirt_emitted;

@@ -171,33 +171,43 @@ wx_result wx_geometry_load(const wx_scene *scene, bool quiet, wx_geometry *out, 
     return r;
 }
 
-wx_result wx_bake_geometry(wx_scene *scene, const wx_run_def *opts, wx_geometry *geometry,
-                           wx_bake_stats *stats, wx_error *err)
+wx_result wx_bake_geometry_into(const wx_scene *scene, const wx_run_def *opts,
+                                wx_geometry *geometry, wx_bake_maps_fn *on_maps, void *user,
+                                wx_bake_stats *stats, wx_error *err)
 {
     wx_maps *given = NULL;
-    bake_writer *writer = calloc(1, sizeof *writer); // four paths: off the stack
-    wx_result r =
-        writer != NULL ? WX_OK : wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "bake: out of memory");
-    if (r == WX_OK && wx_scene_needs_bake(scene)) {
+    wx_result r = WX_OK;
+    if (wx_scene_needs_bake(scene)) {
         r = read_given_depths(scene, geometry, &given, err);
     }
     if (r == WX_OK) {
-        writer->scene = scene;
-        writer->opts = opts;
         wx_bake_def def = wx_default_bake_def();
         def.scene = scene;
         def.geometry = geometry;
         def.given_depth = given;
         def.threads = opts->threads;
         def.quiet = opts->quiet;
-        def.on_maps = write_maps;
-        def.user = writer;
+        def.on_maps = on_maps;
+        def.user = user;
         r = wx_bake_render(&def, stats, err);
     }
     for (int c = 0; given != NULL && c < scene->camera_count; ++c) {
         wx_maps_free(&given[c]);
     }
     free(given);
+    return r;
+}
+
+wx_result wx_bake_geometry(wx_scene *scene, const wx_run_def *opts, wx_geometry *geometry,
+                           wx_bake_stats *stats, wx_error *err)
+{
+    bake_writer *writer = calloc(1, sizeof *writer); // four paths: off the stack
+    if (writer == NULL) {
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "bake: out of memory");
+    }
+    writer->scene = scene;
+    writer->opts = opts;
+    wx_result r = wx_bake_geometry_into(scene, opts, geometry, write_maps, writer, stats, err);
     free(writer);
     return r;
 }

@@ -21,6 +21,13 @@
 /// triangles is a warning (unless quiet). On failure `out` is left empty.
 wx_result wx_geometry_load(const wx_scene *scene, bool quiet, wx_geometry *out, wx_error *err);
 
+/// Renders with the geometry already imported (wx_geometry_load), handing each
+/// baked camera's maps to `on_maps` (raster/bake.h) instead of writing them:
+/// what the pilot of `info` flies on. `stats` may be NULL.
+wx_result wx_bake_geometry_into(const wx_scene *scene, const wx_run_def *opts,
+                                wx_geometry *geometry, wx_bake_maps_fn *on_maps, void *user,
+                                wx_bake_stats *stats, wx_error *err);
+
 /// Bakes with the geometry already imported (wx_geometry_load);
 /// its mesh arrays are released as they are uploaded. `stats` may be NULL.
 wx_result wx_bake_geometry(wx_scene *scene, const wx_run_def *opts, wx_geometry *geometry,

@@ -95,6 +95,14 @@ wx_result wx_run_phases(wx_scene *scene, const wx_run_def *opts, unsigned phases
                     "initial dirt; see \"Fitting a scene to a model\" in docs/user-guide.md",
                     scene->path, (long long)st->particles_emitted, (long long)st->escaped,
                     (long long)st->alive);
+        } else if (r == WX_OK && 2 * st->escaped_without_hit > st->particles_emitted) {
+            wx_warn(opts->quiet,
+                    "%s: %.0f%% of the particles (%lld of %lld) left the bounding box without "
+                    "hitting anything: aim the emitters at the model (a <BoxEmitter> above or "
+                    "beside it wastes none; see \"Fitting a scene to a model\" in "
+                    "docs/user-guide.md)",
+                    scene->path, 100.0 * (double)st->escaped_without_hit / (double)st->particles_emitted,
+                    (long long)st->escaped_without_hit, (long long)st->particles_emitted);
         }
         report->times.simulate = wx_now_s() - t0;
     }

@@ -585,8 +585,17 @@ static void remove_dead(wx_sim *sim)
         const sim_chunk *ch = &sim->chunks[c];
         for (int64_t k = 0; k < ch->dead_count; ++k) {
             if (ch->dead[k] & 1) {
+                int64_t i = ch->dead[k] >> 1;
                 sim->stats.escaped++;
-                sim->stats.dirt_escaped += sim->particles.load[ch->dead[k] >> 1];
+                sim->stats.dirt_escaped += sim->particles.load[i];
+                // An emitter's particle that escapes with all its collisions left
+                // never hit anything (spawned particles are not counted).
+                uint64_t e = sim->particles.id[i] >> 48;
+                if (e < (uint64_t)sim->emitter_count &&
+                    sim->particles.collisions_left[i] ==
+                        (uint32_t)sim->emitters[e].max_collisions) {
+                    sim->stats.escaped_without_hit++;
+                }
             }
         }
     }
