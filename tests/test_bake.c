@@ -871,7 +871,7 @@ TEST(scene_file_bakes_maps_the_scene_reads_back)
         const wx_scene_camera *sc = &s.cameras[c];
         wx_maps m;
         memset(&m, 0, sizeof m);
-        r = wx_maps_load(&m, WX_MAPS_ALL, sc->depth_path, sc->normal_path, sc->impact_path,
+        r = wx_maps_load(&m, WX_MAPS_ALL, 1, sc->depth_path, sc->normal_path, sc->impact_path,
                          sc->dirt_path, &err);
         if (r != WX_OK) {
             fprintf(stderr, "%s\n", err.message);
@@ -899,7 +899,7 @@ TEST(scene_file_bakes_maps_the_scene_reads_back)
     ENSURE(shot->is_output && !wx_has_path(shot->impact_path));
     wx_maps m;
     memset(&m, 0, sizeof m);
-    ENSURE(wx_maps_load(&m, WX_MAPS_DEPTH | WX_MAPS_NORMAL, shot->depth_path, shot->normal_path,
+    ENSURE(wx_maps_load(&m, WX_MAPS_DEPTH | WX_MAPS_NORMAL, 1, shot->depth_path, shot->normal_path,
                         NULL, NULL, &err) == WX_OK);
     ENSURE(m.width == 32 && m.height == 32);
     // The corner (1,1,1) of the box is nearest to the shot camera: its eye

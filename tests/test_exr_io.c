@@ -208,20 +208,25 @@ static bool write_noisy_file(const char *path)
 }
 
 // Expects reading `path` to fail for `cause` (a bad input), a message naming the
-// file and containing `needle`, and the image left empty.
+// file and containing `needle`, and the image left empty; decoding the chunks
+// on three threads fails the same way, with the same message.
 static bool read_fails(const char *path, wx_cause cause, const char *needle)
 {
     static const char *const wanted[] = {"R"};
-    wx_image image;
-    wx_error err = { 0 };
+    wx_image image, parallel;
+    wx_error err = { 0 }, perr = { 0 };
     wx_result r = wx_exr_read(path, wanted, 1, &image, &err);
+    wx_result pr = wx_exr_read_parallel(path, wanted, 1, 3, &parallel, &perr);
     bool ok = r == WX_BAD_INPUT && err.cause == cause && ensure_contains(err.message, path) &&
               ensure_contains(err.message, needle) && image.channels[0] == NULL && image.width == 0;
-    if (!ok) {
+    bool same = pr == r && perr.cause == err.cause && strcmp(perr.message, err.message) == 0 &&
+                parallel.channels[0] == NULL;
+    if (!ok || !same) {
         fprintf(stderr, "    reading %s: result %d, cause %s, message \"%s\"\n", path, (int)r,
                 wx_cause_name(err.cause), err.message);
+        fprintf(stderr, "    on 3 threads: result %d, message \"%s\"\n", (int)pr, perr.message);
     }
-    return ok;
+    return ok && same;
 }
 
 // ---------------------------------------------------------------------------
@@ -299,7 +304,7 @@ TEST(interleaved_read_orders_channels_as_asked)
     int w = 0;
     int h = 0;
     wx_error err = { 0 };
-    ENSURE(wx_exr_read_interleaved(path, wanted, 3, &texels, &w, &h, &err) == WX_OK);
+    ENSURE(wx_exr_read_interleaved(path, wanted, 3, 1, &texels, &w, &h, &err) == WX_OK);
     ENSURE(w == W && h == H);
     // Texel (i=4, j=32): G = 1000 + 324, B = 2000 + 324, R = 324.
     const float *t = texels + (32 * W + 4) * 3;
@@ -656,6 +661,32 @@ static long chunk_leader_offset(const char *path, int y)
     return offset;
 }
 
+// Chunks decoded on several threads give the same planes, planar and
+// interleaved (64 rows: four ZIP chunks of 16).
+TEST(parallel_decoding_gives_the_same_planes)
+{
+    const char *path = path_in("parallel.exr");
+    ENSURE(write_smooth_file(path));
+    static const char *const wanted[] = {"R"};
+    wx_image one, four;
+    ENSURE(wx_exr_read_parallel(path, wanted, 1, 1, &one, NULL) == WX_OK);
+    ENSURE(wx_exr_read_parallel(path, wanted, 1, 4, &four, NULL) == WX_OK);
+    bool same = one.width == 64 && four.width == 64 &&
+                memcmp(one.channels[0], four.channels[0], 64 * 64 * sizeof(float)) == 0 &&
+                one.channels[0][64 * 40 + 3] == 1.0f + 3.0f / 64.0f + 40.0f / 8.0f;
+    float *a = NULL, *b = NULL;
+    int w = 0, h = 0;
+    ENSURE(wx_exr_read_interleaved(path, wanted, 1, 1, &a, &w, &h, NULL) == WX_OK);
+    ENSURE(wx_exr_read_interleaved(path, wanted, 1, 3, &b, &w, &h, NULL) == WX_OK);
+    same = same && memcmp(a, b, 64 * 64 * sizeof(float)) == 0 &&
+           memcmp(a, one.channels[0], 64 * 64 * sizeof(float)) == 0;
+    free(a);
+    free(b);
+    wx_image_free(&one);
+    wx_image_free(&four);
+    ENSURE(same);
+}
+
 TEST(corrupt_chunk_is_bad_input)
 {
     const char *path = path_in("corrupt.exr");
@@ -921,6 +952,7 @@ int main(void)
     RUN(empty_file_is_bad_input);
     RUN(text_file_is_bad_input);
     RUN(truncated_file_is_bad_input);
+    RUN(parallel_decoding_gives_the_same_planes);
     RUN(corrupt_chunk_is_bad_input);
     RUN(garbage_after_magic_is_bad_input);
     RUN(absurd_size_is_bad_input);

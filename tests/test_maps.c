@@ -82,7 +82,7 @@ TEST(four_maps_load_in_simulation_layout)
 
     wx_maps maps;
     wx_error err = { 0 };
-    ENSURE(wx_maps_load(&maps, WX_MAPS_ALL, depth_path, normal_path, impact_path, dirt_path,
+    ENSURE(wx_maps_load(&maps, WX_MAPS_ALL, 1, depth_path, normal_path, impact_path, dirt_path,
                         &err) == WX_OK);
     ENSURE(maps.width == W && maps.height == H);
     // Depth: the "no surface" values became +inf, the others are kept.
@@ -118,7 +118,7 @@ TEST(depth_is_read_from_z)
     ENSURE(write_map(path, W, H, 1, Z, depth));
     wx_maps maps;
     wx_error err = { 0 };
-    ENSURE(wx_maps_load(&maps, WX_MAPS_DEPTH, path, NULL, NULL, NULL, &err) == WX_OK);
+    ENSURE(wx_maps_load(&maps, WX_MAPS_DEPTH, 1, path, NULL, NULL, NULL, &err) == WX_OK);
     bool right = isinf(maps.depth[0]) && isinf(maps.depth[2]) && maps.depth[9] == 10.0f &&
                  maps.normal == NULL && maps.dirt == NULL && maps.width == W;
     wx_maps_free(&maps);
@@ -134,13 +134,13 @@ TEST(only_selected_maps_are_loaded)
     wx_maps maps;
     wx_error err = { 0 };
     // The impact path is given but not selected: it is not read.
-    ENSURE(wx_maps_load(&maps, WX_MAPS_DIRT, "", NULL, impact_path, dirt_path, &err) == WX_OK);
+    ENSURE(wx_maps_load(&maps, WX_MAPS_DIRT, 1, "", NULL, impact_path, dirt_path, &err) == WX_OK);
     bool right = maps.depth == NULL && maps.normal == NULL && maps.impact == NULL &&
                  maps.dirt[W + 1] == 11.5f && maps.erosion[0] == 200.5f && maps.height == H;
     wx_maps_free(&maps);
     ENSURE(right);
     // A selected map without a file is an error.
-    ENSURE(wx_maps_load(&maps, WX_MAPS_DIRT | WX_MAPS_NORMAL, NULL, NULL, NULL, dirt_path, &err) ==
+    ENSURE(wx_maps_load(&maps, WX_MAPS_DIRT | WX_MAPS_NORMAL, 1, NULL, NULL, NULL, dirt_path, &err) ==
            WX_BAD_INPUT);
     ENSURE_CAUSE(err, BAD_ARGUMENT);
     ENSURE(ensure_contains(err.message, "normal"));
@@ -156,7 +156,7 @@ TEST(mismatched_sizes_name_both_files)
     ENSURE(write_map(normal_path, 16, 8, 3, RGB, NULL));
     wx_maps maps;
     wx_error err = { 0 };
-    ENSURE(wx_maps_load(&maps, WX_MAPS_DEPTH | WX_MAPS_NORMAL, depth_path, normal_path, NULL, NULL,
+    ENSURE(wx_maps_load(&maps, WX_MAPS_DEPTH | WX_MAPS_NORMAL, 1, depth_path, normal_path, NULL, NULL,
                         &err) == WX_BAD_INPUT);
     ENSURE_CAUSE(err, MAP_SIZE);
     ENSURE(ensure_contains(err.message, depth_path));
@@ -178,18 +178,18 @@ TEST(missing_channels_are_errors)
     ENSURE(write_map(depth_path, W, H, 1, RGB + 1, NULL)); // only G
     wx_maps maps;
     wx_error err = { 0 };
-    ENSURE(wx_maps_load(&maps, WX_MAPS_IMPACT, NULL, NULL, impact_path, NULL, &err) ==
+    ENSURE(wx_maps_load(&maps, WX_MAPS_IMPACT, 1, NULL, NULL, impact_path, NULL, &err) ==
            WX_BAD_INPUT);
     ENSURE_CAUSE(err, BAD_MAP);
     ENSURE(ensure_contains(err.message, impact_path));
     ENSURE(ensure_contains(err.message, "no channel G (has: R)"));
     ENSURE(all_null(&maps));
-    ENSURE(wx_maps_load(&maps, WX_MAPS_DIRT, NULL, NULL, NULL, dirt_path, &err) == WX_BAD_INPUT);
+    ENSURE(wx_maps_load(&maps, WX_MAPS_DIRT, 1, NULL, NULL, NULL, dirt_path, &err) == WX_BAD_INPUT);
     ENSURE_CAUSE(err, BAD_MAP);
     ENSURE(ensure_contains(err.message, dirt_path));
     ENSURE(ensure_contains(err.message, "no channel B (has: G, R)"));
     ENSURE(all_null(&maps));
-    ENSURE(wx_maps_load(&maps, WX_MAPS_DEPTH, depth_path, NULL, NULL, NULL, &err) == WX_BAD_INPUT);
+    ENSURE(wx_maps_load(&maps, WX_MAPS_DEPTH, 1, depth_path, NULL, NULL, NULL, &err) == WX_BAD_INPUT);
     ENSURE_CAUSE(err, BAD_MAP);
     ENSURE(ensure_contains(err.message, "no channel R or Z (has: G)"));
 }
@@ -202,13 +202,13 @@ TEST(a_bad_file_frees_the_maps_already_loaded)
     ENSURE(write_map(depth_path, W, H, 1, R, NULL));
     wx_maps maps;
     wx_error err = { 0 };
-    ENSURE(wx_maps_load(&maps, WX_MAPS_DEPTH | WX_MAPS_DIRT, depth_path, NULL, NULL, dirt_path,
+    ENSURE(wx_maps_load(&maps, WX_MAPS_DEPTH | WX_MAPS_DIRT, 1, depth_path, NULL, NULL, dirt_path,
                         &err) == WX_BAD_INPUT);
     ENSURE_CAUSE(err, BAD_MAP);
     ENSURE(ensure_contains(err.message, dirt_path));
     ENSURE(ensure_contains(err.message, "not an OpenEXR file"));
     ENSURE(all_null(&maps));
-    ENSURE(wx_maps_load(&maps, WX_MAPS_DEPTH, path_in("none.exr"), NULL, NULL, NULL, &err) ==
+    ENSURE(wx_maps_load(&maps, WX_MAPS_DEPTH, 1, path_in("none.exr"), NULL, NULL, NULL, &err) ==
            WX_BAD_INPUT);
     ENSURE_CAUSE(err, FILE_MISSING);
     ENSURE(ensure_contains(err.message, "none.exr: cannot open"));

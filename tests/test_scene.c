@@ -180,10 +180,10 @@ TEST(element_defaults)
     ENSURE(out->camera.width == 8 && out->camera.height == 8);
     ENSURE(strcmp(out->output_file, "mask.exr") == 0);
     ENSURE(out->output_width == 8 && out->output_height == 8);
-    // No radius: the adaptive smoothing, noise 4%, radii up to 24 output texels
-    // (the frame is 4 m wide over 8 texels: 12 m).
+    // No radius: the adaptive smoothing, noise 4%, radii up to 16 output texels
+    // (the frame is 4 m wide over 8 texels: 8 m).
     ENSURE(out->adaptive && out->noise == WX_DEFAULT_NOISE && WX_DEFAULT_NOISE == 0.04f);
-    ENSURE_NEAR(out->max_radius, 12.0, 1e-5);
+    ENSURE_NEAR(out->max_radius, 8.0, 1e-5);
     ENSURE(out->second_pass == WX_SECOND_PASS_MEAN && !out->normalize);
     ENSURE(!wx_has_path(out->impact_path) && !wx_has_path(out->dirt_path));
 
@@ -335,11 +335,11 @@ TEST(view_camera_matrices)
     ENSURE_NEAR(uvd[1], 0.75, 1e-6);
     ENSURE_NEAR(uvd[2], 7.0, 1e-5);
     // No <OutputMap>: mask.exr at the View's resolution, adaptive smoothing with
-    // radii up to 24 texels = 24 * 4/8 m.
+    // radii up to 16 texels = 16 * 4/8 m.
     ENSURE(out->is_output && strcmp(out->output_file, "mask.exr") == 0);
     ENSURE(out->output_width == 8 && out->output_height == 4);
     ENSURE(out->adaptive && out->noise == 0.04f);
-    ENSURE_NEAR(out->max_radius, 12.0, 1e-5);
+    ENSURE_NEAR(out->max_radius, 8.0, 1e-5);
     ENSURE(!wx_has_path(out->depth_path));
     wx_scene_free(&s);
 }

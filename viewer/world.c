@@ -478,7 +478,7 @@ static wx_result load_maps(vw_world *world, wx_error *err)
                 which |= WX_MAPS_DIRT | WX_MAPS_INITIAL_DIRT;
             }
         }
-        wx_result r = wx_maps_load(&world->maps[world->camera_maps[c]], which, cam->depth_path,
+        wx_result r = wx_maps_load(&world->maps[world->camera_maps[c]], which, 1, cam->depth_path,
                                    cam->normal_path, cam->impact_path, cam->dirt_path, err);
         if (r != WX_OK) {
             wx_error_prefix(err, "camera '%s'", cam->name);

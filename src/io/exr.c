@@ -19,6 +19,8 @@
 #include <assert.h>
 #include <errno.h>
 #include <fcntl.h>
+#include <stdatomic.h>
+#include <stdbool.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -37,6 +39,9 @@ typedef struct exr_stream {
     int fd;
     int io_errno;      // errno of the first failed read or write, 0 if none
     char message[512]; // first library message since the last stream_reset
+    // While chunks are decoded on several threads nothing is recorded (a
+    // failure is decoded again on one thread, which records it).
+    bool quiet;
 } exr_stream;
 
 static void stream_reset(exr_stream *s)
@@ -52,7 +57,7 @@ static void stream_on_error(exr_const_context_t ctxt, exr_result_t code, const c
         return;
     }
     exr_stream *s = user;
-    if (s->message[0] == '\0') {
+    if (!s->quiet && s->message[0] == '\0') {
         snprintf(s->message, sizeof s->message, "%s",
                  msg != NULL ? msg : exr_get_default_error_message(code));
         // The library quotes bytes of a corrupt header: keep the message one
@@ -84,7 +89,7 @@ static int64_t stream_transfer(exr_stream *s, uint8_t *bytes, uint64_t size, uin
             continue;
         }
         if (n < 0 || (n == 0 && write)) {
-            if (s->io_errno == 0) {
+            if (!s->quiet && s->io_errno == 0) {
                 s->io_errno = n < 0 ? errno : EIO;
             }
             return -1;
@@ -360,63 +365,70 @@ typedef struct read_target {
     int stride;
 } read_target;
 
-// Decodes every chunk of part 0 into the targets.
-static wx_result reader_decode(exr_reader *r, const char *path, const read_target *targets,
-                               int target_count, wx_error *err)
+// Decodes the chunk of part 0 that starts at data-window row `row` into the
+// targets with pipeline `dec` (initialised on its first chunk).
+static exr_result_t decode_chunk(exr_reader *r, const read_target *targets, int target_count,
+                                 int64_t row, exr_decode_pipeline_t *dec, bool *initialized,
+                                 exr_chunk_info_t *ci)
 {
-    int32_t lines = 0;
-    if (exr_get_scanlines_per_chunk(r->ctx, 0, &lines) != EXR_ERR_SUCCESS || lines <= 0) {
-        return wx_fail(err, WX_CAUSE_BAD_MAP, "%s: corrupt OpenEXR header", path);
-    }
     const size_t width = (size_t)r->width;
+    memset(ci, 0, sizeof *ci);
+    exr_result_t rv = exr_read_scanline_chunk_info(r->ctx, 0, (int)(r->min_y + row), ci);
+    if (rv == EXR_ERR_SUCCESS) {
+        rv = *initialized ? exr_decoding_update(r->ctx, 0, ci, dec)
+                          : exr_decoding_initialize(r->ctx, 0, ci, dec);
+        *initialized = true;
+    }
+    if (rv == EXR_ERR_SUCCESS) {
+        // The chunk must lie inside the data window: never write outside the planes.
+        int64_t chunk_row = (int64_t)ci->start_y - r->min_y;
+        if (ci->width != r->width || chunk_row != row || ci->height <= 0 ||
+            chunk_row + ci->height > r->height) {
+            rv = EXR_ERR_CORRUPT_CHUNK;
+        }
+        for (int c = 0; rv == EXR_ERR_SUCCESS && c < dec->channel_count; c++) {
+            exr_coding_channel_info_t *ch = &dec->channels[c];
+            ch->decode_to_ptr = NULL;
+            for (int t = 0; t < target_count; t++) {
+                const exr_attr_string_t *n = targets[t].name;
+                if (ch->channel_name == NULL ||
+                    !name_equals(n, ch->channel_name, strlen(ch->channel_name))) {
+                    continue;
+                }
+                size_t stride = (size_t)targets[t].stride;
+                ch->decode_to_ptr = (uint8_t *)(targets[t].base + (size_t)row * width * stride);
+                ch->user_pixel_stride = (int32_t)(stride * sizeof(float));
+                ch->user_line_stride = (int32_t)(width * stride * sizeof(float));
+                ch->user_data_type = EXR_PIXEL_FLOAT;
+                ch->user_bytes_per_element = (int16_t)sizeof(float);
+                if (ch->height != ci->height || ch->width != r->width) {
+                    rv = EXR_ERR_CORRUPT_CHUNK;
+                }
+            }
+        }
+    }
+    if (rv == EXR_ERR_SUCCESS) {
+        rv = exr_decoding_choose_default_routines(r->ctx, 0, dec);
+    }
+    if (rv == EXR_ERR_SUCCESS) {
+        rv = exr_decoding_run(r->ctx, 0, dec);
+    }
+    return rv;
+}
+
+// Decodes every chunk of part 0 into the targets, one after the other; a
+// failure names the chunk's scanlines.
+static wx_result decode_serial(exr_reader *r, const char *path, const read_target *targets,
+                               int target_count, int32_t lines, wx_error *err)
+{
     exr_decode_pipeline_t dec = EXR_DECODE_PIPELINE_INITIALIZER;
     bool initialized = false;
     wx_result result = WX_OK;
     for (int64_t row = 0; row < r->height; row += lines) {
         int64_t last = row + lines - 1 < r->height - 1 ? row + lines - 1 : r->height - 1;
         exr_chunk_info_t ci;
-        memset(&ci, 0, sizeof ci);
         stream_reset(&r->stream);
-        exr_result_t rv = exr_read_scanline_chunk_info(r->ctx, 0, (int)(r->min_y + row), &ci);
-        if (rv == EXR_ERR_SUCCESS) {
-            rv = initialized ? exr_decoding_update(r->ctx, 0, &ci, &dec)
-                             : exr_decoding_initialize(r->ctx, 0, &ci, &dec);
-            initialized = true;
-        }
-        if (rv == EXR_ERR_SUCCESS) {
-            // The chunk must lie inside the data window: never write outside the planes.
-            int64_t chunk_row = (int64_t)ci.start_y - r->min_y;
-            if (ci.width != r->width || chunk_row != row || ci.height <= 0 ||
-                chunk_row + ci.height > r->height) {
-                rv = EXR_ERR_CORRUPT_CHUNK;
-            }
-            for (int c = 0; rv == EXR_ERR_SUCCESS && c < dec.channel_count; c++) {
-                exr_coding_channel_info_t *ch = &dec.channels[c];
-                ch->decode_to_ptr = NULL;
-                for (int t = 0; t < target_count; t++) {
-                    const exr_attr_string_t *n = targets[t].name;
-                    if (ch->channel_name == NULL ||
-                        !name_equals(n, ch->channel_name, strlen(ch->channel_name))) {
-                        continue;
-                    }
-                    size_t stride = (size_t)targets[t].stride;
-                    ch->decode_to_ptr = (uint8_t *)(targets[t].base + (size_t)row * width * stride);
-                    ch->user_pixel_stride = (int32_t)(stride * sizeof(float));
-                    ch->user_line_stride = (int32_t)(width * stride * sizeof(float));
-                    ch->user_data_type = EXR_PIXEL_FLOAT;
-                    ch->user_bytes_per_element = (int16_t)sizeof(float);
-                    if (ch->height != ci.height || ch->width != r->width) {
-                        rv = EXR_ERR_CORRUPT_CHUNK;
-                    }
-                }
-            }
-        }
-        if (rv == EXR_ERR_SUCCESS) {
-            rv = exr_decoding_choose_default_routines(r->ctx, 0, &dec);
-        }
-        if (rv == EXR_ERR_SUCCESS) {
-            rv = exr_decoding_run(r->ctx, 0, &dec);
-        }
+        exr_result_t rv = decode_chunk(r, targets, target_count, row, &dec, &initialized, &ci);
         if (rv == EXR_ERR_OUT_OF_MEMORY) {
             // The decoders also say "out of memory" for corrupt compressed data
             // (found by fuzzing: a B44A chunk): it is one only if a buffer twice
@@ -448,6 +460,72 @@ static wx_result reader_decode(exr_reader *r, const char *path, const read_targe
     return result;
 }
 
+// The chunks of one read, decoded by the workers of wx_parallel_for: each
+// worker has its own pipeline; every chunk writes its own rows of the planes.
+typedef struct decode_batch {
+    exr_reader *r;
+    const read_target *targets;
+    int target_count;
+    int32_t lines;
+    exr_decode_pipeline_t *pipelines; // one per worker
+    bool *initialized;
+    _Atomic bool failed;
+} decode_batch;
+
+static void decode_chunks(int64_t begin, int64_t end, int worker, void *context)
+{
+    decode_batch *b = context;
+    for (int64_t k = begin; k < end && !atomic_load(&b->failed); ++k) {
+        exr_chunk_info_t ci;
+        exr_result_t rv = decode_chunk(b->r, b->targets, b->target_count, k * b->lines,
+                                       &b->pipelines[worker], &b->initialized[worker], &ci);
+        if (rv != EXR_ERR_SUCCESS) {
+            atomic_store(&b->failed, true);
+        }
+    }
+}
+
+// Decodes every chunk of part 0 into the targets, on `threads` workers; the
+// planes are the same for any count. A failure is decoded again in order on
+// one thread, which gives the message a serial read gives.
+static wx_result reader_decode(exr_reader *r, const char *path, const read_target *targets,
+                               int target_count, int threads, wx_error *err)
+{
+    int32_t lines = 0;
+    if (exr_get_scanlines_per_chunk(r->ctx, 0, &lines) != EXR_ERR_SUCCESS || lines <= 0) {
+        return wx_fail(err, WX_CAUSE_BAD_MAP, "%s: corrupt OpenEXR header", path);
+    }
+    int64_t chunks = (r->height + lines - 1) / lines;
+    if (threads <= 1 || chunks < 2) {
+        return decode_serial(r, path, targets, target_count, lines, err);
+    }
+    threads = chunks < threads ? (int)chunks : threads;
+    decode_batch b = { .r = r, .targets = targets, .target_count = target_count, .lines = lines };
+    b.pipelines = malloc((size_t)threads * sizeof *b.pipelines);
+    b.initialized = calloc((size_t)threads, sizeof *b.initialized);
+    if (b.pipelines == NULL || b.initialized == NULL) {
+        free(b.pipelines);
+        free(b.initialized);
+        return decode_serial(r, path, targets, target_count, lines, err);
+    }
+    for (int w = 0; w < threads; ++w) {
+        b.pipelines[w] = (exr_decode_pipeline_t)EXR_DECODE_PIPELINE_INITIALIZER;
+    }
+    atomic_init(&b.failed, false);
+    r->stream.quiet = true;
+    wx_parallel_for(threads, chunks, 1, decode_chunks, &b);
+    r->stream.quiet = false;
+    for (int w = 0; w < threads; ++w) {
+        if (b.initialized[w]) {
+            exr_decoding_destroy(r->ctx, &b.pipelines[w]);
+        }
+    }
+    bool failed = atomic_load(&b.failed);
+    free(b.pipelines);
+    free(b.initialized);
+    return failed ? decode_serial(r, path, targets, target_count, lines, err) : WX_OK;
+}
+
 // reader_open, then the channel list of part 0.
 static wx_result reader_open_channels(exr_reader *r, const char *path,
                                       const exr_attr_chlist_t **chlist, wx_error *err)
@@ -468,7 +546,8 @@ static wx_result reader_open_channels(exr_reader *r, const char *path,
 // Reads the wanted channels of `path`. With `planar`, each channel into its own plane
 // out->channels[i]; otherwise into one interleaved buffer returned in *interleaved.
 static wx_result read_channels(const char *path, const char *const *wanted, int wanted_count,
-                               bool planar, wx_image *out, float **interleaved, wx_error *err)
+                               bool planar, int threads, wx_image *out, float **interleaved,
+                               wx_error *err)
 {
     if (wanted == NULL || wanted_count < 1 || wanted_count > WX_IMAGE_MAX_CHANNELS) {
         return wx_fail(err, WX_CAUSE_INTERNAL, "%s: cannot read %d channels (1 to %d)", path,
@@ -537,7 +616,7 @@ static wx_result read_channels(const char *path, const char *const *wanted, int 
         }
     }
     if (result == WX_OK) {
-        result = reader_decode(&r, path, targets, wanted_count, err);
+        result = reader_decode(&r, path, targets, wanted_count, threads, err);
     }
     if (result == WX_OK) {
         out->width = r.width;
@@ -577,8 +656,14 @@ wx_result wx_exr_read_header(const char *path, wx_image *out, wx_error *err)
 wx_result wx_exr_read(const char *path, const char *const *wanted, int wanted_count, wx_image *out,
                       wx_error *err)
 {
+    return wx_exr_read_parallel(path, wanted, wanted_count, 1, out, err);
+}
+
+wx_result wx_exr_read_parallel(const char *path, const char *const *wanted, int wanted_count,
+                               int threads, wx_image *out, wx_error *err)
+{
     memset(out, 0, sizeof *out);
-    wx_result result = read_channels(path, wanted, wanted_count, true, out, NULL, err);
+    wx_result result = read_channels(path, wanted, wanted_count, true, threads, out, NULL, err);
     if (result != WX_OK) {
         wx_image_free(out);
     }
@@ -586,8 +671,8 @@ wx_result wx_exr_read(const char *path, const char *const *wanted, int wanted_co
 }
 
 wx_result wx_exr_read_interleaved(const char *path, const char *const *wanted, int wanted_count,
-                                  float **out_texels, int *out_width, int *out_height,
-                                  wx_error *err)
+                                  int threads, float **out_texels, int *out_width,
+                                  int *out_height, wx_error *err)
 {
     *out_texels = NULL;
     *out_width = 0;
@@ -598,7 +683,8 @@ wx_result wx_exr_read_interleaved(const char *path, const char *const *wanted, i
     }
     memset(info, 0, sizeof *info);
     float *texels = NULL;
-    wx_result result = read_channels(path, wanted, wanted_count, false, info, &texels, err);
+    wx_result result =
+        read_channels(path, wanted, wanted_count, false, threads, info, &texels, err);
     if (result == WX_OK) {
         *out_texels = texels;
         *out_width = info->width;
@@ -842,6 +928,9 @@ static wx_result write_body(exr_stream *s, const char *path, const char *tmp_pat
     if (rv == EXR_ERR_SUCCESS) {
         rv = exr_initialize_required_attr_simple(ctx, part, image->width, image->height,
                                                  exr_compression(image->compression));
+    }
+    if (rv == EXR_ERR_SUCCESS && image->zip_level >= 1 && image->zip_level <= 9) {
+        rv = exr_set_zip_compression_level(ctx, part, image->zip_level);
     }
     for (int c = 0; rv == EXR_ERR_SUCCESS && c < image->channel_count; c++) {
         rv = (exr_result_t)exr_add_channel(ctx, part, image->channel_names[c], EXR_PIXEL_FLOAT,

@@ -27,12 +27,18 @@ wx_result wx_exr_read_header(const char *path, wx_image *out, wx_error *err);
 wx_result wx_exr_read(const char *path, const char *const *wanted, int wanted_count,
                       wx_image *out, wx_error *err);
 
+/// wx_exr_read with the chunks decoded on `threads` workers (<= 1: the calling
+/// thread): the same planes and the same messages for any count.
+wx_result wx_exr_read_parallel(const char *path, const char *const *wanted, int wanted_count,
+                               int threads, wx_image *out, wx_error *err);
+
 /// Like wx_exr_read, but into one malloc'd buffer of wanted_count floats per texel,
 /// interleaved in `wanted` order: channel c of texel (i, j) is at
-/// (j*width + i)*wanted_count + c. The caller frees *out_texels with free().
+/// (j*width + i)*wanted_count + c, its chunks decoded on `threads` workers. The
+/// caller frees *out_texels with free().
 wx_result wx_exr_read_interleaved(const char *path, const char *const *wanted, int wanted_count,
-                                  float **out_texels, int *out_width, int *out_height,
-                                  wx_error *err);
+                                  int threads, float **out_texels, int *out_width,
+                                  int *out_height, wx_error *err);
 
 /// Writes every channel of `image` as float32 with image->compression (ZIP
 /// unless set), plus its attributes, atomically (temporary ".<name>.tmp<pid>"

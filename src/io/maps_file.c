@@ -10,10 +10,13 @@
 #include "io/exr.h"
 
 // The first loaded map fixes the size; every other one must match it.
+// What the maps of one camera share: the size of the first (all must have it)
+// and the workers that decode each file's chunks.
 typedef struct size_check {
     const char *first_path;
     int width;
     int height;
+    int threads;
 } size_check;
 
 static wx_result check_size(size_check *check, const char *path, int width, int height,
@@ -71,7 +74,8 @@ static wx_result load_interleaved(const char *path, const char *const *channels,
 {
     int width = 0;
     int height = 0;
-    wx_result result = wx_exr_read_interleaved(path, channels, count, out, &width, &height, err);
+    wx_result result = wx_exr_read_interleaved(path, channels, count, check->threads, out, &width,
+                                               &height, err);
     if (result == WX_OK) {
         result = check_size(check, path, width, height, err);
     }
@@ -94,12 +98,12 @@ static wx_result load_finite(const char *path, const char *what, const char *con
     return result;
 }
 
-wx_result wx_maps_load(wx_maps *maps, unsigned which, const char *depth_path,
+wx_result wx_maps_load(wx_maps *maps, unsigned which, int threads, const char *depth_path,
                        const char *normal_path, const char *impact_path, const char *dirt_path,
                        wx_error *err)
 {
     memset(maps, 0, sizeof *maps);
-    size_check check = {NULL, 0, 0};
+    size_check check = { NULL, 0, 0, threads };
     wx_result result = WX_OK;
 
     if (wanted(which, WX_MAPS_DEPTH)) {
@@ -143,7 +147,7 @@ wx_result wx_maps_load(wx_maps *maps, unsigned which, const char *depth_path,
             }
         }
         if (result == WX_OK) {
-            result = wx_exr_read(dirt_path, channels, channel_count, image, err);
+            result = wx_exr_read_parallel(dirt_path, channels, channel_count, threads, image, err);
             if (result == WX_OK) {
                 // Take the planes over from the image.
                 float **planes[5] = { &maps->dirt, &maps->deposit, &maps->erosion,

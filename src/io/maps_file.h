@@ -30,8 +30,9 @@ enum {
 
 /// Loads the maps selected by `which` from the given paths (NULL or "" for a map
 /// not wanted). Depth reads channel R or Z, normal R G B, impact R G, dirt R G B.
-/// All loaded maps must have the same size; a mismatch names both files.
-wx_result wx_maps_load(wx_maps *maps, unsigned which, const char *depth_path,
+/// All loaded maps must have the same size; a mismatch names both files. Each
+/// file's chunks are decoded on `threads` workers (the same maps for any count).
+wx_result wx_maps_load(wx_maps *maps, unsigned which, int threads, const char *depth_path,
                        const char *normal_path, const char *impact_path,
                        const char *dirt_path, wx_error *err);
 

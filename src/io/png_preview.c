@@ -112,6 +112,8 @@ static bool write_rows(png_writer *w)
     png_set_IHDR(w->png, w->info, (png_uint_32)w->width, (png_uint_32)w->height, 8,
                  w->channels == 2 ? PNG_COLOR_TYPE_GRAY_ALPHA : PNG_COLOR_TYPE_RGB,
                  PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+    // The preview is for looking: the fastest zlib level (docs/performance.md).
+    png_set_compression_level(w->png, 1);
     png_write_info(w->png, w->info);
     size_t row = (size_t)w->channels * (size_t)w->width;
     for (int j = 0; j < w->height; ++j) {

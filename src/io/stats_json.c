@@ -34,6 +34,9 @@ wx_result wx_write_stats(const char *path, const wx_sim_stats *stats, const wx_p
         "    \"gather\": %.6f,\n"
         "    \"total\": %.6f\n"
         "  },\n"
+        "  \"simulate_seconds\": { \"read\": %.6f, \"setup\": %.6f, \"steps\": %.6f, "
+        "\"write\": %.6f },\n"
+        "  \"gather_seconds\": { \"read\": %.6f, \"compute\": %.6f, \"write\": %.6f },\n"
         "  \"threads\": %d,\n"
         "  \"seed\": %llu\n"
         "}\n",
@@ -43,7 +46,10 @@ wx_result wx_write_stats(const char *path, const wx_sim_stats *stats, const wx_p
         (long long)stats->alive, stats->dirt_initial_surface,
         stats->dirt_emitted, stats->dirt_final_surface, stats->dirt_in_flight,
         stats->dirt_escaped, times->load, times->bake, times->simulate, times->gather,
-        times->total, threads, (unsigned long long)seed);
+        times->total, times->simulate_detail.read, times->simulate_detail.setup,
+        times->simulate_detail.compute, times->simulate_detail.write, times->gather_detail.read,
+        times->gather_detail.compute, times->gather_detail.write, threads,
+        (unsigned long long)seed);
     if (n < 0 || n >= (int)sizeof json) {
         return wx_fail(err, WX_CAUSE_INTERNAL, "%s: statistics too long", path);
     }

@@ -41,6 +41,9 @@ typedef struct wx_image {
     /// Threads that compress the chunks in wx_exr_write (<= 1: the calling
     /// thread only); the file's bytes are the same for every count.
     int threads;
+    /// zlib level of ZIP and ZIPS, 1 (fastest) to 9 (smallest); 0: OpenEXR's
+    /// default (4). The maps the pipeline writes for itself use 1.
+    int zip_level;
     int channel_count;
     char channel_names[WX_IMAGE_MAX_CHANNELS][WX_NAME_MAX];
     float *channels[WX_IMAGE_MAX_CHANNELS];

@@ -68,7 +68,7 @@ typedef enum wx_second_pass {
 /// The adaptive smoothing's defaults: the relative noise aimed at, and the
 /// largest radius in output texels.
 #define WX_DEFAULT_NOISE 0.04f
-#define WX_DEFAULT_MAX_RADIUS_TEXELS 24.0f
+#define WX_DEFAULT_MAX_RADIUS_TEXELS 16.0f
 
 /// An <Ortho> camera with its maps.
 typedef struct wx_scene_camera {

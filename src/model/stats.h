@@ -23,6 +23,16 @@ typedef struct wx_sim_stats {
     double dirt_escaped;
 } wx_sim_stats;
 
+/// Wall-clock seconds of the parts of a phase: reading its inputs, setting up
+/// (the simulation's collider and dirt maps), computing (the steps, the
+/// gather's passes) and writing its files.
+typedef struct wx_phase_detail {
+    double read;
+    double setup;
+    double compute;
+    double write;
+} wx_phase_detail;
+
 /// Wall-clock seconds per phase.
 typedef struct wx_phase_times {
     double load;
@@ -30,6 +40,8 @@ typedef struct wx_phase_times {
     double simulate;
     double gather;
     double total;
+    wx_phase_detail simulate_detail;
+    wx_phase_detail gather_detail;
 } wx_phase_times;
 
 #endif

@@ -68,6 +68,7 @@ static wx_result write_maps(int camera, wx_image *maps, int count, void *user, w
         wx_image_set_m44f(&maps[k], "WTCMatrix", sc->camera.wtc);
         wx_image_set_m44f(&maps[k], "CTWMatrix", sc->camera.ctw);
         wx_image_set_string(&maps[k], "cameraName", sc->name);
+        maps[k].zip_level = 1; // the pipeline's own intermediates: the fastest zlib
         f->image = &maps[k];
         f->result = WX_OK;
     }
@@ -109,7 +110,7 @@ static wx_result read_given_depths(const wx_scene *scene, const wx_geometry *geo
         if (sc->is_output || (sc->has_view && !wx_has_path(sc->depth_path))) {
             continue; // the output camera has no dirt; a baked camera renders its own
         }
-        wx_result r = wx_maps_load(&maps[c], WX_MAPS_DEPTH, sc->depth_path, NULL, NULL, NULL,
+        wx_result r = wx_maps_load(&maps[c], WX_MAPS_DEPTH, 1, sc->depth_path, NULL, NULL, NULL,
                                    err);
         if (r != WX_OK) {
             return r;

@@ -11,6 +11,7 @@
 #include "io/maps_file.h"
 #include "io/png_preview.h"
 #include "pipeline/load.h"
+#include "core/progress.h"
 #include "pipeline/outputs.h"
 
 wx_result wx_gather_scene(const wx_scene *scene, const wx_run_def *opts, wx_error *err)
@@ -22,7 +23,7 @@ wx_result wx_gather_scene(const wx_scene *scene, const wx_run_def *opts, wx_erro
     }
     wx_result result = wx_load_gather_maps(scene, opts, in_maps, err);
     if (result == WX_OK) {
-        result = wx_gather_maps(scene, opts, in_maps, err);
+        result = wx_gather_maps(scene, opts, in_maps, NULL, err);
     }
     for (int c = 0; c < input_count; ++c) {
         wx_maps_free(&in_maps[c]);
@@ -53,8 +54,12 @@ wx_result wx_gather_check(const wx_scene *scene, wx_error *err)
 }
 
 wx_result wx_gather_maps(const wx_scene *scene, const wx_run_def *opts, const wx_maps *in_maps,
-                         wx_error *err)
+                         wx_phase_detail *detail, wx_error *err)
 {
+    wx_phase_detail local;
+    detail = detail != NULL ? detail : &local;
+    memset(detail, 0, sizeof *detail);
+    double t0 = wx_now_s();
     if (scene->output_index < 0 || scene->output_index >= scene->camera_count) {
         return wx_fail(err, WX_CAUSE_MISSING,
                        "%s: no output camera (an <Ortho out=\"true\">); gather needs one",
@@ -82,7 +87,7 @@ wx_result wx_gather_maps(const wx_scene *scene, const wx_run_def *opts, const wx
         return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "gather: out of memory");
     }
 
-    result = wx_maps_load(&out_maps, WX_MAPS_DEPTH | WX_MAPS_NORMAL, out->depth_path,
+    result = wx_maps_load(&out_maps, WX_MAPS_DEPTH | WX_MAPS_NORMAL, opts->threads, out->depth_path,
                           out->normal_path, NULL, NULL, err);
     if (result != WX_OK) {
         wx_error_prefix(err, "output camera '%s'", out->name);
@@ -101,6 +106,8 @@ wx_result wx_gather_maps(const wx_scene *scene, const wx_run_def *opts, const wx
             k++;
         }
     }
+    double t1 = wx_now_s();
+    detail->read = t1 - t0;
     if (result == WX_OK) {
         static const char *const names[] = { "Y" };
         result = wx_image_alloc(image, out_maps.width, out_maps.height, 1, names, err);
@@ -118,8 +125,20 @@ wx_result wx_gather_maps(const wx_scene *scene, const wx_run_def *opts, const wx
         def.normalize = out->normalize;
         def.threads = opts->threads;
         def.quiet = opts->quiet;
-        result = wx_gather_compute(&def, image->channels[0], NULL, err);
+        wx_gather_stats st;
+        result = wx_gather_compute(&def, image->channels[0], &st, err);
+        if (result == WX_OK && def.adaptive && st.surface_texels > 0 &&
+            10 * st.capped_texels > st.surface_texels) {
+            wx_note(opts->quiet,
+                    "gather: %.0f%% of the mask's surface holds fewer than the %.0f impacts "
+                    "within maxRadius (%g m) that %g%% noise needs: it stays noisier; fly more "
+                    "particles or raise maxRadius",
+                    100.0 * (double)st.capped_texels / (double)st.surface_texels, st.target_hits,
+                    (double)out->max_radius, 100.0 * (double)out->noise);
+        }
     }
+    double t2 = wx_now_s();
+    detail->compute = t2 - t1;
     if (result == WX_OK) {
         float m[16];
         wx_mask_world_to_camera(&out->camera, m);
@@ -136,6 +155,7 @@ wx_result wx_gather_maps(const wx_scene *scene, const wx_run_def *opts, const wx
         result = wx_preview_write_png(png_path, image->channels[0], out_maps.depth,
                                       out_maps.width, out_maps.height, err);
     }
+    detail->write = wx_now_s() - t2;
 
     wx_image_free(image);
     free(image);

@@ -7,6 +7,7 @@
 #include "core/error.h"
 #include "model/maps.h"
 #include "model/scene.h"
+#include "model/stats.h"
 #include "pipeline/pipeline.h"
 
 /// Checks what the gather would refuse about the scene, before any work: the
@@ -25,8 +26,9 @@ wx_result wx_gather_scene(const wx_scene *scene, const wx_run_def *opts, wx_erro
 
 /// The `gather` phase with the input cameras' maps already in memory (one per
 /// input camera in scene order: depth, normal and the dirt to gather): reads
-/// the output camera's maps, computes and writes the mask and its preview.
+/// the output camera's maps, computes and writes the mask and its preview;
+/// `detail` (may be NULL) gets the read, compute and write times.
 wx_result wx_gather_maps(const wx_scene *scene, const wx_run_def *opts, const wx_maps *in_maps,
-                         wx_error *err);
+                         wx_phase_detail *detail, wx_error *err);
 
 #endif

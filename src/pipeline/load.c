@@ -12,7 +12,8 @@
 #include "io/exr.h"
 #include "io/maps_file.h"
 
-wx_result wx_load_simulation_maps(const wx_scene *scene, wx_maps *maps, wx_error *err)
+wx_result wx_load_simulation_maps(const wx_scene *scene, int threads, wx_maps *maps,
+                                  wx_error *err)
 {
     int k = 0;
     for (int c = 0; c < scene->camera_count; ++c) {
@@ -31,7 +32,7 @@ wx_result wx_load_simulation_maps(const wx_scene *scene, wx_maps *maps, wx_error
             // started from (channel initialDirt), so running again is repeatable.
             which |= WX_MAPS_DIRT | WX_MAPS_INITIAL_DIRT;
         }
-        wx_result r = wx_maps_load(&maps[k], which, cam->depth_path, cam->normal_path,
+        wx_result r = wx_maps_load(&maps[k], which, threads, cam->depth_path, cam->normal_path,
                                    cam->impact_path, cam->dirt_path, err);
         if (r != WX_OK) {
             wx_error_prefix(err, "camera '%s'", cam->name);
@@ -98,7 +99,7 @@ wx_result wx_load_gather_maps(const wx_scene *scene, const wx_run_def *opts, wx_
         } else {
             which |= WX_MAPS_SIMULATED;
         }
-        wx_result r = wx_maps_load(&maps[k], which, cam->depth_path, cam->normal_path, NULL,
+        wx_result r = wx_maps_load(&maps[k], which, opts->threads, cam->depth_path, cam->normal_path, NULL,
                                    dirt_path, err);
         if (r != WX_OK) {
             wx_error_prefix(err, "camera '%s'", cam->name);

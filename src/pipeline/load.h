@@ -13,7 +13,8 @@
 /// impact and, when the camera has one, its dirt map (from the channel
 /// initialDirt when an earlier `simulate` wrote it, so a second run starts
 /// where the first started). Errors name the camera and the file.
-wx_result wx_load_simulation_maps(const wx_scene *scene, wx_maps *maps, wx_error *err);
+wx_result wx_load_simulation_maps(const wx_scene *scene, int threads, wx_maps *maps,
+                                  wx_error *err);
 
 /// Loads the maps of every input camera as the gather reads them: depth,
 /// normal, and the dirt `simulate` left in the output folder

@@ -123,7 +123,7 @@ wx_result wx_pilot_run(const wx_scene *scene, const wx_run_def *opts, wx_geometr
         if (maps[k].depth == NULL) { // maps the scene gives as files
             unsigned which = WX_MAPS_DEPTH | WX_MAPS_NORMAL | WX_MAPS_IMPACT |
                              (wx_has_path(sc->dirt_path) ? WX_MAPS_DIRT | WX_MAPS_INITIAL_DIRT : 0);
-            r = wx_maps_load(&maps[k], which, sc->depth_path, sc->normal_path, sc->impact_path,
+            r = wx_maps_load(&maps[k], which, opts->threads, sc->depth_path, sc->normal_path, sc->impact_path,
                              sc->dirt_path, err);
         }
         k++;

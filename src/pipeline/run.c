@@ -82,11 +82,14 @@ wx_result wx_run_phases(wx_scene *scene, const wx_run_def *opts, unsigned phases
     if (r == WX_OK && (phases & WX_PHASE_SIMULATE)) {
         double t0 = wx_now_s();
         maps = calloc((size_t)scene->input_count + 1, sizeof *maps);
-        r = maps != NULL ? wx_load_simulation_maps(scene, maps, err)
+        r = maps != NULL ? wx_load_simulation_maps(scene, opts->threads, maps, err)
                          : wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (maps)");
+        double t1 = wx_now_s();
         if (r == WX_OK) {
-            r = wx_simulate_maps(scene, opts, maps, &report->stats, err);
+            r = wx_simulate_maps(scene, opts, maps, &report->stats,
+                                 &report->times.simulate_detail, err);
         }
+        report->times.simulate_detail.read = t1 - t0;
         const wx_sim_stats *st = &report->stats;
         if (r == WX_OK && scene->emitter_count > 0 && st->collisions == 0) {
             wx_warn(opts->quiet,
@@ -108,8 +111,19 @@ wx_result wx_run_phases(wx_scene *scene, const wx_run_def *opts, unsigned phases
     }
     if (r == WX_OK && (phases & WX_PHASE_GATHER)) {
         double t0 = wx_now_s();
-        r = maps != NULL ? wx_gather_maps(scene, opts, maps, err)
-                         : wx_gather_scene(scene, opts, err);
+        if (maps != NULL) {
+            r = wx_gather_maps(scene, opts, maps, &report->times.gather_detail, err);
+        } else {
+            wx_maps *in = calloc((size_t)scene->input_count + 1, sizeof *in);
+            r = in != NULL ? wx_load_gather_maps(scene, opts, in, err)
+                           : wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (maps)");
+            double t1 = wx_now_s();
+            if (r == WX_OK) {
+                r = wx_gather_maps(scene, opts, in, &report->times.gather_detail, err);
+            }
+            report->times.gather_detail.read += t1 - t0;
+            free_maps(in, scene->input_count);
+        }
         report->times.gather = wx_now_s() - t0;
     }
     free_maps(maps, scene->input_count);

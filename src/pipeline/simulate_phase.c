@@ -56,6 +56,7 @@ static wx_result write_one(const wx_scene *scene, const wx_run_def *opts, const 
         wx_image_set_string(image, "cameraName", cam->name);
     }
     image->threads = opts->threads; // compresses chunks in parallel: same bytes
+    image->zip_level = 1;           // the pipeline's own intermediate: the fastest zlib
     r = wx_exr_write(path, image, err);
     wx_image_free(image);
     return r;
@@ -82,14 +83,19 @@ wx_result wx_write_dirt_maps(const wx_scene *scene, const wx_run_def *opts, cons
 }
 
 wx_result wx_simulate_maps(const wx_scene *scene, const wx_run_def *opts, wx_maps *maps,
-                           wx_sim_stats *stats, wx_error *err)
+                           wx_sim_stats *stats, wx_phase_detail *detail, wx_error *err)
 {
+    wx_phase_detail local;
+    detail = detail != NULL ? detail : &local;
+    double t0 = wx_now_s();
     wx_sim_def config = wx_default_sim_def(scene);
     config.seed = opts->seed;
     config.threads = opts->threads;
     config.maps = maps;
     wx_sim *sim = NULL;
     wx_result r = wx_sim_create(scene, &config, &sim, err);
+    double t1 = wx_now_s();
+    detail->setup = t1 - t0;
     if (r != WX_OK) {
         return r;
     }
@@ -100,9 +106,12 @@ wx_result wx_simulate_maps(const wx_scene *scene, const wx_run_def *opts, wx_map
         wx_progress_update(&progress, s + 1);
     }
     wx_progress_end(&progress);
+    double t2 = wx_now_s();
+    detail->compute = t2 - t1;
     if (r == WX_OK) {
         r = wx_write_dirt_maps(scene, opts, sim, maps, err);
     }
+    detail->write = wx_now_s() - t2;
     if (stats != NULL) {
         wx_sim_get_stats(sim, stats);
     }
@@ -145,9 +154,9 @@ wx_result wx_simulate_scene(const wx_scene *scene, const wx_run_def *opts,
     if (maps == NULL) {
         return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (maps)");
     }
-    wx_result r = wx_load_simulation_maps(scene, maps, err);
+    wx_result r = wx_load_simulation_maps(scene, opts->threads, maps, err);
     if (r == WX_OK) {
-        r = wx_simulate_maps(scene, opts, maps, stats, err);
+        r = wx_simulate_maps(scene, opts, maps, stats, NULL, err);
     }
     for (int c = 0; c < scene->input_count; ++c) {
         wx_maps_free(&maps[c]);

@@ -204,7 +204,7 @@ static bool maps_world_finish(maps_world *w)
         if (sc->is_output) {
             continue;
         }
-        if (wx_maps_load(&w->maps[w->count], WX_MAPS_DEPTH | WX_MAPS_NORMAL | WX_MAPS_IMPACT,
+        if (wx_maps_load(&w->maps[w->count], WX_MAPS_DEPTH | WX_MAPS_NORMAL | WX_MAPS_IMPACT, 1,
                          sc->depth_path, sc->normal_path, sc->impact_path, NULL,
                          &err) != WX_OK) {
             fprintf(stderr, "bench_embree: %s\n", err.message);

@@ -48,7 +48,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         return 0;
     }
     wx_maps maps;
-    r = wx_maps_load(&maps, WX_MAPS_ALL | WX_MAPS_INITIAL_DIRT, fuzz_input, fuzz_input,
+    r = wx_maps_load(&maps, WX_MAPS_ALL | WX_MAPS_INITIAL_DIRT, 1, fuzz_input, fuzz_input,
                      fuzz_input, fuzz_input, &err);
     if (r != WX_OK) {
         check_error(r, &err);
