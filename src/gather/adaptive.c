@@ -141,9 +141,12 @@ static void half_rect(int i, int j, int k, int side, int r[4])
 }
 
 // Whether texel (i, j), holding no impact of its own, lies in a clean region:
-// on some side the largest empty half-rectangle covers enough surface texels
-// that `density` (impacts per texel) would have put CLEAN_EXPECTED there.
-static bool is_clean(const job *jb, int i, int j, double density, int k_max)
+// on some side the largest empty half-rectangle reaches at least k_min texels
+// out and covers enough surface texels that `density` (impacts per texel) would
+// have put CLEAN_EXPECTED there. k_min (half the texel's radius) keeps the
+// sparse fringe of a dense region, where empty pockets are small next to the
+// radius, from being cut out of the mask.
+static bool is_clean(const job *jb, int i, int j, double density, int k_min, int k_max)
 {
     for (int side = 0; side < 4; ++side) {
         int r[4];
@@ -164,7 +167,7 @@ static bool is_clean(const job *jb, int i, int j, double density, int k_max)
         }
         half_rect(i, j, lo, side, r);
         double surface = rect_sum(jb, jb->sat_surface, r[0], r[1], r[2], r[3]);
-        if (density * surface >= CLEAN_EXPECTED) {
+        if (lo >= k_min && density * surface >= CLEAN_EXPECTED) {
             return true;
         }
     }
@@ -210,7 +213,8 @@ static void radii_row(const job *jb, int j)
         if (own < EMPTY_IMPACTS) {
             double texels = 3.14159265358979323846 * (h / jb->texel_i) * (h / jb->texel_j);
             double density = impacts_within(jb, i, j, h) / texels;
-            jb->clean[t] = is_clean(jb, i, j, density, k_max);
+            int k_min = (int)ceil(0.5 * h / fmax(jb->texel_i, jb->texel_j));
+            jb->clean[t] = is_clean(jb, i, j, density, k_min, k_max);
         }
     }
 }
