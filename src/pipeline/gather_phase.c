@@ -11,6 +11,7 @@
 #include "io/maps_file.h"
 #include "io/png_preview.h"
 #include "pipeline/load.h"
+#include "core/parallel.h"
 #include "core/progress.h"
 #include "pipeline/outputs.h"
 
@@ -51,6 +52,27 @@ wx_result wx_gather_check(const wx_scene *scene, wx_error *err)
                         out->name);
     }
     return r;
+}
+
+// The two files of a mask: item 0 the EXR, item 1 the PNG preview.
+typedef struct mask_files {
+    const wx_image *image;
+    const char *mask_path, *png_path;
+    const float *depth;
+    wx_result result[2];
+    wx_error err[2];
+} mask_files;
+
+static void write_mask_files(int64_t begin, int64_t end, int worker, void *context)
+{
+    (void)worker;
+    mask_files *f = context;
+    for (int64_t k = begin; k < end; ++k) {
+        f->result[k] = k == 0 ? wx_exr_write(f->mask_path, f->image, &f->err[k])
+                              : wx_preview_write_png(f->png_path, f->image->channels[0], f->depth,
+                                                     f->image->width, f->image->height,
+                                                     &f->err[k]);
+    }
 }
 
 wx_result wx_gather_maps(const wx_scene *scene, const wx_run_def *opts, const wx_maps *in_maps,
@@ -148,12 +170,16 @@ wx_result wx_gather_maps(const wx_scene *scene, const wx_run_def *opts, const wx
         wx_image_set_m44f(image, "WTCMatrix", out->camera.wtc);
         wx_image_set_m44f(image, "CTWMatrix", out->camera.ctw);
         wx_image_set_string(image, "cameraName", out->name);
-        image->threads = opts->threads; // compresses chunks in parallel: same bytes
-        result = wx_exr_write(mask_path, image, err);
-    }
-    if (result == WX_OK) {
-        result = wx_preview_write_png(png_path, image->channels[0], out_maps.depth,
-                                      out_maps.width, out_maps.height, err);
+        // The mask and its preview are written side by side (the mask's chunks
+        // on the other workers when there are more than two): the same bytes.
+        mask_files files = { .image = image, .mask_path = mask_path, .png_path = png_path,
+                             .depth = out_maps.depth };
+        image->threads = opts->threads > 2 ? opts->threads - 1 : 1;
+        wx_parallel_for(opts->threads > 1 ? 2 : 1, 2, 1, write_mask_files, &files);
+        result = files.result[0] != WX_OK ? files.result[0] : files.result[1];
+        if (result != WX_OK && err != NULL) {
+            *err = files.result[0] != WX_OK ? files.err[0] : files.err[1];
+        }
     }
     detail->write = wx_now_s() - t2;
 
