@@ -3,6 +3,7 @@
 // each camera's maps written as they come.
 #include "pipeline/bake_phase.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -27,6 +28,7 @@ typedef struct map_file {
 typedef struct bake_writer {
     wx_scene *scene;
     const wx_run_def *opts;
+    wx_maps *output_maps; ///< when not NULL: the output camera's depth and normal kept
     bool prepared; ///< the output folder exists (made with the first camera's maps)
     map_file files[4];
 } bake_writer;
@@ -40,6 +42,33 @@ static void write_files(int64_t begin, int64_t end, int worker, void *context)
         map_file *f = &w->files[k];
         f->result = wx_exr_write(f->path, f->image, &f->err);
     }
+}
+
+// The output camera's depth and normal as the gather reads them (depth +inf
+// where there is no surface, normals interleaved), so a run need not read its
+// own files back.
+static wx_result keep_output_maps(const wx_image *depth, const wx_image *normal, wx_maps *out,
+                                  wx_error *err)
+{
+    int w = depth->width, h = depth->height;
+    size_t texels = (size_t)w * (size_t)h;
+    memset(out, 0, sizeof *out);
+    out->depth = malloc(texels * sizeof *out->depth);
+    out->normal = malloc(3 * texels * sizeof *out->normal);
+    if (out->depth == NULL || out->normal == NULL) {
+        wx_maps_free(out);
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "bake: out of memory");
+    }
+    out->width = w;
+    out->height = h;
+    for (size_t t = 0; t < texels; ++t) {
+        float d = depth->channels[0][t];
+        out->depth[t] = wx_depth_is_empty(d) ? INFINITY : d;
+        for (int k = 0; k < 3; ++k) {
+            out->normal[3 * t + (size_t)k] = normal->channels[k][t];
+        }
+    }
+    return WX_OK;
 }
 
 // wx_bake_maps_fn: names the camera's files, stamps the headers, writes them in
@@ -78,6 +107,12 @@ static wx_result write_maps(int camera, wx_image *maps, int count, void *user, w
             *err = w->files[k].err;
             wx_error_prefix(err, "bake camera '%s'", sc->name);
             return w->files[k].result;
+        }
+    }
+    if (sc->is_output && w->output_maps != NULL) {
+        wx_result r = keep_output_maps(&maps[0], &maps[1], w->output_maps, err);
+        if (r != WX_OK) {
+            return r;
         }
     }
     char **dest[4] = { &sc->depth_path, &sc->normal_path, &sc->impact_path, &sc->dirt_path };
@@ -200,7 +235,7 @@ wx_result wx_bake_geometry_into(const wx_scene *scene, const wx_run_def *opts,
 }
 
 wx_result wx_bake_geometry(wx_scene *scene, const wx_run_def *opts, wx_geometry *geometry,
-                           wx_bake_stats *stats, wx_error *err)
+                           wx_maps *output_maps, wx_bake_stats *stats, wx_error *err)
 {
     bake_writer *writer = calloc(1, sizeof *writer); // four paths: off the stack
     if (writer == NULL) {
@@ -208,6 +243,7 @@ wx_result wx_bake_geometry(wx_scene *scene, const wx_run_def *opts, wx_geometry 
     }
     writer->scene = scene;
     writer->opts = opts;
+    writer->output_maps = output_maps;
     wx_result r = wx_bake_geometry_into(scene, opts, geometry, write_maps, writer, stats, err);
     free(writer);
     return r;
@@ -223,7 +259,7 @@ wx_result wx_bake_scene_stats(wx_scene *scene, const wx_run_def *opts, wx_bake_s
         r = wx_geometry_load(scene, opts->quiet, &geometry, err);
     }
     if (r == WX_OK) {
-        r = wx_bake_geometry(scene, opts, &geometry, stats, err);
+        r = wx_bake_geometry(scene, opts, &geometry, NULL, stats, err);
     }
     wx_geometry_free(&geometry);
     return r;

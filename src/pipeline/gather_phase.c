@@ -11,7 +11,6 @@
 #include "io/maps_file.h"
 #include "io/png_preview.h"
 #include "pipeline/load.h"
-#include "core/parallel.h"
 #include "core/progress.h"
 #include "pipeline/outputs.h"
 
@@ -24,7 +23,7 @@ wx_result wx_gather_scene(const wx_scene *scene, const wx_run_def *opts, wx_erro
     }
     wx_result result = wx_load_gather_maps(scene, opts, in_maps, err);
     if (result == WX_OK) {
-        result = wx_gather_maps(scene, opts, in_maps, NULL, err);
+        result = wx_gather_maps(scene, opts, in_maps, NULL, NULL, err);
     }
     for (int c = 0; c < input_count; ++c) {
         wx_maps_free(&in_maps[c]);
@@ -54,29 +53,8 @@ wx_result wx_gather_check(const wx_scene *scene, wx_error *err)
     return r;
 }
 
-// The two files of a mask: item 0 the EXR, item 1 the PNG preview.
-typedef struct mask_files {
-    const wx_image *image;
-    const char *mask_path, *png_path;
-    const float *depth;
-    wx_result result[2];
-    wx_error err[2];
-} mask_files;
-
-static void write_mask_files(int64_t begin, int64_t end, int worker, void *context)
-{
-    (void)worker;
-    mask_files *f = context;
-    for (int64_t k = begin; k < end; ++k) {
-        f->result[k] = k == 0 ? wx_exr_write(f->mask_path, f->image, &f->err[k])
-                              : wx_preview_write_png(f->png_path, f->image->channels[0], f->depth,
-                                                     f->image->width, f->image->height,
-                                                     &f->err[k]);
-    }
-}
-
 wx_result wx_gather_maps(const wx_scene *scene, const wx_run_def *opts, const wx_maps *in_maps,
-                         wx_phase_detail *detail, wx_error *err)
+                         const wx_maps *given_out, wx_phase_detail *detail, wx_error *err)
 {
     wx_phase_detail local;
     detail = detail != NULL ? detail : &local;
@@ -109,15 +87,18 @@ wx_result wx_gather_maps(const wx_scene *scene, const wx_run_def *opts, const wx
         return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "gather: out of memory");
     }
 
-    result = wx_maps_load(&out_maps, WX_MAPS_DEPTH | WX_MAPS_NORMAL, opts->threads, out->depth_path,
-                          out->normal_path, NULL, NULL, err);
+    const wx_maps *om = given_out != NULL ? given_out : &out_maps;
+    if (given_out == NULL) {
+        result = wx_maps_load(&out_maps, WX_MAPS_DEPTH | WX_MAPS_NORMAL, opts->threads,
+                              out->depth_path, out->normal_path, NULL, NULL, err);
+    }
     if (result != WX_OK) {
         wx_error_prefix(err, "output camera '%s'", out->name);
-    } else if (out_maps.width != out->output_width || out_maps.height != out->output_height) {
+    } else if (om->width != out->output_width || om->height != out->output_height) {
         result = wx_fail(err, WX_CAUSE_MAP_SIZE,
                          "%s: output camera '%s': its maps are %d x %d but <OutputMap> "
                          "asks for %d x %d",
-                         scene->path, out->name, out_maps.width, out_maps.height, out->output_width,
+                         scene->path, out->name, om->width, om->height, out->output_width,
                          out->output_height);
     }
     int k = 0;
@@ -132,11 +113,11 @@ wx_result wx_gather_maps(const wx_scene *scene, const wx_run_def *opts, const wx
     detail->read = t1 - t0;
     if (result == WX_OK) {
         static const char *const names[] = { "Y" };
-        result = wx_image_alloc(image, out_maps.width, out_maps.height, 1, names, err);
+        result = wx_image_alloc(image, om->width, om->height, 1, names, err);
     }
     if (result == WX_OK) {
         wx_gather_def def = wx_default_gather_def();
-        def.target = wx_target_from_camera(&out->camera, &out_maps);
+        def.target = wx_target_from_camera(&out->camera, om);
         def.inputs = views;
         def.input_count = k;
         def.radius = out->radius;
@@ -170,16 +151,12 @@ wx_result wx_gather_maps(const wx_scene *scene, const wx_run_def *opts, const wx
         wx_image_set_m44f(image, "WTCMatrix", out->camera.wtc);
         wx_image_set_m44f(image, "CTWMatrix", out->camera.ctw);
         wx_image_set_string(image, "cameraName", out->name);
-        // The mask and its preview are written side by side (the mask's chunks
-        // on the other workers when there are more than two): the same bytes.
-        mask_files files = { .image = image, .mask_path = mask_path, .png_path = png_path,
-                             .depth = out_maps.depth };
-        image->threads = opts->threads > 2 ? opts->threads - 1 : 1;
-        wx_parallel_for(opts->threads > 1 ? 2 : 1, 2, 1, write_mask_files, &files);
-        result = files.result[0] != WX_OK ? files.result[0] : files.result[1];
-        if (result != WX_OK && err != NULL) {
-            *err = files.result[0] != WX_OK ? files.err[0] : files.err[1];
-        }
+        image->threads = opts->threads; // the chunks compressed in parallel: the same bytes
+        result = wx_exr_write(mask_path, image, err);
+    }
+    if (result == WX_OK) {
+        result = wx_preview_write_png(png_path, image->channels[0], om->depth, om->width,
+                                      om->height, err);
     }
     detail->write = wx_now_s() - t2;
 

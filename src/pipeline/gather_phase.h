@@ -26,9 +26,10 @@ wx_result wx_gather_scene(const wx_scene *scene, const wx_run_def *opts, wx_erro
 
 /// The `gather` phase with the input cameras' maps already in memory (one per
 /// input camera in scene order: depth, normal and the dirt to gather): reads
-/// the output camera's maps, computes and writes the mask and its preview;
+/// the output camera's maps (or takes `out_maps`, its depth and normal, when
+/// not NULL), computes and writes the mask and its preview;
 /// `detail` (may be NULL) gets the read, compute and write times.
 wx_result wx_gather_maps(const wx_scene *scene, const wx_run_def *opts, const wx_maps *in_maps,
-                         wx_phase_detail *detail, wx_error *err);
+                         const wx_maps *out_maps, wx_phase_detail *detail, wx_error *err);
 
 #endif

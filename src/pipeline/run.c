@@ -45,6 +45,8 @@ wx_result wx_run_phases(wx_scene *scene, const wx_run_def *opts, unsigned phases
     wx_geometry geometry;
     memset(&geometry, 0, sizeof geometry);
     wx_maps *maps = NULL;
+    wx_maps output_maps;
+    memset(&output_maps, 0, sizeof output_maps);
     char created[WX_PATH_MAX] = "";
     wx_result r = WX_OK;
     bool bake = (phases & WX_PHASE_BAKE) && mark_baked_cameras(scene);
@@ -72,7 +74,9 @@ wx_result wx_run_phases(wx_scene *scene, const wx_run_def *opts, unsigned phases
     if (r == WX_OK && (phases & WX_PHASE_BAKE)) {
         double t0 = wx_now_s();
         if (bake) {
-            r = wx_bake_geometry(scene, opts, &geometry, NULL, err);
+            // The output camera's maps stay in memory for the gather below.
+            r = wx_bake_geometry(scene, opts, &geometry,
+                                 (phases & WX_PHASE_GATHER) ? &output_maps : NULL, NULL, err);
         } else if (phases == WX_PHASE_BAKE) {
             wx_note(opts->quiet, "%s: every camera has its maps; nothing to bake", scene->path);
         }
@@ -112,14 +116,17 @@ wx_result wx_run_phases(wx_scene *scene, const wx_run_def *opts, unsigned phases
     if (r == WX_OK && (phases & WX_PHASE_GATHER)) {
         double t0 = wx_now_s();
         if (maps != NULL) {
-            r = wx_gather_maps(scene, opts, maps, &report->times.gather_detail, err);
+            r = wx_gather_maps(scene, opts, maps, output_maps.depth != NULL ? &output_maps : NULL,
+                               &report->times.gather_detail, err);
         } else {
             wx_maps *in = calloc((size_t)scene->input_count + 1, sizeof *in);
             r = in != NULL ? wx_load_gather_maps(scene, opts, in, err)
                            : wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (maps)");
             double t1 = wx_now_s();
             if (r == WX_OK) {
-                r = wx_gather_maps(scene, opts, in, &report->times.gather_detail, err);
+                r = wx_gather_maps(scene, opts, in,
+                                   output_maps.depth != NULL ? &output_maps : NULL,
+                                   &report->times.gather_detail, err);
             }
             report->times.gather_detail.read += t1 - t0;
             free_maps(in, scene->input_count);
@@ -127,6 +134,7 @@ wx_result wx_run_phases(wx_scene *scene, const wx_run_def *opts, unsigned phases
         report->times.gather = wx_now_s() - t0;
     }
     free_maps(maps, scene->input_count);
+    wx_maps_free(&output_maps);
     if (r != WX_OK) {
         wx_output_remove_empty(opts->out_dir, created); // a failed run leaves no empty folder
     }
