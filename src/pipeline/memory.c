@@ -77,15 +77,19 @@ void wx_memory_estimate(const wx_scene *scene, unsigned phases, wx_memory_need *
         need->gather_bytes = WX_GATHER_BYTES_PER_INPUT_TEXEL * input_texels +
                              WX_GATHER_BYTES_PER_OUTPUT_TEXEL * output_texels;
     }
-    double sim = need->sim_map_bytes + need->particle_bytes;
+    // The renderer leaves part of its memory behind for the phases after it.
+    double residue = need->bake_bytes > 0.0 ? WX_BAKE_RESIDUE_BYTES : 0.0;
+    double sim = need->sim_map_bytes + need->particle_bytes +
+                 ((phases & WX_PHASE_SIMULATE) ? residue : 0.0);
+    double gather = need->gather_bytes + ((phases & WX_PHASE_GATHER) ? residue : 0.0);
     double peak = need->bake_bytes;
     need->phase = "bake";
     if (sim > peak) {
         peak = sim;
         need->phase = "simulation";
     }
-    if (need->gather_bytes > peak) {
-        peak = need->gather_bytes;
+    if (gather > peak) {
+        peak = gather;
         need->phase = "gather";
     }
     need->total_bytes = need->baseline_bytes + WX_MEMORY_MARGIN * peak;

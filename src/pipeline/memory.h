@@ -31,6 +31,10 @@ typedef struct wx_memory_need {
 #define WX_MEMORY_BASELINE (64.0 * 1024.0 * 1024.0)
 /// The GL context and llvmpipe's own buffers in the bake.
 #define WX_BAKE_CONTEXT_BYTES (40.0 * 1024.0 * 1024.0)
+/// What the renderer (LLVM's code and caches) keeps after the bake, counted in
+/// the phases that follow it in the same run (measured: Spot's run peaks 57 MB
+/// above its gather alone).
+#define WX_BAKE_RESIDUE_BYTES (48.0 * 1024.0 * 1024.0)
 /// Bytes per byte of mesh file while Assimp imports it (measured: about 18 for
 /// OBJ; binary formats hold fewer bytes per triangle).
 #define WX_MESH_BYTES_PER_FILE_BYTE 32.0
@@ -50,11 +54,15 @@ typedef struct wx_memory_need {
 /// Bytes per particle: WX_PARTICLE_BYTES with room for the arrays to double as
 /// they grow, plus the per-step events and candidates of the workers.
 #define WX_BYTES_PER_PARTICLE 192.0
-/// Bytes per input texel in the gather (depth, normal, dirt) and per output
-/// texel (its depth and normal, the mask, the second pass's 5 planes, the
-/// preview's sorted values).
-#define WX_GATHER_BYTES_PER_INPUT_TEXEL 20.0
-#define WX_GATHER_BYTES_PER_OUTPUT_TEXEL 48.0
+/// Bytes per input texel in the gather (depth, normal, and the dirt map's five
+/// channels while it is read) and per output texel (its depth and normal, the
+/// mask, the first pass's three planes, the adaptive smoothing's eight padded
+/// planes, summed-area tables, radii and changes, the preview's sorted values
+/// and pixels, and in a run the output camera's baked depth and normal kept
+/// from the bake; the fixed second pass needs less). Measured: 690 MB for a
+/// 2048-px `gather` with three 2048-px input cameras, estimated 920 MB.
+#define WX_GATHER_BYTES_PER_INPUT_TEXEL 36.0
+#define WX_GATHER_BYTES_PER_OUTPUT_TEXEL 112.0
 /// Margin over the measured sizes (allocator rounding, small buffers).
 #define WX_MEMORY_MARGIN 1.15
 
