@@ -322,7 +322,7 @@ static int command_info(const cli_args *args)
         }
         printf(", %g/s from %g to %g s (%lld particles), speed %g, mass %g, dirt %g, "
                "max collisions %d\n",
-               em->rate, em->start, em->end, (long long)count, em->speed, em->mass, em->dirt,
+               em->rate, em->start, em->end, (long long)count, em->speed, em->mass, em->load[0],
                em->max_collisions);
     }
     printf("force fields (%d):\n", scene.field_count);
@@ -351,8 +351,8 @@ static int command_info(const cli_args *args)
         for (int s = 0; s < mesh->surface_count; ++s) {
             const wx_surface *sf = &mesh->surfaces[s];
             printf("%s material '%s' absorption %g bounce %g dirt %g deposit %g erosion %g",
-                   s ? ";" : "", sf->material, sf->absorption, sf->bounce, sf->dirt,
-                   sf->deposit, sf->erosion);
+                   s ? ";" : "", sf->material, sf->absorption, sf->bounce, sf->initial[0],
+                   sf->deposit[0], sf->erosion[0]);
         }
         printf("\n");
         if (imported) {

@@ -1,7 +1,7 @@
 // bake_frag.glsl: the four maps of docs/design.md section 2 in one pass (src/raster/bake.c).
 //   attachment 0 (RGBA32F): d, world normal x y z (unit, facing the camera)
 //   attachment 1 (RGBA32F): absorption, bounce, deposit, erosion
-//   attachment 2 (R32F):    initial dirt density per square metre
+//   attachment 2 (RG32F):   initial dirt density per square metre, <Surface> index + 1
 // d is computed here from the interpolated position, in float, not read back
 // from the depth buffer.
 #version 450 core
@@ -10,14 +10,14 @@ in vec3 v_position;
 in vec3 v_normal;
 in vec4 v_color;
 flat in vec4 v_material_a; // absorption, bounce, dirt, deposit
-flat in vec2 v_material_b; // erosion, vertex colour use
+flat in vec3 v_material_b; // erosion, vertex colour use, surface index + 1
 
 uniform vec4 u_depth_row;  // d = dot(position, xyz) + w
 uniform vec3 u_view_dir;   // unit viewing direction (towards larger d)
 
 layout(location = 0) out vec4 o_depth_normal;
 layout(location = 1) out vec4 o_impact_dirt;
-layout(location = 2) out float o_dirt_density;
+layout(location = 2) out vec2 o_density_surface;
 
 const float COLORS_IMPACT = 1.0; // wx_color_use
 const float COLORS_DIRT = 2.0;
@@ -42,5 +42,5 @@ void main()
     vec3 dirt = v_material_b.y == COLORS_DIRT ? v_color.rgb
                                               : vec3(v_material_a.z, v_material_a.w, v_material_b.x);
     o_impact_dirt = vec4(impact, dirt.y, dirt.z);
-    o_dirt_density = dirt.x;
+    o_density_surface = vec2(dirt.x, v_material_b.z);
 }

@@ -7,7 +7,7 @@
 // Every vertex belongs to triangles of one material (src/mesh.h), so the
 // material's properties are looked up here, once per vertex, from a buffer
 // texture of two RGBA texels per material: (absorption, bounce, dirt, deposit),
-// (erosion, vertex colour use, 0, 0).
+// (erosion, vertex colour use, global surface index + 1, 0).
 #version 450 core
 
 layout(location = 0) in vec3 a_position;
@@ -23,7 +23,7 @@ out vec3 v_position;
 out vec3 v_normal;
 out vec4 v_color;
 flat out vec4 v_material_a; // absorption, bounce, dirt, deposit
-flat out vec2 v_material_b; // erosion, vertex colour use
+flat out vec3 v_material_b; // erosion, vertex colour use, surface index + 1
 
 void main()
 {
@@ -36,5 +36,5 @@ void main()
     v_color = a_color;
     int m = int(a_material);
     v_material_a = texelFetch(u_material_props, 2 * m);
-    v_material_b = texelFetch(u_material_props, 2 * m + 1).xy;
+    v_material_b = texelFetch(u_material_props, 2 * m + 1).xyz;
 }

@@ -247,7 +247,7 @@ static inline wx_emitter *fx_emitter(fx_scene *f, wx_emitter_kind kind, float x,
     e->end = 1e30;
     e->speed = 1;
     e->mass = 1;
-    e->dirt = 1;
+    e->load[0] = 1;
     e->max_collisions = 100;
     return e;
 }

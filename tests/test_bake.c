@@ -45,6 +45,9 @@ static void scene_begin(wx_scene *s)
     wx_scene_set_path(&s->dir, ".");
     snprintf(s->name, sizeof s->name, "scene");
     s->output_index = -1;
+    s->substance_count = 1; // version 1's one substance, as the scene loader sets it
+    snprintf(s->substances[0], sizeof s->substances[0], "dirt");
+    s->iterations = 1;
 }
 
 static wx_scene_camera *add_camera(wx_scene *s, const char *name, const float eye[3],
@@ -102,9 +105,9 @@ static wx_surface *add_surface(wx_mesh *m, const char *material, float absorptio
     snprintf(s->material, sizeof s->material, "%s", material);
     s->absorption = absorption;
     s->bounce = bounce;
-    s->dirt = dirt;
-    s->deposit = deposit;
-    s->erosion = erosion;
+    s->initial[0] = dirt;
+    s->deposit[0] = deposit;
+    s->erosion[0] = erosion;
     s->line = m->line + 1 + m->surface_count;
     return s;
 }

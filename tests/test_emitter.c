@@ -18,7 +18,7 @@ static wx_emitter point_emitter(double rate, double start, double end, float spe
     e.end = end;
     e.speed = speed;
     e.mass = 1;
-    e.dirt = 1;
+    e.load[0] = 1;
     e.max_collisions = 100;
     return e;
 }

@@ -1,5 +1,6 @@
-// test_scene.c: the scene file (docs/design.md section 3): defaults, every attribute,
-// camera matrices, the bad scenes of tests/bad/, entity attacks, and the schema.
+// test_scene.c: the scene file (docs/design.md sections 3, 8, 9, 10): defaults, every
+// attribute, camera matrices, substances, loads, exchanges, iterations and ageing
+// rules, the bad scenes of tests/bad/, entity attacks, and the schema.
 #include <dirent.h>
 #include <errno.h>
 #include <stdlib.h>
@@ -158,7 +159,7 @@ TEST(element_defaults)
         ENSURE(e->center[0] == 0.0f && e->center[1] == 0.0f && e->center[2] == 0.0f);
         ENSURE(e->rate == 1000.0 && e->start == 0.0);
         ENSURE_NEAR(e->end, 10.0, 1e-12); // steps * timeStep = 1000 * 0.01
-        ENSURE(e->speed == 1.0f && e->mass == 1.0f && e->dirt == 1.0f);
+        ENSURE(e->speed == 1.0f && e->mass == 1.0f && e->load[0] == 1.0f);
         ENSURE(e->max_collisions == 100);
     }
     ENSURE(s.emitters[0].kind == WX_EMITTER_POINT && s.emitters[0].radius == 0.0f);
@@ -191,8 +192,8 @@ TEST(element_defaults)
     ENSURE(strcmp(s.meshes[0].path, data_path("box.obj")) == 0);
     const wx_surface *sf = &s.meshes[0].surfaces[0];
     ENSURE(strcmp(sf->material, "*") == 0);
-    ENSURE(sf->absorption == 0.0f && sf->bounce == 0.0f && sf->dirt == 0.0f);
-    ENSURE(sf->deposit == 0.0f && sf->erosion == 0.0f && sf->colors == WX_COLOR_NONE);
+    ENSURE(sf->absorption == 0.0f && sf->bounce == 0.0f && sf->initial[0] == 0.0f);
+    ENSURE(sf->deposit[0] == 0.0f && sf->erosion[0] == 0.0f && sf->colors == WX_COLOR_NONE);
     wx_scene_free(&s);
 }
 
@@ -230,13 +231,13 @@ TEST(full_scene)
     ENSURE(p1->kind == WX_EMITTER_POINT && strcmp(p1->name, "p1") == 0);
     ENSURE(p1->center[0] == 1.0f && p1->center[1] == 5.0f && p1->center[2] == -2.0f);
     ENSURE(p1->rate == 250.0 && p1->start == 0.5 && p1->end == 2.0);
-    ENSURE(p1->speed == 3.0f && p1->mass == 2.0f && p1->dirt == 0.5f);
+    ENSURE(p1->speed == 3.0f && p1->mass == 2.0f && p1->load[0] == 0.5f);
     ENSURE(p1->max_collisions == 7);
     const wx_emitter *sky = &s.emitters[1];
     ENSURE(sky->kind == WX_EMITTER_HEMISPHERE && strcmp(sky->name, "sky") == 0);
     ENSURE(sky->center[1] == 1.0f && sky->radius == 20.0f);
     ENSURE(sky->rate == 5000.0 && sky->start == 1.0 && sky->end == 9.5);
-    ENSURE(sky->speed == 2.0f && sky->mass == 0.5f && sky->dirt == 1.5f);
+    ENSURE(sky->speed == 2.0f && sky->mass == 0.5f && sky->load[0] == 1.5f);
     ENSURE(sky->max_collisions == 50);
     const wx_emitter *rain = &s.emitters[2];
     ENSURE(rain->kind == WX_EMITTER_BOX && strcmp(rain->name, "rain") == 0);
@@ -247,7 +248,7 @@ TEST(full_scene)
     ENSURE_NEAR(rain->dir[2], 2.0 / 3.0, 1e-7);
     ENSURE(rain->spread == 15.0f && rain->rate == 8000.0 && rain->start == 0.25);
     ENSURE(rain->end == 3.0 && rain->speed == 6.0f && rain->mass == 0.25f);
-    ENSURE(rain->dirt == 2.0f && rain->max_collisions == 3);
+    ENSURE(rain->load[0] == 2.0f && rain->max_collisions == 3);
 
     ENSURE(s.camera_count == 4 && s.input_count == 3 && s.output_index == 3);
     const wx_scene_camera *front = &s.cameras[0];
@@ -280,11 +281,11 @@ TEST(full_scene)
     ENSURE(s.meshes[0].surface_count == 2 && s.meshes[1].surface_count == 0);
     const wx_surface *wall = &s.meshes[0].surfaces[0];
     ENSURE(strcmp(wall->material, "wall") == 0);
-    ENSURE(wall->absorption == 0.25f && wall->bounce == 0.5f && wall->dirt == 2.0f);
-    ENSURE(wall->deposit == 0.75f && wall->erosion == 0.125f && wall->colors == WX_COLOR_IMPACT);
+    ENSURE(wall->absorption == 0.25f && wall->bounce == 0.5f && wall->initial[0] == 2.0f);
+    ENSURE(wall->deposit[0] == 0.75f && wall->erosion[0] == 0.125f && wall->colors == WX_COLOR_IMPACT);
     const wx_surface *rest = &s.meshes[0].surfaces[1];
     ENSURE(strcmp(rest->material, "*") == 0 && rest->absorption == 1.0f);
-    ENSURE(rest->erosion == 1.0f && rest->colors == WX_COLOR_DIRT);
+    ENSURE(rest->erosion[0] == 1.0f && rest->colors == WX_COLOR_DIRT);
     wx_scene_free(&s);
 }
 
@@ -504,6 +505,393 @@ TEST(bad_scenes)
     }
     ENSURE(count >= 12);
     ENSURE(failures == 0);
+}
+
+// --- substances, loads, exchanges, iterations, rules (docs/design.md sections 9, 10) ---
+
+// A version-1 scene has the one substance "dirt" at index 0, emitters carry 1
+// of it, one iteration, no rules, no image sequence.
+TEST(version1_scene_has_substance_dirt)
+{
+    wx_scene s;
+    wx_error err;
+    wx_result r = wx_scene_load(data_path("defaults.xml"), &s, &err);
+    if (r != WX_OK) {
+        fprintf(stderr, "%s\n", err.message);
+    }
+    ENSURE(r == WX_OK);
+    ENSURE(!s.substances_declared && s.substance_count == 1);
+    ENSURE(strcmp(s.substances[0], "dirt") == 0 && s.dirt_substance == 0);
+    ENSURE(wx_scene_substance(&s, "dirt") == 0 && wx_scene_substance(&s, "water") == -1);
+    ENSURE(s.iterations == 1 && s.rule_count == 0 && s.rules == NULL);
+    ENSURE(!wx_scene_has_ageing(&s) && !wx_scene_has_surface_rules(&s));
+    for (int i = 0; i < s.emitter_count; ++i) {
+        ENSURE(s.emitters[i].load[0] == 1.0f);
+        for (int k = 1; k < WX_MAX_SUBSTANCES; ++k) {
+            ENSURE(s.emitters[i].load[k] == 0.0f);
+        }
+    }
+    ENSURE(s.cameras[s.output_index].every == 0);
+    const wx_surface *sf = &s.meshes[0].surfaces[0];
+    ENSURE(sf->rule_count == 0 && sf->rules == NULL);
+    for (int k = 0; k < WX_MAX_SUBSTANCES; ++k) {
+        ENSURE(sf->initial[k] == 0.0f && sf->deposit[k] == 0.0f && sf->erosion[k] == 0.0f);
+    }
+    wx_scene_free(&s);
+
+    // The thesis' format: no emitters, no <Solver>, the same substance defaults.
+    r = wx_scene_load(data_path("thesis_minimal.xml"), &s, &err);
+    ENSURE(r == WX_OK);
+    ENSURE(s.substance_count == 1 && strcmp(s.substances[0], "dirt") == 0);
+    ENSURE(s.dirt_substance == 0 && !s.substances_declared && s.iterations == 1);
+    wx_scene_free(&s);
+
+    // full.xml's dirt attributes are substance dirt's, at index 0.
+    r = wx_scene_load(data_path("full.xml"), &s, &err);
+    ENSURE(r == WX_OK);
+    ENSURE(s.emitters[0].load[0] == 0.5f && s.emitters[0].load[1] == 0.0f);
+    ENSURE(s.meshes[0].surfaces[0].initial[0] == 2.0f);
+    ENSURE(s.meshes[0].surfaces[0].deposit[0] == 0.75f);
+    wx_scene_free(&s);
+}
+
+// A file of tests/data by an absolute path, for scenes written elsewhere.
+static const char *abs_data_path(const char *name)
+{
+    static char paths[2][8200];
+    static int next;
+    char *path = paths[next];
+    next = (next + 1) % 2;
+    const char *rel = data_path(name);
+    char cwd[4096];
+    if (rel[0] == '/' || getcwd(cwd, sizeof cwd) == NULL) {
+        snprintf(path, 8200, "%s", rel);
+    } else {
+        snprintf(path, 8200, "%s/%s", cwd, rel);
+    }
+    return path;
+}
+
+// A collider of two View cameras (maps that bake makes), as text for a scene.
+#define VIEW_COLLIDER                                                                        \
+    "  <Collider><ProjectedMaps>\n"                                                          \
+    "    <Ortho cameraName=\"top\">\n"                                                       \
+    "      <View eye=\"0 10 0\" target=\"0 0 0\" up=\"0 0 -1\" width=\"4\" height=\"4\"\n"  \
+    "            resolution=\"8\"/>\n"                                                       \
+    "    </Ortho>\n"                                                                         \
+    "    <Ortho cameraName=\"out\" out=\"true\">\n"                                          \
+    "      <View eye=\"0 10 0\" target=\"0 0 0\" up=\"0 0 -1\" width=\"4\" height=\"4\"\n"  \
+    "            resolution=\"8\"/>\n"                                                       \
+    "      <OutputMap file=\"mask.exr\" every=\"3\"/>\n"                                     \
+    "    </Ortho>\n"                                                                         \
+    "  </ProjectedMaps></Collider>\n"
+
+static bool rule_is(const wx_rule *rule, wx_rule_kind kind, int substance, int to, float rate,
+                    float amount, int line)
+{
+    bool ok = rule->kind == kind && rule->substance == substance && rule->to == to &&
+              rule->rate == rate && rule->amount == amount && rule->line == line;
+    if (!ok) {
+        fprintf(stderr, "rule at line %d: kind %d substance %d to %d rate %g amount %g\n",
+                rule->line, (int)rule->kind, rule->substance, rule->to, (double)rule->rate,
+                (double)rule->amount);
+    }
+    return ok;
+}
+
+// Every element of sections 9 and 10, <Substances> after the elements that name
+// its substances (it is read first, wherever it stands).
+TEST(substances_loads_exchanges_rules)
+{
+    char text[65536];
+    snprintf(text, sizeof text,
+             "<Weathering>\n"                                                          // 1
+             "  <Emitters>\n"                                                          // 2
+             "    <BoxEmitter name=\"rain\" minX=\"-1\" minY=\"5\" minZ=\"-1\" maxX=\"1\" "
+             "maxY=\"5\" maxZ=\"1\" dirt=\"0.2\">\n"                                   // 3
+             "      <Load substance=\"water\" amount=\"1\"/>\n"                        // 4
+             "      <Load substance=\"rust\" amount=\"0\"/>\n"                         // 5
+             "    </BoxEmitter>\n"                                                     // 6
+             "    <PointEmitter name=\"dry\" centerY=\"3\"/>\n"                        // 7
+             "    <HemisphereEmitter name=\"mist\" radius=\"9\">\n"                    // 8
+             "      <Load substance=\"moss\" amount=\"0.5\"/>\n"                       // 9
+             "    </HemisphereEmitter>\n"                                              // 10
+             "  </Emitters>\n"                                                         // 11
+             "  <Ageing>\n"                                                            // 12
+             "    <Transfer from=\"water\" to=\"rust\" rate=\"0.1\"/>\n"               // 13
+             "    <Decay substance=\"water\" rate=\"0.5\"/>\n"                         // 14
+             "    <Grow substance=\"moss\" amount=\"0.01\"/>\n"                        // 15
+             "    <Transfer from=\"rust\" to=\"dirt\" rate=\"1\"/>\n"                  // 16
+             "  </Ageing>\n"                                                           // 17
+             "  <Geometry><Mesh file=\"%s\">\n"                                        // 18
+             "    <Surface material=\"iron\" absorption=\"0.2\" bounce=\"0.3\" dirt=\"0.5\" "
+             "deposit=\"0.25\" erosion=\"0.125\">\n"                                   // 19
+             "      <Decay substance=\"rust\" rate=\"0\"/>\n"                          // 20
+             "      <Exchange substance=\"water\" initial=\"2\" deposit=\"0.75\" "
+             "erosion=\"0.5\"/>\n"                                                     // 21
+             "      <Transfer from=\"water\" to=\"rust\" rate=\"0.3\"/>\n"             // 22
+             "      <Exchange substance=\"moss\" deposit=\"1\"/>\n"                    // 23
+             "      <Grow substance=\"moss\" amount=\"2\"/>\n"                         // 24
+             "    </Surface>\n"                                                        // 25
+             "    <Surface material=\"*\"/>\n"                                         // 26
+             "  </Mesh></Geometry>\n"                                                  // 27
+             "  <Solver><Simulation steps=\"10\" iterations=\"7\"/></Solver>\n"        // 28
+             "  <Substances>\n"                                                        // 29
+             "    <Substance name=\"water\"/>\n"                                       // 30
+             "    <Substance name=\"rust\"/>\n"                                        // 31
+             "    <Substance name=\"dirt\"/>\n"                                        // 32
+             "    <Substance name=\"moss\"/>\n"                                        // 33
+             "  </Substances>\n" VIEW_COLLIDER "</Weathering>\n",
+             abs_data_path("box.obj"));
+    const char *path = ensure_write_file(ensure_tmpdir(), "substances.xml", text);
+    wx_scene s;
+    wx_error err;
+    wx_result r = wx_scene_load(path, &s, &err);
+    if (r != WX_OK) {
+        fprintf(stderr, "%s\n", err.message);
+    }
+    ENSURE(r == WX_OK);
+    enum { WATER, RUST, DIRT, MOSS };
+    ENSURE(s.substances_declared && s.substance_count == 4);
+    ENSURE(strcmp(s.substances[WATER], "water") == 0 && strcmp(s.substances[RUST], "rust") == 0);
+    ENSURE(strcmp(s.substances[DIRT], "dirt") == 0 && strcmp(s.substances[MOSS], "moss") == 0);
+    ENSURE(s.substances[4][0] == '\0');
+    ENSURE(s.dirt_substance == DIRT && s.iterations == 7 && s.steps == 10);
+    ENSURE(wx_scene_has_ageing(&s) && wx_scene_has_surface_rules(&s) && wx_scene_has_grow(&s));
+
+    // Loads: dirt= is substance dirt's; every other load defaults to 0.
+    ENSURE(s.emitter_count == 3);
+    const float rain[WX_MAX_SUBSTANCES] = { [WATER] = 1.0f, [DIRT] = 0.2f };
+    const float mist[WX_MAX_SUBSTANCES] = { [MOSS] = 0.5f };
+    for (int k = 0; k < WX_MAX_SUBSTANCES; ++k) {
+        ENSURE(s.emitters[0].load[k] == rain[k]);
+        ENSURE(s.emitters[1].load[k] == 0.0f);
+        ENSURE(s.emitters[2].load[k] == mist[k]);
+    }
+
+    // Global rules in document order.
+    ENSURE(s.rule_count == 4);
+    ENSURE(rule_is(&s.rules[0], WX_RULE_TRANSFER, WATER, RUST, 0.1f, 0.0f, 13));
+    ENSURE(rule_is(&s.rules[1], WX_RULE_DECAY, WATER, -1, 0.5f, 0.0f, 14));
+    ENSURE(rule_is(&s.rules[2], WX_RULE_GROW, MOSS, -1, 0.0f, 0.01f, 15));
+    ENSURE(rule_is(&s.rules[3], WX_RULE_TRANSFER, RUST, DIRT, 1.0f, 0.0f, 16));
+
+    // Exchanges: the attributes are dirt's, <Exchange> the others', 0 elsewhere.
+    const wx_surface *iron = &s.meshes[0].surfaces[0];
+    ENSURE(strcmp(iron->material, "iron") == 0 && iron->line == 19);
+    ENSURE(iron->absorption == 0.2f && iron->bounce == 0.3f);
+    const float initial[WX_MAX_SUBSTANCES] = { [WATER] = 2.0f, [DIRT] = 0.5f };
+    const float deposit[WX_MAX_SUBSTANCES] = { [WATER] = 0.75f, [DIRT] = 0.25f, [MOSS] = 1.0f };
+    const float erosion[WX_MAX_SUBSTANCES] = { [WATER] = 0.5f, [DIRT] = 0.125f };
+    for (int k = 0; k < WX_MAX_SUBSTANCES; ++k) {
+        ENSURE(iron->initial[k] == initial[k]);
+        ENSURE(iron->deposit[k] == deposit[k]);
+        ENSURE(iron->erosion[k] == erosion[k]);
+    }
+    // The surface's own rules, in document order among its <Exchange>s.
+    ENSURE(iron->rule_count == 3);
+    ENSURE(rule_is(&iron->rules[0], WX_RULE_DECAY, RUST, -1, 0.0f, 0.0f, 20));
+    ENSURE(rule_is(&iron->rules[1], WX_RULE_TRANSFER, WATER, RUST, 0.3f, 0.0f, 22));
+    ENSURE(rule_is(&iron->rules[2], WX_RULE_GROW, MOSS, -1, 0.0f, 2.0f, 24));
+    const wx_surface *rest = &s.meshes[0].surfaces[1];
+    ENSURE(rest->rule_count == 0 && rest->rules == NULL);
+    for (int k = 0; k < WX_MAX_SUBSTANCES; ++k) {
+        ENSURE(rest->initial[k] == 0.0f && rest->deposit[k] == 0.0f && rest->erosion[k] == 0.0f);
+    }
+    ENSURE(s.cameras[s.output_index].every == 3);
+    ENSURE(s.cameras[0].every == 0);
+    wx_scene_free(&s);
+    ENSURE(s.rules == NULL && s.rule_count == 0);
+    if (ensure_shell(NULL, 0, "command -v xmllint >/dev/null") == 0) {
+        char out[8192];
+        int status = ensure_shell(
+            out, sizeof out, "xmllint --noout --schema xml_scenes/weathering.xsd '%s'", path);
+        if (status != 0) {
+            fprintf(stderr, "%s", out);
+        }
+        ENSURE(status == 0);
+    }
+}
+
+/// Loads `text` written as `name`; says why when a scene that should load does not.
+static wx_result load_text(const char *name, const char *text, wx_scene *s, wx_error *err,
+                           bool should_load)
+{
+    const char *path = ensure_write_file(ensure_tmpdir(), name, text);
+    memset(err, 0, sizeof *err);
+    wx_result r = wx_scene_load(path, s, err);
+    if ((r != WX_OK) == should_load) {
+        fprintf(stderr, "(%s) %s\n", name, r != WX_OK ? err->message : "loads");
+    }
+    return r;
+}
+
+// Substance dirt anywhere in the list, or not declared at all.
+TEST(substance_dirt_index_or_none)
+{
+    char text[65536];
+    // "dirt" third: the dirt attributes go there, not to index 0.
+    snprintf(text, sizeof text,
+             "<Weathering>\n"
+             "  <Substances><Substance name=\"a\"/><Substance name=\"b_2\"/>"
+             "<Substance name=\"dirt\"/></Substances>\n"
+             "  <Emitters><PointEmitter dirt=\"3\"/><PointEmitter/></Emitters>\n"
+             "  <Geometry><Mesh file=\"%s\">\n"
+             "    <Surface material=\"*\" dirt=\"4\" deposit=\"0.5\" erosion=\"0.25\"/>\n"
+             "  </Mesh></Geometry>\n" VIEW_COLLIDER "</Weathering>\n",
+             abs_data_path("box.obj"));
+    wx_scene s;
+    wx_error err;
+    ENSURE(load_text("dirt_third.xml", text, &s, &err, true) == WX_OK);
+    ENSURE(s.substance_count == 3 && s.dirt_substance == 2);
+    ENSURE(s.emitters[0].load[0] == 0.0f && s.emitters[0].load[2] == 3.0f);
+    ENSURE(s.emitters[1].load[0] == 0.0f && s.emitters[1].load[2] == 0.0f); // 0 with <Substances>
+    const wx_surface *sf = &s.meshes[0].surfaces[0];
+    ENSURE(sf->initial[2] == 4.0f && sf->deposit[2] == 0.5f && sf->erosion[2] == 0.25f);
+    ENSURE(sf->initial[0] == 0.0f && sf->deposit[0] == 0.0f && sf->erosion[0] == 0.0f);
+    wx_scene_free(&s);
+
+    // No "dirt": dirt_substance -1, loads and exchanges only by name; a Surface
+    // without the dirt attributes is fine.
+    snprintf(text, sizeof text,
+             "<Weathering>\n"
+             "  <Substances><Substance name=\"water\"/></Substances>\n"
+             "  <Emitters><PointEmitter><Load substance=\"water\" amount=\"0.5\"/>"
+             "</PointEmitter></Emitters>\n"
+             "  <Geometry><Mesh file=\"%s\">\n"
+             "    <Surface material=\"*\" absorption=\"0.5\" vertexColors=\"impact\">"
+             "<Exchange substance=\"water\" initial=\"1\"/></Surface>\n"
+             "  </Mesh></Geometry>\n" VIEW_COLLIDER "</Weathering>\n",
+             abs_data_path("box.obj"));
+    ENSURE(load_text("no_dirt.xml", text, &s, &err, true) == WX_OK);
+    ENSURE(s.substance_count == 1 && s.dirt_substance == -1 && s.substances_declared);
+    ENSURE(strcmp(s.substances[0], "water") == 0 && s.emitters[0].load[0] == 0.5f);
+    ENSURE(s.meshes[0].surfaces[0].initial[0] == 1.0f);
+    ENSURE(s.meshes[0].surfaces[0].deposit[0] == 0.0f);
+    ENSURE(wx_scene_has_ageing(&s) && !wx_scene_has_surface_rules(&s));
+    wx_scene_free(&s);
+
+    // Without <Substances>, "dirt" can be named too: <Load>, <Exchange>, rules.
+    snprintf(text, sizeof text,
+             "<Weathering>\n"
+             "  <Emitters><PointEmitter><Load substance=\"dirt\" amount=\"2\"/>"
+             "</PointEmitter></Emitters>\n"
+             "  <Ageing><Decay substance=\"dirt\" rate=\"0.5\"/></Ageing>\n"
+             "  <Geometry><Mesh file=\"%s\">\n"
+             "    <Surface material=\"*\"><Exchange substance=\"dirt\" initial=\"1\" "
+             "deposit=\"0.5\"/><Grow substance=\"dirt\" amount=\"1\"/></Surface>\n"
+             "  </Mesh></Geometry>\n" VIEW_COLLIDER "</Weathering>\n",
+             abs_data_path("box.obj"));
+    ENSURE(load_text("dirt_by_name.xml", text, &s, &err, true) == WX_OK);
+    ENSURE(!s.substances_declared && s.substance_count == 1 && s.dirt_substance == 0);
+    ENSURE(s.emitters[0].load[0] == 2.0f);
+    ENSURE(s.rule_count == 1 && s.rules[0].kind == WX_RULE_DECAY && s.rules[0].substance == 0);
+    ENSURE(s.meshes[0].surfaces[0].initial[0] == 1.0f);
+    ENSURE(s.meshes[0].surfaces[0].deposit[0] == 0.5f);
+    ENSURE(s.meshes[0].surfaces[0].rule_count == 1);
+    wx_scene_free(&s);
+}
+
+// The limits: 8 substances of up to 32 characters, names near the reserved ones,
+// iterations up to 100000.
+TEST(substance_limits_accepted)
+{
+    char text[65536];
+    snprintf(text, sizeof text,
+             "<Weathering>\n"
+             "  <Substances>\n"
+             "    <Substance name=\"a2345678901234567890123456789012\"/>\n"
+             "    <Substance name=\"y\"/><Substance name=\"Ys\"/><Substance name=\"Seen\"/>\n"
+             "    <Substance name=\"seen_2\"/><Substance name=\"see\"/>"
+             "<Substance name=\"dirt\"/><Substance name=\"Z_\"/>\n"
+             "  </Substances>\n"
+             "  <Solver><Simulation steps=\"1\" iterations=\"100000\"/></Solver>\n"
+             "%s</Weathering>\n",
+             VIEW_COLLIDER);
+    wx_scene s;
+    wx_error err;
+    ENSURE(load_text("limits.xml", text, &s, &err, true) == WX_OK);
+    ENSURE(s.substance_count == WX_MAX_SUBSTANCES && s.dirt_substance == 6);
+    ENSURE(strlen(s.substances[0]) == WX_SUBSTANCE_NAME_MAX);
+    ENSURE(strcmp(s.substances[7], "Z_") == 0 && s.iterations == 100000);
+    wx_scene_free(&s);
+}
+
+// Each bad input of issue 16 is refused at its element's line with its cause;
+// tests/bad/ holds them as files (bad_scenes), these need a scene of their own.
+TEST(substance_errors_at_their_line)
+{
+    char text[65536];
+    wx_scene s;
+    wx_error err;
+    // Per-surface rules when an input camera's maps are given, even by a
+    // <View> camera that names them: the bake does not record the surfaces.
+    char map[8200];
+    snprintf(map, sizeof map, "%s", abs_data_path("map8.exr"));
+    snprintf(text, sizeof text,
+             "<Weathering>\n"
+             "  <Geometry><Mesh file=\"%s\">\n"
+             "    <Surface material=\"*\">\n"
+             "      <Grow substance=\"dirt\" amount=\"1\"/>\n"
+             "    </Surface>\n"
+             "  </Mesh></Geometry>\n"
+             "  <Collider><ProjectedMaps>\n"
+             "    <Ortho cameraName=\"baked\">\n"
+             "      <View eye=\"0 10 0\" target=\"0 0 0\" up=\"0 0 -1\" width=\"4\" height=\"4\"\n"
+             "            resolution=\"8\"/>\n"
+             "    </Ortho>\n"
+             "    <Ortho cameraName=\"given\">\n"
+             "      <View eye=\"0 10 0\" target=\"0 0 0\" up=\"0 0 -1\" width=\"4\" height=\"4\"\n"
+             "            resolution=\"8\"/>\n"
+             "      <DepthMap file=\"%s\"/><NormalMap file=\"%s\"/>\n"
+             "      <ImpactMap file=\"%s\"/><DirtMap file=\"%s\"/>\n"
+             "    </Ortho>\n"
+             "  </ProjectedMaps></Collider>\n"
+             "</Weathering>\n",
+             abs_data_path("box.obj"), map, map, map, map);
+    ENSURE(load_text("view_maps_given.xml", text, &s, &err, false) == WX_BAD_INPUT);
+    ENSURE_CAUSE(err, BAD_SCENE);
+    ENSURE(ensure_contains(err.message, "view_maps_given.xml:4: <Grow> in <Surface material=\"*\"> "
+                                        "is a per-surface rule"));
+    ENSURE(ensure_contains(err.message, "input camera 'given' (line 12) has pre-rendered maps"));
+    ENSURE(s.meshes == NULL && s.rules == NULL);
+    wx_scene_free(&s);
+
+    // Global rules, exchanges and loads are fine with pre-rendered maps.
+    snprintf(text, sizeof text,
+             "<Weathering>\n"
+             "  <Substances><Substance name=\"dirt\"/><Substance name=\"water\"/></Substances>\n"
+             "  <Ageing><Decay substance=\"water\" rate=\"0.5\"/></Ageing>\n"
+             "  <Emitters><PointEmitter><Load substance=\"water\" amount=\"1\"/></PointEmitter>"
+             "</Emitters>\n"
+             "  <Collider><ProjectedMaps>\n"
+             "    <Ortho cameraName=\"given\">\n"
+             "      <WTCMatrix matrix=\"0.25 0 0 0  0 0.25 0 0  0 0 -1 0  0.5 0.5 10 1\"/>\n"
+             "      <DepthMap file=\"%s\"/><NormalMap file=\"%s\"/>\n"
+             "      <ImpactMap file=\"%s\"/><DirtMap file=\"%s\"/>\n"
+             "    </Ortho>\n"
+             "  </ProjectedMaps></Collider>\n"
+             "</Weathering>\n",
+             map, map, map, map);
+    ENSURE(load_text("global_rules_given_maps.xml", text, &s, &err, true) == WX_OK);
+    ENSURE(s.rule_count == 1 && s.emitters[0].load[1] == 1.0f && s.emitters[0].load[0] == 0.0f);
+    wx_scene_free(&s);
+
+    // An error in <Substances> is found first, wherever it stands, and a
+    // reference before the declaration is not an error.
+    snprintf(text, sizeof text,
+             "<Weathering>\n"
+             "  <Emitters><PointEmitter><Load substance=\"rust\" amount=\"1\"/></PointEmitter>"
+             "</Emitters>\n"
+             "  <Substances>\n"
+             "    <Substance name=\"rust\"/>\n"
+             "    <Substance name=\"seen\"/>\n"
+             "  </Substances>\n" VIEW_COLLIDER "</Weathering>\n");
+    ENSURE(load_text("substances_last.xml", text, &s, &err, false) == WX_BAD_INPUT);
+    ENSURE_CAUSE(err, BAD_VALUE);
+    ENSURE(ensure_contains(err.message, "substances_last.xml:5: <Substance> name=\"seen\" is "
+                                        "reserved"));
+    wx_scene_free(&s);
 }
 
 static double seconds_now(void)
@@ -747,6 +1135,14 @@ TEST(schema_rejects_bad_values)
         "wrong_root",         "missing_required_attribute",
         "collider_friction_above_one", "box_emitter_spread_90",
         "box_emitter_without_a_corner", "box_emitter_has_no_center",
+        // docs/design.md sections 9 and 10 (issue 16).
+        "substances_nine", "substances_empty", "substances_twice", "substance_duplicate_name",
+        "substance_reserved_y", "substance_reserved_seen", "substance_name_starts_with_digit",
+        "substance_name_with_a_dot", "substance_name_too_long", "load_amount_negative",
+        "load_twice", "exchange_twice", "exchange_deposit_above_one", "exchange_initial_negative",
+        "transfer_rate_above_one", "decay_rate_negative", "grow_amount_negative",
+        "rule_without_rate", "iterations_zero", "iterations_too_many", "iterations_not_integer",
+        "every_negative", "child_of_a_leaf_element",
     };
     int failures = 0;
     for (size_t i = 0; i < sizeof invalid / sizeof invalid[0]; ++i) {
@@ -771,6 +1167,11 @@ int main(void)
     RUN(view_camera_matrices);
     RUN(ctw_derived_when_absent);
     RUN(ctw_not_inverse_is_an_error);
+    RUN(version1_scene_has_substance_dirt);
+    RUN(substances_loads_exchanges_rules);
+    RUN(substance_dirt_index_or_none);
+    RUN(substance_limits_accepted);
+    RUN(substance_errors_at_their_line);
     RUN(bad_scenes);
     RUN(entity_bomb_refused_quickly);
     RUN(external_entity_refused);

@@ -374,7 +374,7 @@ static void busy_scene(fx_scene *f)
     wx_emitter *fountain = fx_emitter(f, WX_EMITTER_POINT, 0.3f, 1.5f, 0.2f);
     fountain->rate = 5000;
     fountain->speed = 3;
-    fountain->dirt = 0.5f;
+    fountain->load[0] = 0.5f;
     fountain->mass = 2;
     fountain->max_collisions = 10;
 }

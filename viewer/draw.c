@@ -29,8 +29,8 @@ static const char *const COLOR_FS =
     "out vec4 frag;\n"
     "void main() { frag = vec4(v_color, 1.0); }\n";
 
-// Particles: x, y, z and load interleaved; the colour goes from clean to dirty
-// with the load.
+// Particles: x, y, z and load (of the shown substance) interleaved; the colour
+// goes from clean to the substance's colour with the load.
 static const char *const PARTICLE_VS =
     "#version 330 core\n"
     "layout(location = 0) in vec4 particle;\n" // x, y, z, load
@@ -206,6 +206,11 @@ static bool reserve_staging(vw_draw *draw, int width, int height)
         return false;
     }
     draw->vertices = vertices;
+    uint32_t *picked = realloc(draw->depth_picked, pixels * sizeof *picked);
+    if (picked == NULL) {
+        return false;
+    }
+    draw->depth_picked = picked;
     draw->staging_capacity = pixels;
     return true;
 }
@@ -233,11 +238,19 @@ static bool depth_samples_current(const vw_draw *draw, const vw_show *show, cons
 }
 
 // The depth samples of the shown cameras, nearest per pixel: picked again only
-// when the view or the shown cameras change.
+// when the view or the shown cameras change; coloured again every frame when
+// they show deposits, which change with every step.
 static wx_result update_depth_samples(vw_draw *draw, const vw_world *world, const vw_show *show,
                                       const float mvp[16], int width, int height, wx_error *err)
 {
+    bool deposits = vw_world_shows_deposits(world);
     if (depth_samples_current(draw, show, mvp, width, height)) {
+        if (deposits || !draw->depth_uploaded) {
+            vw_world_deposit_colors(world, draw->depth_picked, (size_t)draw->depth_count,
+                                    draw->vertices);
+            upload(draw->depth_vbo, draw->vertices, (size_t)draw->depth_count * sizeof(vw_vertex));
+            draw->depth_uploaded = true;
+        }
         return WX_OK;
     }
     vw_point_filter *f = &draw->filter;
@@ -258,9 +271,14 @@ static wx_result update_depth_samples(vw_draw *draw, const vw_world *world, cons
     for (size_t k = 0; k < n; ++k) {
         uint32_t i;
         memcpy(&i, &draw->staging[4 * k + 3], sizeof i);
+        draw->depth_picked[k] = i;
         draw->vertices[k] = world->points[i];
     }
+    if (deposits) {
+        vw_world_deposit_colors(world, draw->depth_picked, n, draw->vertices);
+    }
     upload(draw->depth_vbo, draw->vertices, n * sizeof(vw_vertex));
+    draw->depth_uploaded = true;
     draw->depth_count = (int)n;
     memcpy(draw->depth_mvp, mvp, sizeof draw->depth_mvp);
     draw->depth_width = width;
@@ -270,7 +288,8 @@ static wx_result update_depth_samples(vw_draw *draw, const vw_world *world, cons
     return WX_OK;
 }
 
-// The live particles, nearest per pixel, as x, y, z, load.
+// The live particles, nearest per pixel, as x, y, z and load of the shown
+// substance.
 static wx_result update_particles(vw_draw *draw, const vw_world *world, const float mvp[16],
                                   int width, int height, wx_error *err)
 {
@@ -286,7 +305,7 @@ static wx_result update_particles(vw_draw *draw, const vw_world *world, const fl
     }
     for (int64_t i = 0; i < view.count; ++i) {
         float x = view.x[i], y = view.y[i], z = view.z[i];
-        vw_points_offer(f, x, y, z, x, y, z, (float)view.load[i]);
+        vw_points_offer(f, x, y, z, x, y, z, (float)vw_particle_load(world, &view, i));
     }
     size_t n = vw_points_winners(f, draw->staging);
     upload(draw->particle_vbo, draw->staging, n * 4 * sizeof(float));
@@ -385,7 +404,9 @@ void vw_draw_frame(const vw_draw *draw, const vw_world *world, const vw_show *sh
         glUniformMatrix4fv(draw->particle_mvp, 1, GL_FALSE, mvp);
         glUniform1f(draw->particle_load_scale, world->load_scale);
         uniform_color(draw->particle_clean, VW_PARTICLE_CLEAN_COLOR);
-        uniform_color(draw->particle_dirty, VW_PARTICLE_DIRTY_COLOR);
+        float dirty[3];
+        vw_world_substance_color(world, world->substance, dirty);
+        glUniform3f(draw->particle_dirty, dirty[0], dirty[1], dirty[2]);
         glPointSize(PARTICLE_POINT_SIZE);
         glBindVertexArray(draw->particle_vao);
         glDrawArrays(GL_POINTS, 0, (GLsizei)draw->particle_count);
@@ -410,6 +431,7 @@ void vw_draw_free(vw_draw *draw)
     free(draw->staging);
     free(draw->vertices);
     free(draw->depth_cameras);
+    free(draw->depth_picked);
     free(draw->hits);
     free(draw->hit_vertices);
     memset(draw, 0, sizeof *draw);

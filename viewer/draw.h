@@ -1,7 +1,8 @@
 // draw.h: draws a world with OpenGL 3.3 core (thesis 4.8.5): camera frames,
-// emitters and bounding box from a static buffer; depth samples, live particles
-// (coloured by their dirt load) and recent hit points from buffers refilled as
-// needed. Depth samples and particles are one-pixel points, reduced on the CPU
+// emitters and bounding box from a static buffer; depth samples (with
+// <Substances>, tinted by the shown substance on their surface), live particles
+// (coloured by their load of the shown substance) and recent hit points from
+// buffers refilled as needed. Depth samples and particles are one-pixel points, reduced on the CPU
 // to the nearest per pixel before upload (points.h).
 #ifndef VW_DRAW_H
 #define VW_DRAW_H
@@ -36,6 +37,8 @@ typedef struct vw_draw {
     float depth_mvp[16];           ///< the view the depth samples were picked for
     int depth_width, depth_height;
     bool *depth_cameras;           ///< cameras shown when they were picked
+    uint32_t *depth_picked;        ///< the picked samples (indices into world->points)
+    bool depth_uploaded;           ///< depth_vbo holds the picked samples' colours
     int camera_count;
 
     GLuint particle_vao, particle_vbo; ///< x, y, z, load per particle

@@ -31,6 +31,23 @@ static const uint8_t VW_EMITTER_COLOR[3] = { 255, 160, 160 };
 static const uint8_t VW_PARTICLE_CLEAN_COLOR[3] = { 190, 225, 255 };
 static const uint8_t VW_PARTICLE_DIRTY_COLOR[3] = { 150, 100, 50 };
 
+/// The colour of the shown substance (docs/design.md section 9): particles go
+/// from the clean colour to it with their load, depth samples towards it with
+/// the amount on their surface. Substance "dirt" (the one substance of a scene
+/// without <Substances>) is VW_PARTICLE_DIRTY_COLOR; substance s otherwise
+/// VW_SUBSTANCE_COLORS[s] (in xml_scenes/rusty_tank.xml: water blue, rust,
+/// moss green).
+static const uint8_t VW_SUBSTANCE_COLORS[8][3] = {
+    { 25, 75, 215 },   // deep blue
+    { 200, 30, 60 },   // crimson
+    { 185, 75, 20 },   // rust
+    { 50, 130, 30 },   // moss green
+    { 40, 40, 40 },    // soot
+    { 245, 245, 245 }, // white
+    { 110, 40, 160 },  // purple
+    { 0, 120, 120 },   // teal
+};
+
 /// Hit points by what the particle did: absorbed, bounced, slid.
 static const uint8_t VW_HIT_COLORS[3][3] = {
     { 255, 40, 40 },   // absorbed (or settled)

@@ -77,8 +77,10 @@ static bool same_view(const wx_view *a, const wx_view *b)
 static bool same_surface(const wx_surface *a, const wx_surface *b)
 {
     return strcmp(a->material, b->material) == 0 && a->absorption == b->absorption &&
-           a->bounce == b->bounce && a->dirt == b->dirt && a->deposit == b->deposit &&
-           a->erosion == b->erosion && a->colors == b->colors;
+           a->bounce == b->bounce &&
+           memcmp(a->initial, b->initial, sizeof a->initial) == 0 &&
+           memcmp(a->deposit, b->deposit, sizeof a->deposit) == 0 &&
+           memcmp(a->erosion, b->erosion, sizeof a->erosion) == 0 && a->colors == b->colors;
 }
 
 // True when what `weathering bake` reads (cameras and geometry) is the same.
@@ -160,6 +162,8 @@ typedef struct vertex_list {
     int count;
     int64_t capacity;
     bool failed;
+    vw_sample *samples; ///< depth samples only: one per vertex
+    int64_t sample_capacity;
 } vertex_list;
 
 static void push_vertex(vertex_list *list, const float p[3], const float color[3])
@@ -249,6 +253,7 @@ static void add_camera_points(vw_world *world, vertex_list *points, int c, int s
     }
     float color[3];
     camera_color(world, c, color);
+    int input = world->scene.cameras[c].is_output ? -1 : world->camera_maps[c];
     const float light[3] = { 0.40f, 0.80f, 0.45f }; // roughly unit
     for (int j = stride / 2; j < m->height; j += stride) {
         for (int i = stride / 2; i < m->width; i += stride) {
@@ -270,6 +275,14 @@ static void add_camera_points(vw_world *world, vertex_list *points, int c, int s
             for (int a = 0; a < 3; ++a) {
                 shaded[a] = color[a] * shade;
             }
+            if (!wx_array_reserve((void **)&points->samples, &points->sample_capacity,
+                                  (int64_t)points->count + 1, sizeof *points->samples, 256)) {
+                points->failed = true;
+                return;
+            }
+            points->samples[points->count] = (vw_sample){
+                .input = input, .texel = (int)t, .shade = shade
+            };
             push_vertex(points, p, shaded);
         }
     }
@@ -432,6 +445,7 @@ static wx_result build_geometry(vw_world *world, wx_error *err)
     world->lines = lines.data;
     world->line_count = lines.count;
     world->points = points.data;
+    world->samples = points.samples;
     world->point_count = points.count;
     if (lines.failed || points.failed) {
         return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (viewer geometry)");
@@ -478,8 +492,9 @@ static wx_result load_maps(vw_world *world, wx_error *err)
                 which |= WX_MAPS_DIRT | WX_MAPS_INITIAL_DIRT;
             }
         }
-        wx_result r = wx_maps_load(&world->maps[world->camera_maps[c]], which, 1, cam->depth_path,
-                                   cam->normal_path, cam->impact_path, cam->dirt_path, err);
+        wx_result r = wx_maps_load_scene(&world->maps[world->camera_maps[c]], which, 1,
+                                         &world->scene, cam->depth_path, cam->normal_path,
+                                         cam->impact_path, cam->dirt_path, err);
         if (r != WX_OK) {
             wx_error_prefix(err, "camera '%s'", cam->name);
             return r;
@@ -511,15 +526,110 @@ wx_result vw_world_finish(vw_world *world, const vw_settings *settings, wx_error
         r = create_sim(world, settings, err);
     }
     if (r == WX_OK) {
-        world->load_scale = 0.0f;
-        for (int e = 0; e < world->scene.emitter_count; ++e) {
-            world->load_scale = fmaxf(world->load_scale, world->scene.emitters[e].dirt);
-        }
-        if (!(world->load_scale > 0.0f)) {
-            world->load_scale = 1.0f;
-        }
+        vw_world_show_substance(world, 0);
     }
     return r;
+}
+
+// --- substances ----------------------------------------------------------------------
+
+int vw_world_substance_count(const vw_world *world)
+{
+    return world->scene.substance_count > 1 ? world->scene.substance_count : 1;
+}
+
+void vw_world_show_substance(vw_world *world, int s)
+{
+    int S = vw_world_substance_count(world);
+    s %= S;
+    world->substance = s < 0 ? s + S : s;
+    float own = 0.0f, any = 0.0f;
+    for (int e = 0; e < world->scene.emitter_count; ++e) {
+        const float *load = world->scene.emitters[e].load;
+        own = fmaxf(own, load[world->substance]);
+        for (int k = 0; k < S; ++k) {
+            any = fmaxf(any, load[k]);
+        }
+    }
+    world->load_scale = own > 0.0f ? own : any > 0.0f ? any : 1.0f;
+}
+
+int vw_world_next_substance(vw_world *world)
+{
+    vw_world_show_substance(world, world->substance + 1);
+    return world->substance;
+}
+
+int vw_world_find_substance(const vw_world *world, const char *name)
+{
+    for (int s = 0; s < world->scene.substance_count; ++s) {
+        if (strcmp(world->scene.substances[s], name) == 0) {
+            return s;
+        }
+    }
+    return -1;
+}
+
+void vw_world_keep_substance(vw_world *world, const char *name)
+{
+    int s = name != NULL ? vw_world_find_substance(world, name) : -1;
+    vw_world_show_substance(world, s >= 0 ? s : 0);
+}
+
+const char *vw_world_substance_name(const vw_world *world)
+{
+    return world->scene.substances[world->substance];
+}
+
+void vw_world_substance_color(const vw_world *world, int s, float out[3])
+{
+    to_float_color(s == world->scene.dirt_substance ? VW_PARTICLE_DIRTY_COLOR
+                                                    : VW_SUBSTANCE_COLORS[s % 8],
+                   out);
+}
+
+bool vw_world_shows_deposits(const vw_world *world)
+{
+    return world->scene.substances_declared;
+}
+
+double vw_world_deposit(const vw_world *world, int point)
+{
+    const vw_sample *sample = &world->samples[point];
+    const wx_dirt_map *map =
+        sample->input >= 0 && world->sim != NULL ? wx_sim_dirt_map(world->sim, sample->input)
+                                                 : NULL;
+    if (map == NULL) {
+        return -1.0;
+    }
+    int S = map->substances > 1 ? map->substances : 1;
+    int s = world->substance < S ? world->substance : 0;
+    return map->texels[(size_t)sample->texel * (size_t)S + (size_t)s].dirt;
+}
+
+void vw_world_deposit_colors(const vw_world *world, const uint32_t *picked, size_t n,
+                             vw_vertex *out)
+{
+    double most = 0.0;
+    for (size_t k = 0; k < n; ++k) {
+        double a = vw_world_deposit(world, (int)picked[k]);
+        most = a > most ? a : most;
+    }
+    float color[3];
+    vw_world_substance_color(world, world->substance, color);
+    for (size_t k = 0; k < n; ++k) {
+        const int i = (int)picked[k];
+        out[k] = world->points[i];
+        double a = most > 0.0 ? vw_world_deposit(world, i) : 0.0;
+        if (!(a > 0.0)) {
+            continue;
+        }
+        float t = sqrtf((float)(a < most ? a / most : 1.0));
+        float shade = world->samples[i].shade;
+        for (int c = 0; c < 3; ++c) {
+            out[k].color[c] += t * (color[c] * shade - out[k].color[c]);
+        }
+    }
 }
 
 wx_result vw_world_restart(vw_world *world, const vw_settings *settings, wx_error *err)
@@ -570,6 +680,7 @@ void vw_world_free(vw_world *world)
     free(world->input_camera);
     free(world->lines);
     free(world->points);
+    free(world->samples);
     free(world->camera_lines);
     free(world->camera_points);
     wx_scene_free(&world->scene);

@@ -11,6 +11,7 @@
 #define VW_WORLD_H
 
 #include <stdbool.h>
+#include <stddef.h>
 #include <stdint.h>
 
 #include "core/error.h"
@@ -28,6 +29,13 @@ typedef struct vw_vertex {
     float position[3];
     float color[3];
 } vw_vertex;
+
+/// Where a depth sample lies in its camera's maps, for its deposits.
+typedef struct vw_sample {
+    int input;   ///< input camera (index into the simulation's dirt maps), -1: output camera
+    int texel;   ///< j * width + i
+    float shade; ///< its normal shading: drawn in its camera's colour times this
+} vw_sample;
 
 /// A run of vertices in one of the world's vertex lists.
 typedef struct vw_range {
@@ -52,11 +60,16 @@ typedef struct vw_world {
     int *camera_maps;        ///< scene camera index -> index into maps
     int *input_camera;       ///< input index -> scene camera index
     wx_sim *sim;
-    float load_scale;        ///< particle load drawn fully dirty (largest emitter dirt)
+    /// The substance shown (docs/design.md section 9): particles are coloured
+    /// by their load of it, depth samples (with <Substances>) by its amount on
+    /// their surface. An index into scene.substances.
+    int substance;
+    float load_scale;        ///< load of it drawn in full colour (its largest emitter load)
 
     vw_vertex *lines;        ///< GL_LINES pairs
     int line_count;
     vw_vertex *points;       ///< depth samples
+    vw_sample *samples;      ///< per depth sample: its texel
     int point_count;
     vw_range *camera_lines;  ///< per scene camera: frame and viewing direction
     vw_range *camera_points; ///< per scene camera: its depth samples
@@ -94,6 +107,55 @@ bool vw_world_finished(const vw_world *world);
 /// output camera, gathers the mask; `saved` receives the mask's path (or the
 /// output folder when there is no output camera).
 wx_result vw_world_gather(vw_world *world, char saved[WX_PATH_MAX], wx_error *err);
+
+/// Substances of the scene (1 without <Substances>).
+int vw_world_substance_count(const vw_world *world);
+
+/// Shows substance s (taken modulo the count): the particles' colour and
+/// load_scale, the largest load of s over the emitters; when no emitter
+/// carries s (it is only picked up from surfaces), the largest load of any
+/// substance, else 1.
+void vw_world_show_substance(vw_world *world, int s);
+
+/// Shows the next substance, after the last the first again; returns it.
+int vw_world_next_substance(vw_world *world);
+
+/// After a reload: shows the substance of that name if the new scene has one,
+/// else the first.
+void vw_world_keep_substance(vw_world *world, const char *name);
+
+/// Index of the substance called `name`, or -1.
+int vw_world_find_substance(const vw_world *world, const char *name);
+
+/// Name of the shown substance.
+const char *vw_world_substance_name(const vw_world *world);
+
+/// Colour of substance s (palette.h), 0..1 per channel.
+void vw_world_substance_color(const vw_world *world, int s, float out[3]);
+
+/// True when the depth samples show deposits: scenes with <Substances> (a
+/// scene without keeps version 1's look, its samples in their camera's colour).
+bool vw_world_shows_deposits(const vw_world *world);
+
+/// Load of the shown substance carried by particle i of a view of the
+/// world's simulation (the view holds one load per substance per particle).
+static inline double vw_particle_load(const vw_world *world, const wx_particle_view *view,
+                                      int64_t i)
+{
+    int64_t S = world->scene.substance_count > 1 ? world->scene.substance_count : 1;
+    return view->load[i * S + world->substance];
+}
+
+/// Amount of the shown substance on the surface of depth sample `point` now,
+/// or -1 for a sample of the output camera (it has no dirt map).
+double vw_world_deposit(const vw_world *world, int point);
+
+/// Copies depth samples picked[0..n) into out, coloured by the deposits of the
+/// shown substance: from their camera's shaded colour towards the substance's
+/// shaded colour by sqrt(amount / largest amount among them); output-camera
+/// samples and surfaces without any keep their colour.
+void vw_world_deposit_colors(const vw_world *world, const uint32_t *picked, size_t n,
+                             vw_vertex *out);
 
 /// Frees everything; the struct is zeroed.
 void vw_world_free(vw_world *world);

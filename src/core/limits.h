@@ -14,8 +14,14 @@
 /// Most input cameras a scene may have (the collider numbers them in a byte).
 #define WX_MAX_INPUT_CAMERAS 64
 
-/// Channels and header attributes of an image.
-#define WX_IMAGE_MAX_CHANNELS 8
+/// Most substances a scene may declare (docs/design.md section 9), and the
+/// longest substance name.
+#define WX_MAX_SUBSTANCES 8
+#define WX_SUBSTANCE_NAME_MAX 32
+
+/// Channels and header attributes of an image: a dirt map of 8 substances holds
+/// 4 channels per substance and the surface record.
+#define WX_IMAGE_MAX_CHANNELS 40
 #define WX_IMAGE_MAX_ATTRS 16
 /// Longest channel or attribute name, and string attribute.
 #define WX_NAME_MAX 64

@@ -5,6 +5,7 @@
 
 #include <math.h>
 #include <stdlib.h>
+#include <stdio.h>
 #include <string.h>
 
 #include "io/exr.h"
@@ -98,9 +99,163 @@ static wx_result load_finite(const char *path, const char *what, const char *con
     return result;
 }
 
+static bool header_has(const wx_image *header, const char *name)
+{
+    for (int c = 0; c < header->channel_count; ++c) {
+        if (strcmp(header->channel_names[c], name) == 0) {
+            return true;
+        }
+    }
+    return false;
+}
+
+// One plane of wx_maps the dirt map fills: a channel (or alternatives) of the
+// file, or zeros.
+typedef struct dirt_plane {
+    char channel[2 * (WX_NAME_MAX + 8) + 2]; ///< "" = zeros
+    float **dest;                      ///< the wx_maps plane block
+    size_t offset;                     ///< plane index within it
+} dirt_plane;
+
+// The dirt map of a scene with substances, or with the bake's surface and area
+// records: the planes model/maps.h lays out, from the channels the file has.
+static wx_result load_scene_dirt(wx_maps *maps, unsigned which, int threads,
+                                 const wx_scene *scene, const char *dirt_path,
+                                 size_check *check, wx_error *err)
+{
+    wx_image *image = calloc(2, sizeof *image); // header and planes: off the stack
+    dirt_plane *planes = calloc(WX_IMAGE_MAX_CHANNELS, sizeof *planes);
+    if (image == NULL || planes == NULL) {
+        free(image);
+        free(planes);
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "%s: out of memory", dirt_path);
+    }
+    wx_image *header = &image[1];
+    wx_result result = wx_exr_read_header(dirt_path, header, err);
+    int S = scene->substances_declared ? scene->substance_count : 1;
+    bool simulated = wanted(which, WX_MAPS_SIMULATED);
+    bool restart = wanted(which, WX_MAPS_INITIAL_DIRT);
+    int count = 0;
+    for (int s = 0; s < S && result == WX_OK; ++s) {
+        char amount[WX_NAME_MAX + 8], deposit[WX_NAME_MAX + 8], erosion[WX_NAME_MAX + 8],
+            initial[WX_NAME_MAX + 8];
+        if (scene->substances_declared) {
+            snprintf(amount, sizeof amount, "%s.amount", scene->substances[s]);
+            snprintf(deposit, sizeof deposit, "%s.deposit", scene->substances[s]);
+            snprintf(erosion, sizeof erosion, "%s.erosion", scene->substances[s]);
+            snprintf(initial, sizeof initial, "%s.initial", scene->substances[s]);
+        }
+        if (!scene->substances_declared ||
+            (!header_has(header, amount) && s == scene->dirt_substance)) {
+            snprintf(amount, sizeof amount, "R");
+            snprintf(deposit, sizeof deposit, "G");
+            snprintf(erosion, sizeof erosion, "B");
+            snprintf(initial, sizeof initial, "%s", WX_INITIAL_DIRT_CHANNEL);
+        }
+        bool present = header_has(header, amount);
+        bool has_initial = present && header_has(header, initial);
+        dirt_plane *p = &planes[count];
+        if (present) {
+            snprintf(p[0].channel, sizeof p[0].channel, "%s%s%s", restart && has_initial ? initial : "",
+                     restart && has_initial ? "|" : "", amount);
+            snprintf(p[1].channel, sizeof p[1].channel, "%s", deposit);
+            snprintf(p[2].channel, sizeof p[2].channel, "%s", erosion);
+        }
+        p[0].dest = &maps->dirt;
+        p[1].dest = &maps->deposit;
+        p[2].dest = &maps->erosion;
+        for (int k = 0; k < 3; ++k) {
+            p[k].offset = (size_t)s;
+        }
+        count += 3;
+        if (simulated) {
+            p = &planes[count++];
+            if (has_initial) {
+                snprintf(p->channel, sizeof p->channel, "%s", initial);
+            }
+            p->dest = &maps->initial_dirt;
+            p->offset = (size_t)s;
+        }
+    }
+    if (simulated) {
+        dirt_plane *p = &planes[count++];
+        snprintf(p->channel, sizeof p->channel, "%s", WX_HITS_CHANNEL);
+        p->dest = &maps->hits;
+    }
+    if (result == WX_OK && header_has(header, WX_SURFACE_CHANNEL)) {
+        dirt_plane *p = &planes[count++];
+        snprintf(p->channel, sizeof p->channel, "%s", WX_SURFACE_CHANNEL);
+        p->dest = &maps->surface;
+    }
+    if (result == WX_OK && header_has(header, WX_AREA_CHANNEL)) {
+        dirt_plane *p = &planes[count++];
+        snprintf(p->channel, sizeof p->channel, "%s", WX_AREA_CHANNEL);
+        p->dest = &maps->area;
+    }
+    const char *channels[WX_IMAGE_MAX_CHANNELS];
+    int read = 0;
+    for (int k = 0; k < count; ++k) {
+        if (planes[k].channel[0] != '\0') {
+            channels[read++] = planes[k].channel;
+        }
+    }
+    if (result == WX_OK) {
+        result = wx_exr_read_parallel(dirt_path, channels, read, threads, image, err);
+    }
+    if (result == WX_OK) {
+        result = check_size(check, dirt_path, image->width, image->height, err);
+    }
+    size_t n = (size_t)check->width * (size_t)check->height;
+    for (int k = 0, c = 0; k < count && result == WX_OK; ++k) {
+        dirt_plane *p = &planes[k];
+        size_t block = p->dest == &maps->dirt || p->dest == &maps->deposit ||
+                               p->dest == &maps->erosion || p->dest == &maps->initial_dirt
+                           ? (size_t)S
+                           : 1;
+        if (*p->dest == NULL) {
+            *p->dest = calloc(n * block + 1, sizeof(float));
+            if (*p->dest == NULL) {
+                result = wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "%s: out of memory", dirt_path);
+                break;
+            }
+        }
+        if (p->channel[0] == '\0') {
+            continue; // zeros
+        }
+        const char *name[1] = { image->channel_names[c] };
+        result = check_finite(dirt_path, "dirt", image->channels[c], n, check->width, 1, name, err);
+        if (result == WX_OK) {
+            memcpy(*p->dest + p->offset * n, image->channels[c], n * sizeof(float));
+        }
+        c++;
+    }
+    if (result == WX_OK && image->attr_count > 0) {
+        maps->dirt_attrs = malloc((size_t)image->attr_count * sizeof *maps->dirt_attrs);
+        if (maps->dirt_attrs == NULL) {
+            result = wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "%s: out of memory", dirt_path);
+        } else {
+            memcpy(maps->dirt_attrs, image->attrs, (size_t)image->attr_count * sizeof *maps->dirt_attrs);
+            maps->dirt_attr_count = image->attr_count;
+        }
+    }
+    maps->substances = S;
+    wx_image_free(image);
+    free(image);
+    free(planes);
+    return result;
+}
+
 wx_result wx_maps_load(wx_maps *maps, unsigned which, int threads, const char *depth_path,
                        const char *normal_path, const char *impact_path, const char *dirt_path,
                        wx_error *err)
+{
+    return wx_maps_load_scene(maps, which, threads, NULL, depth_path, normal_path, impact_path,
+                              dirt_path, err);
+}
+
+wx_result wx_maps_load_scene(wx_maps *maps, unsigned which, int threads, const wx_scene *scene,
+                             const char *depth_path, const char *normal_path,
+                             const char *impact_path, const char *dirt_path, wx_error *err)
 {
     memset(maps, 0, sizeof *maps);
     size_check check = { NULL, 0, 0, threads };
@@ -130,7 +285,15 @@ wx_result wx_maps_load(wx_maps *maps, unsigned which, int threads, const char *d
         static const char *const channels[] = {"R", "G"};
         result = load_finite(impact_path, "impact", channels, 2, &maps->impact, &check, err);
     }
-    if (result == WX_OK && wanted(which, WX_MAPS_DIRT)) {
+    bool scene_layout = scene != NULL && (scene->substances_declared ||
+                                          wx_scene_has_surface_rules(scene) ||
+                                          wx_scene_has_grow(scene));
+    if (result == WX_OK && wanted(which, WX_MAPS_DIRT) && scene_layout) {
+        result = need_path(dirt_path, "dirt", err);
+        if (result == WX_OK) {
+            result = load_scene_dirt(maps, which, threads, scene, dirt_path, &check, err);
+        }
+    } else if (result == WX_OK && wanted(which, WX_MAPS_DIRT)) {
         // A dirt map that `simulate` wrote keeps the dirt it started from in
         // "initialDirt": a new simulation starts from that, not from its result.
         const char *const channels[] = {

@@ -6,6 +6,7 @@
 
 #include "core/error.h"
 #include "model/maps.h"
+#include "model/scene.h"
 
 /// Which maps to load.
 enum {
@@ -22,11 +23,14 @@ enum {
     WX_MAPS_SIMULATED = 1 << 5,
 };
 
-/// Name of the channel in which a simulated dirt map keeps its initial dirt.
-#define WX_INITIAL_DIRT_CHANNEL "initialDirt"
-
-/// Name of the channel in which a simulated dirt map counts each texel's hits.
-#define WX_HITS_CHANNEL "hits"
+/// wx_maps_load for the maps of `scene` (NULL: version 1's one substance): the
+/// dirt map's substances as the scene declares them. A substance whose
+/// NAME.amount the file lacks reads as zeros, but for substance "dirt" of a
+/// file in version 1's layout (R G B, e.g. the thesis' maps). The surface and
+/// area planes are read when the file has them.
+wx_result wx_maps_load_scene(wx_maps *maps, unsigned which, int threads, const wx_scene *scene,
+                             const char *depth_path, const char *normal_path,
+                             const char *impact_path, const char *dirt_path, wx_error *err);
 
 /// Loads the maps selected by `which` from the given paths (NULL or "" for a map
 /// not wanted). Depth reads channel R or Z, normal R G B, impact R G, dirt R G B.

@@ -1,4 +1,5 @@
-// scene_xml.c: loads and validates a scene file (docs/design.md section 3) with libxml2.
+// scene_xml.c: loads and validates a scene file (docs/design.md sections 3, 8,
+// 9 and 10) with libxml2.
 //
 // The document is parsed without network access, entity substitution or
 // XInclude; any entity declaration stops the parser at once (so an entity bomb
@@ -8,8 +9,10 @@
 // range, where the value goes) and one table of the children it allows, so an
 // unknown element or attribute is an error that names it. Once the whole file is
 // read, the checks that need the whole picture run (emitter end times, map
-// files and their sizes, names that must be unique). Choices where docs/design.md is
-// silent are written down in docs/scene-format-notes.md.
+// files and their sizes, names that must be unique, per-surface rules against
+// pre-rendered maps). <Substances> is read first, wherever it stands, since
+// loads, exchanges and rules name its substances. Choices where docs/design.md
+// is silent are written down in docs/scene-format-notes.md.
 #include "io/scene_xml.h"
 
 #include <errno.h>
@@ -44,6 +47,14 @@
 #define SCENE_MAX_SURFACES 10000
 #define SCENE_MAX_STEPS 1000000000LL
 #define SCENE_MAX_COLLISIONS 1000000000LL
+/// <Simulation iterations> and <OutputMap every>: a huge count is refused
+/// rather than run for ever.
+#define SCENE_MAX_ITERATIONS 100000
+/// Ageing rules in <Ageing>, and in each <Surface>.
+#define SCENE_MAX_RULES 1000
+/// Buffer for a substance named by a Load, Exchange or rule: longer than any
+/// declared name, so a long undeclared one is reported as undeclared.
+#define SCENE_REF_MAX 128
 
 /// CTWMatrix must be the inverse of WTCMatrix to this relative tolerance
 /// (wx_camera_inverse_error): matrices printed with 4-6 digits pass.
@@ -63,8 +74,9 @@ typedef struct parser {
     const char *path; ///< the scene file as given, the prefix of every message
     wx_error *err;
     wx_scene *scene;
-    int64_t field_cap, emitter_cap, camera_cap, mesh_cap;
+    int64_t field_cap, emitter_cap, camera_cap, mesh_cap, rule_cap;
     const xmlNode *collider; ///< <Collider>, once seen
+    const xmlNode *substances; ///< <Substances>, read before everything else (or NULL)
 } parser;
 
 static int line_of(const xmlNode *node)
@@ -862,6 +874,19 @@ static wx_result parse_children(parser *p, const xmlNode *parent, const child_sp
 
 #define CHILDREN(table, user, seen) \
     parse_children(p, node, table, (int)(sizeof table / sizeof table[0]), user, seen)
+/// An element that holds no elements: any child is an unknown element.
+#define NO_CHILDREN() parse_children(p, node, NULL, 0, NULL, NULL)
+
+/// The attributes of an element without children.
+static wx_result parse_leaf(parser *p, const xmlNode *node, const attr_spec *specs, int count,
+                            void *dst, unsigned *present)
+{
+    wx_result r = parse_attributes(p, node, specs, count, dst, present);
+    return r != WX_OK ? r : NO_CHILDREN();
+}
+
+#define LEAF(table, dst, present) \
+    parse_leaf(p, node, table, (int)(sizeof table / sizeof table[0]), dst, present)
 
 // ---------------------------------------------------------------------------
 // Paths
@@ -900,18 +925,21 @@ static const attr_spec simulation_attrs[] = {
     { "timeStep", T_DOUBLE, offsetof(wx_scene, time_step), .range = R_POSITIVE },
     { "steps", T_INT64, offsetof(wx_scene, steps), .lo = 1, .hi = SCENE_MAX_STEPS },
     { "seed", T_UINT64, offsetof(wx_scene, seed), .range = R_FINITE },
+    // docs/design.md section 9: the simulation's steps, repeated.
+    { "iterations", T_INT, offsetof(wx_scene, iterations), .lo = 1,
+      .hi = SCENE_MAX_ITERATIONS },
 };
 
 static wx_result parse_bounding_box(parser *p, const xmlNode *node, void *user)
 {
     (void)user;
-    return ATTRS(bbox_attrs, p->scene, NULL);
+    return LEAF(bbox_attrs, p->scene, NULL);
 }
 
 static wx_result parse_simulation(parser *p, const xmlNode *node, void *user)
 {
     (void)user;
-    return ATTRS(simulation_attrs, p->scene, NULL);
+    return LEAF(simulation_attrs, p->scene, NULL);
 }
 
 static const child_spec solver_children[] = {
@@ -923,6 +951,250 @@ static wx_result parse_solver(parser *p, const xmlNode *node, void *user)
 {
     wx_result r = NO_ATTRS();
     return r != WX_OK ? r : CHILDREN(solver_children, user, NULL);
+}
+
+// ---------------------------------------------------------------------------
+// <Substances> (docs/design.md section 9), and the substances other elements name
+
+typedef struct substance_def {
+    char name[WX_SUBSTANCE_NAME_MAX + 1];
+} substance_def;
+
+static const attr_spec substance_attrs[] = {
+    { "name", T_TEXT, offsetof(substance_def, name), .size = sizeof(((substance_def *)0)->name),
+      .required = true },
+};
+
+/// What <Substances> declares, before it is stored in the scene.
+typedef struct substances_state {
+    int count;
+    char names[WX_MAX_SUBSTANCES][WX_SUBSTANCE_NAME_MAX + 1];
+    int lines[WX_MAX_SUBSTANCES];
+} substances_state;
+
+/// Letters, digits and '_', starting with a letter (ASCII, whatever the locale).
+static bool is_substance_name(const char *name)
+{
+    bool letter = (name[0] >= 'a' && name[0] <= 'z') || (name[0] >= 'A' && name[0] <= 'Z');
+    if (!letter) {
+        return false;
+    }
+    for (const char *c = name; *c != '\0'; ++c) {
+        bool ok = (*c >= 'a' && *c <= 'z') || (*c >= 'A' && *c <= 'Z') ||
+                  (*c >= '0' && *c <= '9') || *c == '_';
+        if (!ok) {
+            return false;
+        }
+    }
+    return true;
+}
+
+static wx_result parse_substance(parser *p, const xmlNode *node, void *user)
+{
+    substances_state *st = user;
+    if (st->count >= WX_MAX_SUBSTANCES) {
+        return fail(p, node, WX_CAUSE_TOO_MANY, "too many substances (at most %d)",
+                    WX_MAX_SUBSTANCES);
+    }
+    substance_def d = { .name = "" };
+    wx_result r = LEAF(substance_attrs, &d, NULL);
+    if (r != WX_OK) {
+        return r;
+    }
+    if (!is_substance_name(d.name)) {
+        return fail(p, node, WX_CAUSE_BAD_VALUE,
+                    "<Substance> name=\"%s\" must be letters, digits and '_', starting with a "
+                    "letter",
+                    d.name);
+    }
+    // The mask's channels are NAME.Y, and a TextureMap's plain "seen".
+    if (strcmp(d.name, "Y") == 0 || strcmp(d.name, "seen") == 0) {
+        return fail(p, node, WX_CAUSE_BAD_VALUE,
+                    "<Substance> name=\"%s\" is reserved (Y and seen name mask channels)",
+                    d.name);
+    }
+    for (int k = 0; k < st->count; ++k) {
+        if (strcmp(st->names[k], d.name) == 0) {
+            return fail(p, node, WX_CAUSE_DUPLICATE,
+                        "substance '%s' is declared twice (first at line %d)", d.name,
+                        st->lines[k]);
+        }
+    }
+    memcpy(st->names[st->count], d.name, sizeof d.name);
+    st->lines[st->count] = line_of(node);
+    st->count++;
+    return WX_OK;
+}
+
+static const child_spec substances_children[] = {
+    { "Substance", parse_substance, true },
+};
+
+/// Read before the other children of <Weathering> (parse_root).
+static wx_result parse_substances(parser *p, const xmlNode *node, void *user)
+{
+    (void)user;
+    substances_state st = { .count = 0 };
+    wx_result r = NO_ATTRS();
+    if (r != WX_OK || (r = CHILDREN(substances_children, &st, NULL)) != WX_OK) {
+        return r;
+    }
+    if (st.count == 0) {
+        return fail(p, node, WX_CAUSE_MISSING,
+                    "<Substances> declares no substance (give 1 to %d <Substance name=...>)",
+                    WX_MAX_SUBSTANCES);
+    }
+    wx_scene *s = p->scene;
+    s->substances_declared = true;
+    s->substance_count = st.count;
+    memset(s->substances, 0, sizeof s->substances);
+    memcpy(s->substances, st.names, sizeof st.names);
+    s->dirt_substance = wx_scene_substance(s, "dirt");
+    p->substances = node;
+    return WX_OK;
+}
+
+/// The main pass meets <Substances> again: it was read first.
+static wx_result skip_substances(parser *p, const xmlNode *node, void *user)
+{
+    (void)p;
+    (void)node;
+    (void)user;
+    return WX_OK;
+}
+
+/// The index of the substance that attribute `attr` of `node` names; an
+/// undeclared one is an error at the element's line.
+static wx_result find_substance(parser *p, const xmlNode *node, const char *attr,
+                                const char *name, int *index)
+{
+    const wx_scene *s = p->scene;
+    *index = wx_scene_substance(s, name);
+    if (*index >= 0) {
+        return WX_OK;
+    }
+    if (!s->substances_declared) {
+        return fail(p, node, WX_CAUSE_BAD_SCENE,
+                    "<%s> %s=\"%s\" names an undeclared substance (without <Substances> the "
+                    "scene has the one substance 'dirt')",
+                    name_of(node), attr, name);
+    }
+    char list[WX_MAX_SUBSTANCES * (WX_SUBSTANCE_NAME_MAX + 2) + 1] = "";
+    for (int k = 0; k < s->substance_count; ++k) {
+        wx_list_append(list, sizeof list, s->substances[k]);
+    }
+    return fail(p, node, WX_CAUSE_BAD_SCENE,
+                "<%s> %s=\"%s\" names an undeclared substance (<Substances> at line %d "
+                "declares: %s)",
+                name_of(node), attr, name, line_of(p->substances), list);
+}
+
+// ---------------------------------------------------------------------------
+// Ageing rules: <Transfer>, <Decay>, <Grow> in <Ageing> and in <Surface>
+
+/// Where rules go: the scene's global list or a surface's own.
+typedef struct rule_list {
+    wx_rule **rules;
+    int *count;
+    int64_t *capacity;
+} rule_list;
+
+typedef struct rule_def {
+    char from[SCENE_REF_MAX], to[SCENE_REF_MAX], substance[SCENE_REF_MAX];
+    float rate, amount;
+} rule_def;
+
+static const attr_spec transfer_attrs[] = {
+    { "from", T_TEXT, offsetof(rule_def, from), .size = SCENE_REF_MAX, .required = true },
+    { "to", T_TEXT, offsetof(rule_def, to), .size = SCENE_REF_MAX, .required = true },
+    { "rate", T_FLOAT, offsetof(rule_def, rate), .range = R_UNIT, .required = true },
+};
+
+static const attr_spec decay_attrs[] = {
+    { "substance", T_TEXT, offsetof(rule_def, substance), .size = SCENE_REF_MAX,
+      .required = true },
+    { "rate", T_FLOAT, offsetof(rule_def, rate), .range = R_UNIT, .required = true },
+};
+
+static const attr_spec grow_attrs[] = {
+    { "substance", T_TEXT, offsetof(rule_def, substance), .size = SCENE_REF_MAX,
+      .required = true },
+    { "amount", T_FLOAT, offsetof(rule_def, amount), .range = R_NONNEG, .required = true },
+};
+
+/// Appends the rule `node` gives to `user` (a rule_list, or a struct that
+/// starts with one).
+static wx_result parse_rule(parser *p, const xmlNode *node, wx_rule_kind kind, void *user)
+{
+    rule_list *list = user;
+    rule_def d = { .rate = 0.0f };
+    wx_result r = WX_OK;
+    wx_rule rule = { .kind = kind, .substance = -1, .to = -1, .line = line_of(node) };
+    switch (kind) {
+    case WX_RULE_TRANSFER:
+        if ((r = LEAF(transfer_attrs, &d, NULL)) == WX_OK &&
+            (r = find_substance(p, node, "from", d.from, &rule.substance)) == WX_OK) {
+            r = find_substance(p, node, "to", d.to, &rule.to);
+        }
+        if (r == WX_OK && rule.substance == rule.to) {
+            return fail(p, node, WX_CAUSE_BAD_VALUE,
+                        "<Transfer> from and to are the same substance '%s'", d.from);
+        }
+        break;
+    case WX_RULE_DECAY:
+        if ((r = LEAF(decay_attrs, &d, NULL)) == WX_OK) {
+            r = find_substance(p, node, "substance", d.substance, &rule.substance);
+        }
+        break;
+    case WX_RULE_GROW:
+        if ((r = LEAF(grow_attrs, &d, NULL)) == WX_OK) {
+            r = find_substance(p, node, "substance", d.substance, &rule.substance);
+        }
+        break;
+    }
+    if (r != WX_OK) {
+        return r;
+    }
+    rule.rate = kind == WX_RULE_GROW ? 0.0f : d.rate;
+    rule.amount = kind == WX_RULE_GROW ? d.amount : 0.0f;
+    r = grow_list(p, node, (void **)list->rules, *list->count, list->capacity, sizeof rule,
+                  SCENE_MAX_RULES, "ageing rules");
+    if (r != WX_OK) {
+        return r;
+    }
+    (*list->rules)[(*list->count)++] = rule;
+    return WX_OK;
+}
+
+static wx_result parse_transfer(parser *p, const xmlNode *node, void *user)
+{
+    return parse_rule(p, node, WX_RULE_TRANSFER, user);
+}
+
+static wx_result parse_decay(parser *p, const xmlNode *node, void *user)
+{
+    return parse_rule(p, node, WX_RULE_DECAY, user);
+}
+
+static wx_result parse_grow(parser *p, const xmlNode *node, void *user)
+{
+    return parse_rule(p, node, WX_RULE_GROW, user);
+}
+
+static const child_spec ageing_children[] = {
+    { "Transfer", parse_transfer, true },
+    { "Decay", parse_decay, true },
+    { "Grow", parse_grow, true },
+};
+
+/// <Ageing>: the global rules, run on every surface texel after each iteration.
+static wx_result parse_ageing(parser *p, const xmlNode *node, void *user)
+{
+    (void)user;
+    wx_scene *s = p->scene;
+    rule_list list = { .rules = &s->rules, .count = &s->rule_count, .capacity = &p->rule_cap };
+    wx_result r = NO_ATTRS();
+    return r != WX_OK ? r : CHILDREN(ageing_children, &list, NULL);
 }
 
 // ---------------------------------------------------------------------------
@@ -972,7 +1244,7 @@ static wx_result parse_gravity(parser *p, const xmlNode *node, void *user)
     (void)user;
     wx_field *f;
     wx_result r = add_field(p, node, WX_FIELD_GRAVITY, &f);
-    return r != WX_OK ? r : ATTRS(gravity_attrs, f, NULL);
+    return r != WX_OK ? r : LEAF(gravity_attrs, f, NULL);
 }
 
 static wx_result parse_wind(parser *p, const xmlNode *node, void *user)
@@ -980,7 +1252,7 @@ static wx_result parse_wind(parser *p, const xmlNode *node, void *user)
     (void)user;
     wx_field *f;
     wx_result r = add_field(p, node, WX_FIELD_WIND, &f);
-    if (r != WX_OK || (r = ATTRS(wind_attrs, f, NULL)) != WX_OK) {
+    if (r != WX_OK || (r = LEAF(wind_attrs, f, NULL)) != WX_OK) {
         return r;
     }
     double len = sqrt((double)f->dir[0] * f->dir[0] + (double)f->dir[1] * f->dir[1] +
@@ -1000,7 +1272,7 @@ static wx_result parse_turbulence(parser *p, const xmlNode *node, void *user)
     (void)user;
     wx_field *f;
     wx_result r = add_field(p, node, WX_FIELD_TURBULENCE, &f);
-    return r != WX_OK ? r : ATTRS(turbulence_attrs, f, NULL);
+    return r != WX_OK ? r : LEAF(turbulence_attrs, f, NULL);
 }
 
 static const child_spec force_field_children[] = {
@@ -1018,48 +1290,61 @@ static wx_result parse_force_fields(parser *p, const xmlNode *node, void *user)
 // ---------------------------------------------------------------------------
 // <Emitters>
 
+/// An emitter as its attributes give it: `dirt` apart, since it is the load of
+/// substance "dirt", wherever <Substances> puts that one.
+typedef struct emitter_def {
+    wx_emitter e;
+    float dirt; ///< NAN when the attribute is absent
+} emitter_def;
+
 #define EMITTER_NAME                                                                         \
-    { "name", T_TEXT, offsetof(wx_emitter, name), .size = sizeof(((wx_emitter *)0)->name) }
+    { "name", T_TEXT, offsetof(emitter_def, e.name), .size = sizeof(((wx_emitter *)0)->name) }
 
 #define EMITTER_ATTRS                                                                        \
     EMITTER_NAME,                                                                            \
-    { "centerX", T_FLOAT, offsetof(wx_emitter, center[0]), .range = R_FINITE },              \
-    { "centerY", T_FLOAT, offsetof(wx_emitter, center[1]), .range = R_FINITE },              \
-    { "centerZ", T_FLOAT, offsetof(wx_emitter, center[2]), .range = R_FINITE },              \
+    { "centerX", T_FLOAT, offsetof(emitter_def, e.center[0]), .range = R_FINITE },           \
+    { "centerY", T_FLOAT, offsetof(emitter_def, e.center[1]), .range = R_FINITE },           \
+    { "centerZ", T_FLOAT, offsetof(emitter_def, e.center[2]), .range = R_FINITE },           \
     EMITTER_FLIGHT
 
 // What every emitter has besides its place: rate, times, speed, load.
 #define EMITTER_FLIGHT                                                                       \
-    { "rate", T_DOUBLE, offsetof(wx_emitter, rate), .range = R_NONNEG },                     \
-    { "start", T_DOUBLE, offsetof(wx_emitter, start), .range = R_NONNEG },                   \
-    { "end", T_DOUBLE, offsetof(wx_emitter, end), .range = R_NONNEG },                       \
-    { "speed", T_FLOAT, offsetof(wx_emitter, speed), .range = R_NONNEG },                    \
-    { "mass", T_FLOAT, offsetof(wx_emitter, mass), .range = R_POSITIVE },                    \
-    { "dirt", T_FLOAT, offsetof(wx_emitter, dirt), .range = R_NONNEG },                      \
-    { "maxCollisions", T_INT, offsetof(wx_emitter, max_collisions), .lo = 1,                 \
+    { "rate", T_DOUBLE, offsetof(emitter_def, e.rate), .range = R_NONNEG },                  \
+    { "start", T_DOUBLE, offsetof(emitter_def, e.start), .range = R_NONNEG },                \
+    { "end", T_DOUBLE, offsetof(emitter_def, e.end), .range = R_NONNEG },                    \
+    { "speed", T_FLOAT, offsetof(emitter_def, e.speed), .range = R_NONNEG },                 \
+    { "mass", T_FLOAT, offsetof(emitter_def, e.mass), .range = R_POSITIVE },                 \
+    { "dirt", T_FLOAT, offsetof(emitter_def, dirt), .range = R_NONNEG },                     \
+    { "maxCollisions", T_INT, offsetof(emitter_def, e.max_collisions), .lo = 1,              \
       .hi = SCENE_MAX_COLLISIONS }
 
 static const attr_spec point_emitter_attrs[] = { EMITTER_ATTRS };
 
 static const attr_spec hemisphere_emitter_attrs[] = {
     EMITTER_ATTRS,
-    { "radius", T_FLOAT, offsetof(wx_emitter, radius), .range = R_POSITIVE },
+    { "radius", T_FLOAT, offsetof(emitter_def, e.radius), .range = R_POSITIVE },
 };
 
 // docs/design.md section 8: the box's corners are required (a box has no
 // natural default), the direction defaults to straight down.
 static const attr_spec box_emitter_attrs[] = {
     EMITTER_NAME,
-    { "minX", T_FLOAT, offsetof(wx_emitter, box_min[0]), .range = R_FINITE, .required = true },
-    { "minY", T_FLOAT, offsetof(wx_emitter, box_min[1]), .range = R_FINITE, .required = true },
-    { "minZ", T_FLOAT, offsetof(wx_emitter, box_min[2]), .range = R_FINITE, .required = true },
-    { "maxX", T_FLOAT, offsetof(wx_emitter, box_max[0]), .range = R_FINITE, .required = true },
-    { "maxY", T_FLOAT, offsetof(wx_emitter, box_max[1]), .range = R_FINITE, .required = true },
-    { "maxZ", T_FLOAT, offsetof(wx_emitter, box_max[2]), .range = R_FINITE, .required = true },
-    { "dirX", T_FLOAT, offsetof(wx_emitter, dir[0]), .range = R_FINITE },
-    { "dirY", T_FLOAT, offsetof(wx_emitter, dir[1]), .range = R_FINITE },
-    { "dirZ", T_FLOAT, offsetof(wx_emitter, dir[2]), .range = R_FINITE },
-    { "spread", T_FLOAT, offsetof(wx_emitter, spread), .range = R_NONNEG },
+    { "minX", T_FLOAT, offsetof(emitter_def, e.box_min[0]), .range = R_FINITE,
+      .required = true },
+    { "minY", T_FLOAT, offsetof(emitter_def, e.box_min[1]), .range = R_FINITE,
+      .required = true },
+    { "minZ", T_FLOAT, offsetof(emitter_def, e.box_min[2]), .range = R_FINITE,
+      .required = true },
+    { "maxX", T_FLOAT, offsetof(emitter_def, e.box_max[0]), .range = R_FINITE,
+      .required = true },
+    { "maxY", T_FLOAT, offsetof(emitter_def, e.box_max[1]), .range = R_FINITE,
+      .required = true },
+    { "maxZ", T_FLOAT, offsetof(emitter_def, e.box_max[2]), .range = R_FINITE,
+      .required = true },
+    { "dirX", T_FLOAT, offsetof(emitter_def, e.dir[0]), .range = R_FINITE },
+    { "dirY", T_FLOAT, offsetof(emitter_def, e.dir[1]), .range = R_FINITE },
+    { "dirZ", T_FLOAT, offsetof(emitter_def, e.dir[2]), .range = R_FINITE },
+    { "spread", T_FLOAT, offsetof(emitter_def, e.spread), .range = R_NONNEG },
     EMITTER_FLIGHT,
 };
 
@@ -1091,6 +1376,55 @@ static wx_result check_box_emitter(parser *p, const xmlNode *node, wx_emitter *e
     return WX_OK;
 }
 
+/// An emitter's <Load> children: which substances they gave, and where.
+typedef struct load_state {
+    wx_emitter *e;
+    bool dirt_attribute; ///< the emitter gives dirt=, substance dirt's load
+    unsigned given;      ///< bit k: a <Load> of substance k was read
+    int lines[WX_MAX_SUBSTANCES];
+} load_state;
+
+typedef struct load_def {
+    char substance[SCENE_REF_MAX];
+    float amount;
+} load_def;
+
+static const attr_spec load_attrs[] = {
+    { "substance", T_TEXT, offsetof(load_def, substance), .size = SCENE_REF_MAX,
+      .required = true },
+    { "amount", T_FLOAT, offsetof(load_def, amount), .range = R_NONNEG, .required = true },
+};
+
+static wx_result parse_load(parser *p, const xmlNode *node, void *user)
+{
+    load_state *st = user;
+    load_def d = { .amount = 0.0f };
+    int k;
+    wx_result r = LEAF(load_attrs, &d, NULL);
+    if (r != WX_OK || (r = find_substance(p, node, "substance", d.substance, &k)) != WX_OK) {
+        return r;
+    }
+    if (st->given & (1u << k)) {
+        return fail(p, node, WX_CAUSE_DUPLICATE,
+                    "<Load> of substance '%s' appears twice in this emitter (first at line %d)",
+                    d.substance, st->lines[k]);
+    }
+    if (k == p->scene->dirt_substance && st->dirt_attribute) {
+        return fail(p, node, WX_CAUSE_DUPLICATE,
+                    "<Load> of substance 'dirt' repeats the emitter's dirt attribute (line %d), "
+                    "which is that load: give one or the other",
+                    st->e->line);
+    }
+    st->given |= 1u << k;
+    st->lines[k] = line_of(node);
+    st->e->load[k] = d.amount;
+    return WX_OK;
+}
+
+static const child_spec load_children[] = {
+    { "Load", parse_load, true },
+};
+
 static wx_result parse_emitter(parser *p, const xmlNode *node, wx_emitter_kind kind)
 {
     wx_scene *s = p->scene;
@@ -1101,26 +1435,43 @@ static wx_result parse_emitter(parser *p, const xmlNode *node, wx_emitter_kind k
     }
     wx_emitter *e = &s->emitters[s->emitter_count++];
     // end = NAN until the simulation's duration is known (finish_emitters).
-    *e = (wx_emitter){ .kind = kind, .radius = kind == WX_EMITTER_HEMISPHERE ? 1.0f : 0.0f,
-                       .dir = { 0.0f, -1.0f, 0.0f }, .rate = 1000.0, .start = 0.0, .end = NAN,
-                       .speed = 1.0f, .mass = 1.0f, .dirt = 1.0f, .max_collisions = 100,
-                       .line = line_of(node) };
+    // Loads: 1 of dirt without <Substances> (version 1), else 0 of everything.
+    emitter_def d = {
+        .e = { .kind = kind, .radius = kind == WX_EMITTER_HEMISPHERE ? 1.0f : 0.0f,
+               .dir = { 0.0f, -1.0f, 0.0f }, .rate = 1000.0, .start = 0.0, .end = NAN,
+               .speed = 1.0f, .mass = 1.0f, .max_collisions = 100, .line = line_of(node) },
+        .dirt = NAN,
+    };
+    if (!s->substances_declared) {
+        d.e.load[s->dirt_substance] = 1.0f;
+    }
     switch (kind) {
     case WX_EMITTER_POINT:
-        r = ATTRS(point_emitter_attrs, e, NULL);
+        r = ATTRS(point_emitter_attrs, &d, NULL);
         break;
     case WX_EMITTER_HEMISPHERE:
-        r = ATTRS(hemisphere_emitter_attrs, e, NULL);
+        r = ATTRS(hemisphere_emitter_attrs, &d, NULL);
         break;
     case WX_EMITTER_BOX:
-        r = ATTRS(box_emitter_attrs, e, NULL);
+        r = ATTRS(box_emitter_attrs, &d, NULL);
         if (r == WX_OK) {
-            r = check_box_emitter(p, node, e);
+            r = check_box_emitter(p, node, &d.e);
         }
         break;
     }
+    *e = d.e;
     if (r != WX_OK) {
         return r;
+    }
+    bool dirt_attribute = !isnan(d.dirt); // the range check refused a given NaN
+    if (dirt_attribute) {
+        if (s->dirt_substance < 0) {
+            return fail(p, node, WX_CAUSE_BAD_SCENE,
+                        "<%s> dirt=\"%g\" is the load of substance 'dirt', which <Substances> "
+                        "(line %d) does not declare: give loads by <Load substance=... amount=...>",
+                        name_of(node), (double)d.dirt, line_of(p->substances));
+        }
+        e->load[s->dirt_substance] = d.dirt;
     }
     for (int i = 0; e->name[0] != '\0' && i < s->emitter_count - 1; ++i) {
         if (strcmp(s->emitters[i].name, e->name) == 0) {
@@ -1129,7 +1480,8 @@ static wx_result parse_emitter(parser *p, const xmlNode *node, wx_emitter_kind k
                         s->emitters[i].line);
         }
     }
-    return WX_OK;
+    load_state loads = { .e = e, .dirt_attribute = dirt_attribute };
+    return CHILDREN(load_children, &loads, NULL);
 }
 
 static wx_result parse_point_emitter(parser *p, const xmlNode *node, void *user)
@@ -1226,12 +1578,13 @@ typedef struct output_def {
     int second_pass;
     bool normalize;
     float noise, max_radius;
+    int every;
 } output_def;
 
 static const char *const second_pass_names[] = { "mean", "sum", NULL };
 
 enum { OUT_FILE, OUT_WIDTH, OUT_HEIGHT, OUT_RADIUS, OUT_SECOND_PASS, OUT_NORMALIZE, OUT_NOISE,
-       OUT_MAX_RADIUS }; // bits of `present`
+       OUT_MAX_RADIUS, OUT_EVERY }; // bits of `present`
 
 static const attr_spec output_attrs[] = {
     [OUT_FILE] = { "file", T_NAME, offsetof(output_def, file),
@@ -1246,6 +1599,9 @@ static const attr_spec output_attrs[] = {
     [OUT_NOISE] = { "noise", T_FLOAT, offsetof(output_def, noise), .range = R_POSITIVE },
     [OUT_MAX_RADIUS] = { "maxRadius", T_FLOAT, offsetof(output_def, max_radius),
                          .range = R_POSITIVE },
+    // docs/design.md section 10: BASE.NNNN.exr after every k-th iteration (0: none).
+    [OUT_EVERY] = { "every", T_INT, offsetof(output_def, every), .lo = 0,
+                    .hi = SCENE_MAX_ITERATIONS },
 };
 
 typedef struct view_def {
@@ -1279,7 +1635,7 @@ static wx_result parse_matrix(parser *p, const xmlNode *node, void *user)
     ortho_def *o = user;
     bool is_ctw = strcmp(name_of(node), "CTWMatrix") == 0;
     matrix_def m;
-    wx_result r = ATTRS(matrix_attrs, &m, NULL);
+    wx_result r = LEAF(matrix_attrs, &m, NULL);
     if (r != WX_OK) {
         return r;
     }
@@ -1296,7 +1652,7 @@ static wx_result parse_map(parser *p, const xmlNode *node, void *user)
         ++k;
     }
     map_def m = { NULL };
-    wx_result r = ATTRS(map_attrs, &m, NULL);
+    wx_result r = LEAF(map_attrs, &m, NULL);
     if (r == WX_OK) {
         free(o->map_files[k]);
         o->map_files[k] = m.file;
@@ -1313,7 +1669,7 @@ static wx_result parse_output_map(parser *p, const xmlNode *node, void *user)
     wx_scene_camera *cam = o->cam;
     output_def out = { .second_pass = WX_SECOND_PASS_MEAN, .noise = WX_DEFAULT_NOISE };
     snprintf(out.file, sizeof out.file, "mask.exr");
-    wx_result r = ATTRS(output_attrs, &out, &o->output_present);
+    wx_result r = LEAF(output_attrs, &out, &o->output_present);
     if (r != WX_OK) {
         return r;
     }
@@ -1330,6 +1686,7 @@ static wx_result parse_output_map(parser *p, const xmlNode *node, void *user)
     cam->max_radius = out.max_radius;
     cam->second_pass = out.second_pass == 1 ? WX_SECOND_PASS_SUM : WX_SECOND_PASS_MEAN;
     cam->normalize = out.normalize;
+    cam->every = out.every;
     o->output_node = node;
     return WX_OK;
 }
@@ -1338,7 +1695,7 @@ static wx_result parse_view(parser *p, const xmlNode *node, void *user)
 {
     ortho_def *o = user;
     view_def v = { .up = { 0.0f, 1.0f, 0.0f } };
-    wx_result r = ATTRS(view_attrs, &v, NULL);
+    wx_result r = LEAF(view_attrs, &v, NULL);
     if (r != WX_OK) {
         return r;
     }
@@ -1656,15 +2013,20 @@ typedef struct surface_def {
     int colors;
 } surface_def;
 
+enum { SF_MATERIAL, SF_ABSORPTION, SF_BOUNCE, SF_DIRT, SF_DEPOSIT, SF_EROSION, SF_COLORS };
+
 static const attr_spec surface_attrs[] = {
-    { "material", T_TEXT, offsetof(surface_def, material),
-      .size = sizeof(((surface_def *)0)->material), .required = true },
-    { "absorption", T_FLOAT, offsetof(surface_def, absorption), .range = R_UNIT },
-    { "bounce", T_FLOAT, offsetof(surface_def, bounce), .range = R_UNIT },
-    { "dirt", T_FLOAT, offsetof(surface_def, dirt), .range = R_NONNEG },
-    { "deposit", T_FLOAT, offsetof(surface_def, deposit), .range = R_UNIT },
-    { "erosion", T_FLOAT, offsetof(surface_def, erosion), .range = R_UNIT },
-    { "vertexColors", T_ENUM, offsetof(surface_def, colors), .choices = color_use_names },
+    [SF_MATERIAL] = { "material", T_TEXT, offsetof(surface_def, material),
+                      .size = sizeof(((surface_def *)0)->material), .required = true },
+    [SF_ABSORPTION] = { "absorption", T_FLOAT, offsetof(surface_def, absorption),
+                        .range = R_UNIT },
+    [SF_BOUNCE] = { "bounce", T_FLOAT, offsetof(surface_def, bounce), .range = R_UNIT },
+    // Substance dirt's exchange values (docs/design.md section 9).
+    [SF_DIRT] = { "dirt", T_FLOAT, offsetof(surface_def, dirt), .range = R_NONNEG },
+    [SF_DEPOSIT] = { "deposit", T_FLOAT, offsetof(surface_def, deposit), .range = R_UNIT },
+    [SF_EROSION] = { "erosion", T_FLOAT, offsetof(surface_def, erosion), .range = R_UNIT },
+    [SF_COLORS] = { "vertexColors", T_ENUM, offsetof(surface_def, colors),
+                    .choices = color_use_names },
 };
 
 typedef struct mesh_state {
@@ -1672,14 +2034,94 @@ typedef struct mesh_state {
     int64_t surface_cap;
 } mesh_state;
 
+/// A <Surface>'s children: its own rules (first, so that the rule handlers
+/// take this struct as their rule_list) and its <Exchange>s.
+typedef struct surface_state {
+    rule_list rules;
+    int64_t rule_cap;
+    wx_surface *sf;
+    /// Substance dirt's values come from the attributes (or vertex colours).
+    bool dirt_attributes;
+    unsigned exchanged; ///< bit k: an <Exchange> of substance k was read
+    int lines[WX_MAX_SUBSTANCES];
+} surface_state;
+
+typedef struct exchange_def {
+    char substance[SCENE_REF_MAX];
+    float initial, deposit, erosion;
+} exchange_def;
+
+static const attr_spec exchange_attrs[] = {
+    { "substance", T_TEXT, offsetof(exchange_def, substance), .size = SCENE_REF_MAX,
+      .required = true },
+    { "initial", T_FLOAT, offsetof(exchange_def, initial), .range = R_NONNEG },
+    { "deposit", T_FLOAT, offsetof(exchange_def, deposit), .range = R_UNIT },
+    { "erosion", T_FLOAT, offsetof(exchange_def, erosion), .range = R_UNIT },
+};
+
+static wx_result parse_exchange(parser *p, const xmlNode *node, void *user)
+{
+    surface_state *st = user;
+    exchange_def d = { .initial = 0.0f };
+    int k;
+    wx_result r = LEAF(exchange_attrs, &d, NULL);
+    if (r != WX_OK || (r = find_substance(p, node, "substance", d.substance, &k)) != WX_OK) {
+        return r;
+    }
+    if (st->exchanged & (1u << k)) {
+        return fail(p, node, WX_CAUSE_DUPLICATE,
+                    "<Exchange> of substance '%s' appears twice in this <Surface> (first at line "
+                    "%d)",
+                    d.substance, st->lines[k]);
+    }
+    if (k == p->scene->dirt_substance && st->dirt_attributes) {
+        return fail(p, node, WX_CAUSE_DUPLICATE,
+                    "<Exchange> of substance 'dirt' repeats the <Surface>'s dirt, deposit, "
+                    "erosion or vertexColors=\"dirt\" (line %d), which are its values: give one "
+                    "or the other",
+                    st->sf->line);
+    }
+    st->exchanged |= 1u << k;
+    st->lines[k] = line_of(node);
+    st->sf->initial[k] = d.initial;
+    st->sf->deposit[k] = d.deposit;
+    st->sf->erosion[k] = d.erosion;
+    return WX_OK;
+}
+
+static const child_spec surface_children[] = {
+    { "Exchange", parse_exchange, true },
+    { "Transfer", parse_transfer, true },
+    { "Decay", parse_decay, true },
+    { "Grow", parse_grow, true },
+};
+
 static wx_result parse_surface(parser *p, const xmlNode *node, void *user)
 {
     mesh_state *m = user;
     wx_mesh *mesh = m->mesh;
+    const wx_scene *s = p->scene;
     surface_def d = { .colors = 0 };
-    wx_result r = ATTRS(surface_attrs, &d, NULL);
+    unsigned given;
+    wx_result r = ATTRS(surface_attrs, &d, &given);
     if (r != WX_OK) {
         return r;
+    }
+    static const int dirt_attrs[] = { SF_DIRT, SF_DEPOSIT, SF_EROSION };
+    for (int i = 0; i < 3 && s->dirt_substance < 0; ++i) {
+        if (given & (1u << dirt_attrs[i])) {
+            return fail(p, node, WX_CAUSE_BAD_SCENE,
+                        "<Surface> %s= is substance 'dirt''s, which <Substances> (line %d) does "
+                        "not declare: give each substance's values by <Exchange substance=...>",
+                        surface_attrs[dirt_attrs[i]].name, line_of(p->substances));
+        }
+    }
+    static const wx_color_use colors[] = { WX_COLOR_NONE, WX_COLOR_IMPACT, WX_COLOR_DIRT };
+    if (colors[d.colors] == WX_COLOR_DIRT && s->dirt_substance < 0) {
+        return fail(p, node, WX_CAUSE_BAD_SCENE,
+                    "<Surface> vertexColors=\"dirt\" gives substance 'dirt''s values, which "
+                    "<Substances> (line %d) does not declare",
+                    line_of(p->substances));
     }
     for (int i = 0; i < mesh->surface_count; ++i) {
         if (strcmp(mesh->surfaces[i].material, d.material) == 0) {
@@ -1693,13 +2135,23 @@ static wx_result parse_surface(parser *p, const xmlNode *node, void *user)
     if (r != WX_OK) {
         return r;
     }
-    static const wx_color_use colors[] = { WX_COLOR_NONE, WX_COLOR_IMPACT, WX_COLOR_DIRT };
     wx_surface *sf = &mesh->surfaces[mesh->surface_count++];
-    *sf = (wx_surface){ .absorption = d.absorption, .bounce = d.bounce, .dirt = d.dirt,
-                        .deposit = d.deposit, .erosion = d.erosion, .colors = colors[d.colors],
-                        .line = line_of(node) };
+    // Every substance's initial amount, deposit and erosion default to 0;
+    // substance dirt's come from the attributes.
+    *sf = (wx_surface){ .absorption = d.absorption, .bounce = d.bounce,
+                        .colors = colors[d.colors], .line = line_of(node) };
+    if (s->dirt_substance >= 0) {
+        sf->initial[s->dirt_substance] = d.dirt;
+        sf->deposit[s->dirt_substance] = d.deposit;
+        sf->erosion[s->dirt_substance] = d.erosion;
+    }
     memcpy(sf->material, d.material, sizeof d.material);
-    return WX_OK;
+    surface_state st = { .sf = sf };
+    st.rules = (rule_list){ .rules = &sf->rules, .count = &sf->rule_count,
+                            .capacity = &st.rule_cap };
+    st.dirt_attributes = (given & ((1u << SF_DIRT) | (1u << SF_DEPOSIT) | (1u << SF_EROSION))) ||
+                         sf->colors == WX_COLOR_DIRT;
+    return CHILDREN(surface_children, &st, NULL);
 }
 
 static const attr_spec mesh_attrs[] = {
@@ -1752,8 +2204,56 @@ static wx_result parse_geometry(parser *p, const xmlNode *node, void *user)
 static const child_spec root_children[] = {
     { "Solver", parse_solver, false },         { "ForceFields", parse_force_fields, false },
     { "Emitters", parse_emitters, false },     { "Collider", parse_collider, false },
-    { "Geometry", parse_geometry, false },
+    { "Geometry", parse_geometry, false },     { "Substances", skip_substances, false },
+    { "Ageing", parse_ageing, false },
 };
+
+static const char *const rule_elements[] = { [WX_RULE_TRANSFER] = "Transfer",
+                                             [WX_RULE_DECAY] = "Decay",
+                                             [WX_RULE_GROW] = "Grow" };
+
+/// A surface's own rules need the bake to record which <Surface> each texel of
+/// every input camera shows; maps the scene names were made elsewhere and do
+/// not (docs/design.md section 9: pre-rendered maps have global rules only).
+static wx_result check_surface_rules(parser *p)
+{
+    const wx_scene *s = p->scene;
+    const wx_scene_camera *given = NULL;
+    for (int c = 0; c < s->camera_count && given == NULL; ++c) {
+        if (!s->cameras[c].is_output && wx_has_path(s->cameras[c].depth_path)) {
+            given = &s->cameras[c];
+        }
+    }
+    for (int m = 0; m < s->mesh_count && given != NULL; ++m) {
+        for (int k = 0; k < s->meshes[m].surface_count; ++k) {
+            const wx_surface *sf = &s->meshes[m].surfaces[k];
+            if (sf->rule_count > 0) {
+                const wx_rule *rule = &sf->rules[0];
+                return fail_line(
+                    p, rule->line, WX_CAUSE_BAD_SCENE,
+                    "<%s> in <Surface material=\"%s\"> is a per-surface rule: the bake must "
+                    "record which surface each texel shows, but input camera '%s' (line %d) has "
+                    "pre-rendered maps; give it a <View> without maps so that bake makes them, "
+                    "or move the rule to <Ageing>",
+                    rule_elements[rule->kind], sf->material, given->name, given->line);
+            }
+        }
+    }
+    return WX_OK;
+}
+
+/// The first <Substances> child of the root, read before the rest (a second
+/// one is then refused as a duplicate by the main pass).
+static wx_result read_substances_first(parser *p, const xmlNode *root)
+{
+    for (const xmlNode *n = root->children; n != NULL; n = n->next) {
+        if (n->type == XML_ELEMENT_NODE && n->ns == NULL &&
+            strcmp(name_of(n), "Substances") == 0) {
+            return parse_substances(p, n, NULL);
+        }
+    }
+    return WX_OK;
+}
 
 /// The mask must not take the name of a map that bake or simulate writes.
 static wx_result check_output_name(parser *p)
@@ -1788,17 +2288,17 @@ static wx_result parse_root(parser *p, const xmlNode *node)
                     "the root element is <%s>, expected <Weathering>", name_of(node));
     }
     wx_result r = check_content(p, node);
-    if (r != WX_OK || (r = NO_ATTRS()) != WX_OK ||
+    if (r != WX_OK || (r = NO_ATTRS()) != WX_OK || (r = read_substances_first(p, node)) != WX_OK ||
         (r = CHILDREN(root_children, NULL, NULL)) != WX_OK) {
         return r;
     }
     if (p->collider == NULL) {
         return fail(p, node, WX_CAUSE_MISSING, "<Weathering> needs a <Collider> with the cameras");
     }
-    if ((r = finish_emitters(p)) != WX_OK) {
+    if ((r = finish_emitters(p)) != WX_OK || (r = check_output_name(p)) != WX_OK) {
         return r;
     }
-    return check_output_name(p);
+    return check_surface_rules(p);
 }
 
 // ---------------------------------------------------------------------------
@@ -1837,6 +2337,10 @@ static wx_result scene_init(wx_scene *s, const char *path, wx_error *err)
     s->seed = 1;
     s->collider = wx_default_collider_def();
     s->output_index = -1;
+    s->substance_count = 1;
+    strcpy(s->substances[0], "dirt");
+    s->dirt_substance = 0;
+    s->iterations = 1;
     return WX_OK;
 }
 

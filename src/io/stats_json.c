@@ -8,7 +8,36 @@
 wx_result wx_write_stats(const char *path, const wx_sim_stats *stats, const wx_phase_times *times,
                          int threads, uint64_t seed, wx_error *err)
 {
-    char json[4096];
+    char dirt[1024] = "", substances[8192] = "";
+    if (stats->dirt_index >= 0 || stats->substance_count == 0) {
+        snprintf(dirt, sizeof dirt,
+                 "  \"dirt\": {\n"
+                 "    \"initial_surface\": %.17g,\n"
+                 "    \"emitted\": %.17g,\n"
+                 "    \"final_surface\": %.17g,\n"
+                 "    \"in_flight\": %.17g,\n"
+                 "    \"escaped\": %.17g\n"
+                 "  },\n",
+                 stats->dirt_initial_surface, stats->dirt_emitted, stats->dirt_final_surface,
+                 stats->dirt_in_flight, stats->dirt_escaped);
+    }
+    size_t used = 0;
+    for (int k = 0; k < stats->substance_count && k < WX_MAX_SUBSTANCES; ++k) {
+        const wx_substance_ledger *l = &stats->substance[k];
+        int m = snprintf(substances + used, sizeof substances - used,
+                         "%s    \"%s\": { \"initial_surface\": %.17g, \"emitted\": %.17g, "
+                         "\"grown\": %.17g, \"transferred_in\": %.17g, \"transferred_out\": "
+                         "%.17g, \"decayed\": %.17g, \"final_surface\": %.17g, "
+                         "\"in_flight\": %.17g, \"escaped\": %.17g }",
+                         k > 0 ? ",\n" : "", stats->substance_names[k], l->initial_surface,
+                         l->emitted, l->grown, l->transferred_in, l->transferred_out, l->decayed,
+                         l->final_surface, l->in_flight, l->escaped);
+        if (m < 0 || (size_t)m >= sizeof substances - used) {
+            return wx_fail(err, WX_CAUSE_INTERNAL, "%s: statistics too long", path);
+        }
+        used += (size_t)m;
+    }
+    char json[16384];
     int n = snprintf(
         json, sizeof json,
         "{\n"
@@ -20,13 +49,9 @@ wx_result wx_write_stats(const char *path, const wx_sim_stats *stats, const wx_p
         "  \"escaped\": %lld,\n"
         "  \"escaped_without_hit\": %lld,\n"
         "  \"alive\": %lld,\n"
-        "  \"dirt\": {\n"
-        "    \"initial_surface\": %.17g,\n"
-        "    \"emitted\": %.17g,\n"
-        "    \"final_surface\": %.17g,\n"
-        "    \"in_flight\": %.17g,\n"
-        "    \"escaped\": %.17g\n"
-        "  },\n"
+        "%s"
+        "  \"iterations\": %lld,\n"
+        "  \"substances\": {\n%s\n  },\n"
         "  \"seconds\": {\n"
         "    \"load\": %.6f,\n"
         "    \"bake\": %.6f,\n"
@@ -43,9 +68,7 @@ wx_result wx_write_stats(const char *path, const wx_sim_stats *stats, const wx_p
         (long long)stats->particles_emitted, (long long)stats->particle_steps,
         (long long)stats->collisions, (long long)stats->absorbed, (long long)stats->settled,
         (long long)stats->escaped, (long long)stats->escaped_without_hit,
-        (long long)stats->alive, stats->dirt_initial_surface,
-        stats->dirt_emitted, stats->dirt_final_surface, stats->dirt_in_flight,
-        stats->dirt_escaped, times->load, times->bake, times->simulate, times->gather,
+        (long long)stats->alive, dirt, (long long)stats->iterations, substances, times->load, times->bake, times->simulate, times->gather,
         times->total, times->simulate_detail.read, times->simulate_detail.setup,
         times->simulate_detail.compute, times->simulate_detail.write, times->gather_detail.read,
         times->gather_detail.compute, times->gather_detail.write, threads,

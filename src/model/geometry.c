@@ -47,8 +47,12 @@ wx_result wx_geometry_match(const wx_scene *scene, int mesh_index, wx_geometry_m
                            scene->path, surf->line, surf->material, color_use_name(surf->colors),
                            wx_mesh_display_name(scene, mesh), name);
         }
-        if (surf->dirt > 0.0f || surf->colors == WX_COLOR_DIRT) {
-            *has_dirt = true;
+        int substances = scene->substance_count > 1 ? scene->substance_count : 1;
+        for (int s = 0; s < substances; ++s) {
+            *has_dirt = *has_dirt || surf->initial[s] > 0.0f;
+        }
+        if (surf->colors == WX_COLOR_DIRT || wx_scene_has_grow(scene)) {
+            *has_dirt = true; // Grow needs the same record of who owns each point
         }
         g->surface[m] = match;
     }

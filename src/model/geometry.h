@@ -23,7 +23,7 @@ typedef struct wx_geometry {
     int64_t triangles;  ///< all meshes
     int64_t vertices;
     int64_t file_bytes; ///< sizes of the mesh files
-    bool has_dirt;      ///< some matched surface starts with dirt (a density or vertex colours)
+    bool has_dirt;      ///< some matched surface starts with a substance (a density or vertex colours), or a rule grows one
     double import_s;    ///< wall-clock seconds of the imports
 } wx_geometry;
 

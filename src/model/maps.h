@@ -10,7 +10,9 @@
 #include <stdbool.h>
 
 #include "core/error.h"
+#include "core/limits.h"
 #include "model/image.h"
+#include "model/scene.h"
 
 typedef struct wx_maps {
     int width;
@@ -18,14 +20,25 @@ typedef struct wx_maps {
     float *depth;   ///< width*height, d or +inf
     float *normal;  ///< 3*width*height, interleaved x y z, world space, unit
     float *impact;  ///< 2*width*height, interleaved absorption, bounce
-    float *dirt;    ///< width*height, dirt amount on the texel's surface patch
-    float *deposit; ///< width*height, deposit fraction
-    float *erosion; ///< width*height, erosion fraction
+    /// The dirt planes hold `substances` planes of width*height one after the
+    /// other (substance s at s*width*height; docs/design.md section 9): with
+    /// one substance, version 1's single planes.
+    int substances; ///< 0 or 1: one substance
+    float *dirt;    ///< amount of each substance on the texel's surface patch
+    float *deposit; ///< deposit fraction
+    float *erosion; ///< erosion fraction
     /// What a simulation adds, for the gather (NULL when the dirt map holds no
-    /// simulation: a baked or given map): the dirt it started from, and the
-    /// impacts that exchanged dirt at each texel.
-    float *initial_dirt; ///< width*height
+    /// simulation: a baked or given map): per substance, the amount the surface
+    /// would hold without the particles (the initial amount aged by the rules),
+    /// and the impacts that exchanged dirt at each texel.
+    float *initial_dirt; ///< substances planes
     float *hits;         ///< width*height
+    /// What the bake records for ageing (NULL when not recorded): the global
+    /// index + 1 of the <Surface> each texel shows (0: none), and the surface
+    /// area the texel owns (texel area / |N.view| where this camera sees the
+    /// point most head-on, else 0), which Grow multiplies.
+    float *surface; ///< width*height
+    float *area;    ///< width*height
     /// The dirt map file's header attributes (camera matrices, name), kept so
     /// that the simulated dirt map is written with them without reading the
     /// file again.
@@ -33,8 +46,34 @@ typedef struct wx_maps {
     wx_attr *dirt_attrs;
 } wx_maps;
 
+/// Name of the channel in which a simulated dirt map counts each texel's hits.
+#define WX_HITS_CHANNEL "hits"
+
+/// Name of the channel in which a simulated dirt map keeps its initial dirt.
+#define WX_INITIAL_DIRT_CHANNEL "initialDirt"
+
+/// Names of the channels in which the bake records each texel's <Surface> and
+/// the area Grow multiplies (model/maps.h).
+#define WX_SURFACE_CHANNEL "surface"
+#define WX_AREA_CHANNEL "area"
+
+/// The channels of a dirt map of `scene` (docs/design.md section 9), in the
+/// order of wx_maps' planes: without declared substances version 1's R, G, B
+/// (then initialDirt and hits once `simulated`); with them, per substance
+/// NAME.amount, NAME.deposit, NAME.erosion (then NAME.initial per substance
+/// and hits once simulated). Then "surface" when some surface has rules of
+/// its own, and "area" when a rule grows. Returns the count (at most
+/// WX_IMAGE_MAX_CHANNELS).
+int wx_dirt_channels(const wx_scene *scene, bool simulated, char names[][WX_NAME_MAX]);
+
 /// Frees every plane; the struct is zeroed.
 void wx_maps_free(wx_maps *maps);
+
+/// Substances the dirt planes hold (at least 1).
+static inline int wx_maps_substances(const wx_maps *maps)
+{
+    return maps->substances > 1 ? maps->substances : 1;
+}
 
 /// True when a stored depth value means "no surface" (NaN, <= 0, >= 1e30, inf).
 static inline bool wx_depth_is_empty(float d)

@@ -40,12 +40,83 @@ bool wx_scene_set_path(char **slot, const char *path)
     return true;
 }
 
+int wx_scene_substance(const wx_scene *scene, const char *name)
+{
+    for (int s = 0; s < scene->substance_count; ++s) {
+        if (strcmp(scene->substances[s], name) == 0) {
+            return s;
+        }
+    }
+    return -1;
+}
+
+bool wx_scene_has_surface_rules(const wx_scene *scene)
+{
+    for (int m = 0; m < scene->mesh_count; ++m) {
+        for (int k = 0; k < scene->meshes[m].surface_count; ++k) {
+            if (scene->meshes[m].surfaces[k].rule_count > 0) {
+                return true;
+            }
+        }
+    }
+    return false;
+}
+
+bool wx_scene_has_ageing(const wx_scene *scene)
+{
+    return scene->substances_declared || scene->rule_count > 0 ||
+           wx_scene_has_surface_rules(scene);
+}
+
+static bool rules_grow(const wx_rule *rules, int count)
+{
+    for (int r = 0; r < count; ++r) {
+        if (rules[r].kind == WX_RULE_GROW) {
+            return true;
+        }
+    }
+    return false;
+}
+
+bool wx_scene_has_grow(const wx_scene *scene)
+{
+    if (rules_grow(scene->rules, scene->rule_count)) {
+        return true;
+    }
+    for (int m = 0; m < scene->mesh_count; ++m) {
+        for (int k = 0; k < scene->meshes[m].surface_count; ++k) {
+            const wx_surface *sf = &scene->meshes[m].surfaces[k];
+            if (rules_grow(sf->rules, sf->rule_count)) {
+                return true;
+            }
+        }
+    }
+    return false;
+}
+
+int wx_scene_surface_base(const wx_scene *scene, int mesh)
+{
+    int base = 0;
+    for (int m = 0; m < mesh && m < scene->mesh_count; ++m) {
+        base += scene->meshes[m].surface_count;
+    }
+    return base;
+}
+
+int wx_scene_surface_count(const wx_scene *scene)
+{
+    return wx_scene_surface_base(scene, scene->mesh_count);
+}
+
 void wx_scene_free(wx_scene *scene)
 {
     if (scene == NULL) {
         return;
     }
     for (int m = 0; m < scene->mesh_count; ++m) {
+        for (int k = 0; k < scene->meshes[m].surface_count; ++k) {
+            free(scene->meshes[m].surfaces[k].rules);
+        }
         free(scene->meshes[m].surfaces);
         free(scene->meshes[m].path);
     }
@@ -62,5 +133,6 @@ void wx_scene_free(wx_scene *scene)
     free(scene->dir);
     free(scene->emitters);
     free(scene->fields);
+    free(scene->rules);
     memset(scene, 0, sizeof *scene);
 }

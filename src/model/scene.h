@@ -47,7 +47,10 @@ typedef struct wx_emitter {
     double end;          ///< seconds (default: end of the simulation, steps*timeStep)
     float speed;         ///< m/s (default 1)
     float mass;          ///< default 1, > 0
-    float dirt;          ///< load per particle (default 1)
+    /// Load per particle of each substance (docs/design.md section 9): the
+    /// `dirt` attribute is that of substance "dirt", <Load> children the
+    /// others. Default 1 for "dirt" in a scene without <Substances>, else 0.
+    float load[WX_MAX_SUBSTANCES];
     int max_collisions;  ///< default 100, >= 1
     int line;
 } wx_emitter;
@@ -99,6 +102,7 @@ typedef struct wx_scene_camera {
     float max_radius;        ///< default WX_DEFAULT_MAX_RADIUS_TEXELS output texels
     wx_second_pass second_pass;
     bool normalize;          ///< scale the final mask to [0,1]
+    int every;               ///< write BASE.NNNN.exr after every k-th iteration (0: none)
     int line;
 } wx_scene_camera;
 
@@ -108,15 +112,37 @@ typedef enum wx_color_use {
     WX_COLOR_DIRT,   ///< dirt density, deposit, erosion from R,G,B
 } wx_color_use;
 
+typedef enum wx_rule_kind {
+    WX_RULE_TRANSFER, ///< t = rate * s_from; s_from -= t; s_to += t
+    WX_RULE_DECAY,    ///< s -= rate * s
+    WX_RULE_GROW,     ///< s += amount per square metre of surface
+} wx_rule_kind;
+
+/// One ageing rule (docs/design.md section 9), run on every surface texel
+/// after each iteration.
+typedef struct wx_rule {
+    wx_rule_kind kind;
+    int substance; ///< Transfer: from; Decay, Grow: the substance (index)
+    int to;        ///< Transfer: to (index); else -1
+    float rate;    ///< Transfer, Decay: in [0, 1]
+    float amount;  ///< Grow: per square metre, >= 0
+    int line;
+} wx_rule;
+
 /// Weathering properties of one material name ("*" matches every other).
 typedef struct wx_surface {
     char material[128];
     float absorption; ///< impact R
     float bounce;     ///< impact G
-    float dirt;       ///< initial dirt per square metre
-    float deposit;    ///< dirt G
-    float erosion;    ///< dirt B
+    /// Per substance (index into wx_scene.substances): the initial amount per
+    /// square metre and the exchange fractions. Substance "dirt"'s come from the
+    /// dirt, deposit and erosion attributes, the others' from <Exchange>.
+    float initial[WX_MAX_SUBSTANCES];
+    float deposit[WX_MAX_SUBSTANCES];
+    float erosion[WX_MAX_SUBSTANCES];
     wx_color_use colors; ///< vertexColors="none|impact|dirt"
+    wx_rule *rules;      ///< this surface's own ageing rules, in document order (owned)
+    int rule_count;
     int line;
 } wx_surface;
 
@@ -151,6 +177,16 @@ typedef struct wx_scene {
 
     wx_mesh *meshes;
     int mesh_count;
+
+    /// Substances (docs/design.md section 9): without <Substances> the one
+    /// substance "dirt" (substances_declared false).
+    int substance_count;
+    char substances[WX_MAX_SUBSTANCES][WX_SUBSTANCE_NAME_MAX + 1];
+    bool substances_declared;
+    int dirt_substance;      ///< index of "dirt", or -1 when not declared
+    int iterations;          ///< >= 1, default 1
+    wx_rule *rules;          ///< global ageing rules (<Ageing>), document order (owned)
+    int rule_count;
 } wx_scene;
 
 /// True when a path is given (not NULL, not empty).
@@ -168,6 +204,26 @@ wx_collider_def wx_default_collider_def(void);
 
 /// The mesh path as the scene file wrote it (relative to the scene's folder).
 const char *wx_mesh_display_name(const wx_scene *scene, const wx_mesh *mesh);
+
+/// Index of the substance called `name`, or -1.
+int wx_scene_substance(const wx_scene *scene, const char *name);
+
+/// True when the scene uses anything beyond version 1's one substance: declared
+/// substances or ageing rules (global or per surface). Such a scene's mask has
+/// a channel NAME.Y per substance (docs/design.md section 10).
+bool wx_scene_has_ageing(const wx_scene *scene);
+
+/// True when some surface has rules of its own: the bake then records which
+/// surface each texel shows.
+bool wx_scene_has_surface_rules(const wx_scene *scene);
+
+/// True when some rule (global or per surface) grows a substance.
+bool wx_scene_has_grow(const wx_scene *scene);
+
+/// Total number of <Surface>s over all meshes; surface k of mesh m has the
+/// global index wx_scene_surface_base(scene, m) + k.
+int wx_scene_surface_count(const wx_scene *scene);
+int wx_scene_surface_base(const wx_scene *scene, int mesh);
 
 /// Frees everything the scene owns; the struct is zeroed.
 void wx_scene_free(wx_scene *scene);

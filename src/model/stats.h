@@ -6,6 +6,23 @@
 
 #include <stdint.h>
 
+#include "core/limits.h"
+
+/// The ledger of one substance (docs/design.md section 9): exact to rounding,
+/// initial_surface + emitted + grown + transferred_in = final_surface +
+/// in_flight + escaped + decayed + transferred_out.
+typedef struct wx_substance_ledger {
+    double initial_surface;
+    double emitted;
+    double grown;
+    double transferred_in;
+    double transferred_out;
+    double decayed;
+    double final_surface;
+    double in_flight;
+    double escaped;
+} wx_substance_ledger;
+
 /// Counters of a simulation (the pinned keys of --stats).
 typedef struct wx_sim_stats {
     int64_t particles_emitted;
@@ -16,11 +33,20 @@ typedef struct wx_sim_stats {
     int64_t escaped;
     int64_t escaped_without_hit; ///< of the emitters' particles, those that never hit
     int64_t alive;
+    /// Substance "dirt"'s ledger (docs/design.md section 6); zero when the
+    /// scene declares substances without "dirt".
     double dirt_initial_surface;
     double dirt_emitted;
     double dirt_final_surface;
     double dirt_in_flight;
     double dirt_escaped;
+    /// Every substance's ledger, in the scene's order, and the iterations done
+    /// (each completed by its ageing rules).
+    int substance_count;
+    char substance_names[WX_MAX_SUBSTANCES][WX_SUBSTANCE_NAME_MAX + 1];
+    int dirt_index; ///< substance "dirt", or -1 (the --stats file then has no "dirt")
+    wx_substance_ledger substance[WX_MAX_SUBSTANCES];
+    int64_t iterations;
 } wx_sim_stats;
 
 /// Wall-clock seconds of the parts of a phase: reading its inputs, setting up

@@ -56,6 +56,43 @@ wx_result wx_gather_check(const wx_scene *scene, wx_error *err)
 wx_result wx_gather_maps(const wx_scene *scene, const wx_run_def *opts, const wx_maps *in_maps,
                          const wx_maps *given_out, wx_phase_detail *detail, wx_error *err)
 {
+    return wx_gather_frame(scene, opts, in_maps, given_out, 0, detail, err);
+}
+
+int wx_mask_channels(const wx_scene *scene, char names[][WX_NAME_MAX])
+{
+    if (!scene->substances_declared) {
+        snprintf(names[0], WX_NAME_MAX, "Y");
+        return 1;
+    }
+    for (int s = 0; s < scene->substance_count; ++s) {
+        snprintf(names[s], WX_NAME_MAX, "%s.Y", scene->substances[s]);
+    }
+    return scene->substance_count;
+}
+
+void wx_frame_name(const char *mask_name, int frame, char *out, size_t cap)
+{
+    size_t n = strlen(mask_name);
+    size_t base = n >= 4 && strcmp(mask_name + n - 4, ".exr") == 0 ? n - 4 : n;
+    snprintf(out, cap, "%.*s.%04d.exr", (int)base, mask_name, frame);
+}
+
+void wx_channel_preview_name(const char *mask_name, const char *channel, char *out, size_t cap)
+{
+    size_t n = strlen(mask_name);
+    size_t base = n >= 4 && strcmp(mask_name + n - 4, ".exr") == 0 ? n - 4 : n;
+    size_t len = strlen(channel);
+    if (len >= 2 && strcmp(channel + len - 2, ".Y") == 0) {
+        len -= 2; // rust.Y -> BASE_rust.png
+    }
+    snprintf(out, cap, "%.*s_%.*s.png", (int)base, mask_name, (int)len, channel);
+}
+
+wx_result wx_gather_frame(const wx_scene *scene, const wx_run_def *opts, const wx_maps *in_maps,
+                          const wx_maps *given_out, int frame, wx_phase_detail *detail,
+                          wx_error *err)
+{
     wx_phase_detail local;
     detail = detail != NULL ? detail : &local;
     memset(detail, 0, sizeof *detail);
@@ -66,9 +103,18 @@ wx_result wx_gather_maps(const wx_scene *scene, const wx_run_def *opts, const wx
                        scene->path);
     }
     const wx_scene_camera *out = &scene->cameras[scene->output_index];
+    char names[WX_IMAGE_MAX_CHANNELS][WX_NAME_MAX];
+    const char *channel_names[WX_IMAGE_MAX_CHANNELS];
+    int channels = wx_mask_channels(scene, names);
+    for (int c = 0; c < channels; ++c) {
+        channel_names[c] = names[c];
+    }
     char mask_path[WX_PATH_MAX], png_path[WX_PATH_MAX], png_name[WX_OUTPUT_NAME_MAX];
+    char frame_name[WX_OUTPUT_NAME_MAX];
+    wx_frame_name(out->output_file, frame, frame_name, sizeof frame_name);
     wx_preview_name(out->output_file, png_name, sizeof png_name);
-    wx_result result = wx_output_path(scene, opts, out->output_file, mask_path, err);
+    wx_result result = wx_output_path(scene, opts, frame > 0 ? frame_name : out->output_file,
+                                      mask_path, err);
     if (result == WX_OK) {
         result = wx_output_path(scene, opts, png_name, png_path, err);
     }
@@ -112,10 +158,17 @@ wx_result wx_gather_maps(const wx_scene *scene, const wx_run_def *opts, const wx
     double t1 = wx_now_s();
     detail->read = t1 - t0;
     if (result == WX_OK) {
-        static const char *const names[] = { "Y" };
-        result = wx_image_alloc(image, om->width, om->height, 1, names, err);
+        result = wx_image_alloc(image, om->width, om->height, channels, channel_names, err);
     }
-    if (result == WX_OK) {
+    // One gather per substance: its amount and baseline planes (model/maps.h),
+    // the hits all substances share.
+    for (int s = 0; s < channels && result == WX_OK; ++s) {
+        for (int v = 0; v < k; ++v) {
+            size_t plane = (size_t)s * (size_t)in_maps[v].width * (size_t)in_maps[v].height;
+            views[v].dirt = in_maps[v].dirt != NULL ? in_maps[v].dirt + plane : NULL;
+            views[v].initial = in_maps[v].initial_dirt != NULL ? in_maps[v].initial_dirt + plane
+                                                               : NULL;
+        }
         wx_gather_def def = wx_default_gather_def();
         def.target = wx_target_from_camera(&out->camera, om);
         def.inputs = views;
@@ -129,8 +182,8 @@ wx_result wx_gather_maps(const wx_scene *scene, const wx_run_def *opts, const wx
         def.threads = opts->threads;
         def.quiet = opts->quiet;
         wx_gather_stats st;
-        result = wx_gather_compute(&def, image->channels[0], &st, err);
-        if (result == WX_OK && def.adaptive && st.surface_texels > 0 &&
+        result = wx_gather_compute(&def, image->channels[s], &st, err);
+        if (result == WX_OK && s == 0 && frame == 0 && def.adaptive && st.surface_texels > 0 &&
             10 * st.capped_texels > st.surface_texels) {
             wx_note(opts->quiet,
                     "gather: %.0f%% of the mask's surface holds fewer than the %.0f impacts "
@@ -154,9 +207,17 @@ wx_result wx_gather_maps(const wx_scene *scene, const wx_run_def *opts, const wx
         image->threads = opts->threads; // the chunks compressed in parallel: the same bytes
         result = wx_exr_write(mask_path, image, err);
     }
-    if (result == WX_OK) {
+    if (result == WX_OK && frame == 0 && channels == 1) {
         result = wx_preview_write_png(png_path, image->channels[0], om->depth, om->width,
                                       om->height, err);
+    }
+    for (int c = 0; c < channels && result == WX_OK && frame == 0 && channels > 1; ++c) {
+        wx_channel_preview_name(out->output_file, names[c], png_name, sizeof png_name);
+        result = wx_output_path(scene, opts, png_name, png_path, err);
+        if (result == WX_OK) {
+            result = wx_preview_write_png(png_path, image->channels[c], om->depth, om->width,
+                                          om->height, err);
+        }
     }
     detail->write = wx_now_s() - t2;
 

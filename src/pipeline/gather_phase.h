@@ -32,4 +32,20 @@ wx_result wx_gather_scene(const wx_scene *scene, const wx_run_def *opts, wx_erro
 wx_result wx_gather_maps(const wx_scene *scene, const wx_run_def *opts, const wx_maps *in_maps,
                          const wx_maps *out_maps, wx_phase_detail *detail, wx_error *err);
 
+/// wx_gather_maps for frame `frame` of an image sequence (docs/design.md
+/// section 10): frame 0 writes the final BASE.exr and its previews, frame k > 0
+/// BASE.NNNN.exr (k on four digits) without previews.
+wx_result wx_gather_frame(const wx_scene *scene, const wx_run_def *opts, const wx_maps *in_maps,
+                          const wx_maps *out_maps, int frame, wx_phase_detail *detail,
+                          wx_error *err);
+
+/// The mask's channels (docs/design.md section 10): "Y" for a scene without
+/// <Substances>, else NAME.Y per substance. Returns the count.
+int wx_mask_channels(const wx_scene *scene, char names[][WX_NAME_MAX]);
+
+/// BASE.NNNN.exr of mask file BASE.exr, and BASE_NAME.png, the preview of
+/// channel NAME.Y.
+void wx_frame_name(const char *mask_name, int frame, char *out, size_t cap);
+void wx_channel_preview_name(const char *mask_name, const char *channel, char *out, size_t cap);
+
 #endif

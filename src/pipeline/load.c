@@ -32,8 +32,8 @@ wx_result wx_load_simulation_maps(const wx_scene *scene, int threads, wx_maps *m
             // started from (channel initialDirt), so running again is repeatable.
             which |= WX_MAPS_DIRT | WX_MAPS_INITIAL_DIRT;
         }
-        wx_result r = wx_maps_load(&maps[k], which, threads, cam->depth_path, cam->normal_path,
-                                   cam->impact_path, cam->dirt_path, err);
+        wx_result r = wx_maps_load_scene(&maps[k], which, threads, scene, cam->depth_path,
+                                         cam->normal_path, cam->impact_path, cam->dirt_path, err);
         if (r != WX_OK) {
             wx_error_prefix(err, "camera '%s'", cam->name);
             return r;
@@ -85,7 +85,10 @@ wx_result wx_load_gather_maps(const wx_scene *scene, const wx_run_def *opts, wx_
             wx_note(opts->quiet,
                     "gather: no simulated dirt map %s; camera '%s' uses its scene dirt map %s",
                     simulated, cam->name, dirt_path);
-        } else if (!has_channel(simulated, WX_INITIAL_DIRT_CHANNEL)) {
+        } else if (scene->substances_declared && has_channel(simulated, WX_HITS_CHANNEL)) {
+            which |= WX_MAPS_SIMULATED;
+        } else if (scene->substances_declared ||
+                   !has_channel(simulated, WX_INITIAL_DIRT_CHANNEL)) {
             wx_note(opts->quiet,
                     "gather: %s was never simulated (it holds the initial dirt bake wrote); run "
                     "`weathering simulate` first for the particles' dirt",
@@ -99,8 +102,8 @@ wx_result wx_load_gather_maps(const wx_scene *scene, const wx_run_def *opts, wx_
         } else {
             which |= WX_MAPS_SIMULATED;
         }
-        wx_result r = wx_maps_load(&maps[k], which, opts->threads, cam->depth_path, cam->normal_path, NULL,
-                                   dirt_path, err);
+        wx_result r = wx_maps_load_scene(&maps[k], which, opts->threads, scene, cam->depth_path,
+                                         cam->normal_path, NULL, dirt_path, err);
         if (r != WX_OK) {
             wx_error_prefix(err, "camera '%s'", cam->name);
             return r;

@@ -44,12 +44,33 @@ static wx_result keep_maps(int camera, wx_image *images, int count, void *user, 
     m->depth = malloc(texels * sizeof *m->depth);
     m->normal = malloc(3 * texels * sizeof *m->normal);
     m->impact = malloc(2 * texels * sizeof *m->impact);
-    m->dirt = malloc(texels * sizeof *m->dirt);
-    m->deposit = malloc(texels * sizeof *m->deposit);
-    m->erosion = malloc(texels * sizeof *m->erosion);
+    // The dirt image in the scene's layout (model/maps.h): three channels per
+    // substance, then the surface and area records when the scene has them.
+    size_t S = pm->scene->substances_declared ? (size_t)pm->scene->substance_count : 1;
+    m->substances = (int)S;
+    m->dirt = malloc(S * texels * sizeof *m->dirt);
+    m->deposit = malloc(S * texels * sizeof *m->deposit);
+    m->erosion = malloc(S * texels * sizeof *m->erosion);
     if (m->depth == NULL || m->normal == NULL || m->impact == NULL || m->dirt == NULL ||
         m->deposit == NULL || m->erosion == NULL) {
         return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "info: out of memory (pilot maps)");
+    }
+    for (size_t s = 0; s < S; ++s) {
+        memcpy(m->dirt + s * texels, images[3].channels[3 * s], texels * sizeof(float));
+        memcpy(m->deposit + s * texels, images[3].channels[3 * s + 1], texels * sizeof(float));
+        memcpy(m->erosion + s * texels, images[3].channels[3 * s + 2], texels * sizeof(float));
+    }
+    for (int c = (int)(3 * S); c < images[3].channel_count; ++c) {
+        float **plane = strcmp(images[3].channel_names[c], WX_SURFACE_CHANNEL) == 0 ? &m->surface
+                        : strcmp(images[3].channel_names[c], WX_AREA_CHANNEL) == 0  ? &m->area
+                                                                                     : NULL;
+        if (plane != NULL) {
+            *plane = malloc(texels * sizeof **plane);
+            if (*plane == NULL) {
+                return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "info: out of memory (pilot maps)");
+            }
+            memcpy(*plane, images[3].channels[c], texels * sizeof(float));
+        }
     }
     for (size_t t = 0; t < texels; ++t) {
         float d = images[0].channels[0][t];
@@ -59,9 +80,6 @@ static wx_result keep_maps(int camera, wx_image *images, int count, void *user, 
         }
         m->impact[2 * t] = images[2].channels[0][t];
         m->impact[2 * t + 1] = images[2].channels[1][t];
-        m->dirt[t] = images[3].channels[0][t];
-        m->deposit[t] = images[3].channels[1][t];
-        m->erosion[t] = images[3].channels[2][t];
     }
     return WX_OK;
 }
@@ -123,8 +141,8 @@ wx_result wx_pilot_run(const wx_scene *scene, const wx_run_def *opts, wx_geometr
         if (maps[k].depth == NULL) { // maps the scene gives as files
             unsigned which = WX_MAPS_DEPTH | WX_MAPS_NORMAL | WX_MAPS_IMPACT |
                              (wx_has_path(sc->dirt_path) ? WX_MAPS_DIRT | WX_MAPS_INITIAL_DIRT : 0);
-            r = wx_maps_load(&maps[k], which, opts->threads, sc->depth_path, sc->normal_path, sc->impact_path,
-                             sc->dirt_path, err);
+            r = wx_maps_load_scene(&maps[k], which, opts->threads, &pilot, sc->depth_path,
+                                   sc->normal_path, sc->impact_path, sc->dirt_path, err);
         }
         k++;
     }

@@ -90,7 +90,8 @@ wx_result wx_run_phases(wx_scene *scene, const wx_run_def *opts, unsigned phases
                          : wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (maps)");
         double t1 = wx_now_s();
         if (r == WX_OK) {
-            r = wx_simulate_maps(scene, opts, maps, &report->stats,
+            r = wx_simulate_maps(scene, opts, maps,
+                                 output_maps.depth != NULL ? &output_maps : NULL, &report->stats,
                                  &report->times.simulate_detail, err);
         }
         report->times.simulate_detail.read = t1 - t0;

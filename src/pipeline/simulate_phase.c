@@ -9,10 +9,52 @@
 #include "core/progress.h"
 #include "io/exr.h"
 #include "io/maps_file.h"
+#include "pipeline/gather_phase.h"
 #include "pipeline/load.h"
 #include "pipeline/outputs.h"
 
-// Writes the dirt map of input camera `k` (scene camera `cam`).
+// The planes the gather reads from the simulation's state for input camera k
+// (model/maps.h layout: substance s at s*W*H): the amounts, the amounts
+// without the particles (the baseline, or the planes the simulation started
+// from when the scene has no rules) and the hits. The caller frees them.
+static wx_result gather_planes(const wx_sim *sim, const wx_maps *m, int k, float **dirt,
+                               float **initial, float **hits, wx_error *err)
+{
+    const wx_dirt_map *map = wx_sim_dirt_map(sim, k);
+    const double *baseline = wx_sim_baseline(sim, k);
+    size_t n = (size_t)map->width * (size_t)map->height;
+    size_t S = (size_t)map->substances;
+    *dirt = malloc(n * S * sizeof **dirt + 1);
+    *initial = malloc(n * S * sizeof **initial + 1);
+    *hits = malloc(n * sizeof **hits + 1);
+    if (*dirt == NULL || *initial == NULL || *hits == NULL) {
+        free(*dirt);
+        free(*initial);
+        free(*hits);
+        *dirt = *initial = *hits = NULL;
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (dirt maps)");
+    }
+    for (size_t s = 0; s < S; ++s) {
+        float *d = *dirt + s * n, *i0 = *initial + s * n;
+        const float *start = m->dirt != NULL ? m->dirt + s * n : NULL;
+        for (size_t t = 0; t < n; ++t) {
+            d[t] = (float)map->texels[t * S + s].dirt;
+            i0[t] = baseline != NULL ? (float)baseline[t * S + s]
+                    : start != NULL  ? start[t]
+                                     : 0.0f;
+        }
+    }
+    for (size_t t = 0; t < n; ++t) {
+        (*hits)[t] = map->texels[t * S].hits;
+    }
+    return WX_OK;
+}
+
+// Writes the dirt map of input camera `k` (scene camera `cam`) in the scene's
+// layout (model/maps.h, wx_dirt_channels): per substance the simulated amount,
+// deposit, erosion; the amounts without the particles, which a later
+// `simulate` starts from; the hits, which the gather's smoothing reads; and the
+// bake's surface and area records it carries on.
 static wx_result write_one(const wx_scene *scene, const wx_run_def *opts, const wx_sim *sim,
                            const wx_maps *maps, int k, const wx_scene_camera *cam,
                            wx_image *image, wx_error *err)
@@ -25,23 +67,48 @@ static wx_result write_one(const wx_scene *scene, const wx_run_def *opts, const 
     if (r != WX_OK) {
         return r;
     }
-    // R G B keep the dirt map layout (R now the simulated dirt); initialDirt is
-    // the dirt the simulation started from, which a later `simulate` reads;
-    // hits counts the impacts at each texel, which the gather's smoothing reads.
-    static const char *const channels[5] = { "R", "G", "B", WX_INITIAL_DIRT_CHANNEL,
-                                             WX_HITS_CHANNEL };
-    r = wx_image_alloc(image, map->width, map->height, 5, channels, err);
+    char names[WX_IMAGE_MAX_CHANNELS][WX_NAME_MAX];
+    const char *channels[WX_IMAGE_MAX_CHANNELS];
+    int count = wx_dirt_channels(scene, true, names);
+    for (int c = 0; c < count; ++c) {
+        channels[c] = names[c];
+    }
+    r = wx_image_alloc(image, map->width, map->height, count, channels, err);
+    float *dirt = NULL, *initial = NULL, *hits = NULL;
+    if (r == WX_OK) {
+        r = gather_planes(sim, maps, k, &dirt, &initial, &hits, err);
+    }
     if (r != WX_OK) {
+        wx_image_free(image);
         return r;
     }
-    size_t texels = (size_t)map->width * (size_t)map->height;
-    for (size_t t = 0; t < texels; ++t) {
-        image->channels[0][t] = (float)map->texels[t].dirt;
-        image->channels[1][t] = maps->deposit != NULL ? maps->deposit[t] : 0.0f;
-        image->channels[2][t] = maps->erosion != NULL ? maps->erosion[t] : 0.0f;
-        image->channels[3][t] = maps->dirt != NULL ? maps->dirt[t] : 0.0f;
-        image->channels[4][t] = map->texels[t].hits;
+    size_t n = (size_t)map->width * (size_t)map->height;
+    int S = map->substances;
+    for (int s = 0; s < S; ++s) {
+        size_t plane = (size_t)s * n;
+        memcpy(image->channels[3 * s], dirt + plane, n * sizeof(float));
+        if (maps->deposit != NULL) {
+            memcpy(image->channels[3 * s + 1], maps->deposit + plane, n * sizeof(float));
+        }
+        if (maps->erosion != NULL) {
+            memcpy(image->channels[3 * s + 2], maps->erosion + plane, n * sizeof(float));
+        }
+        memcpy(image->channels[3 * S + s], initial + plane, n * sizeof(float));
     }
+    memcpy(image->channels[4 * S], hits, n * sizeof(float));
+    int next = 4 * S + 1;
+    if (next < count && strcmp(names[next], WX_SURFACE_CHANNEL) == 0) {
+        if (maps->surface != NULL) {
+            memcpy(image->channels[next], maps->surface, n * sizeof(float));
+        }
+        next++;
+    }
+    if (next < count && strcmp(names[next], WX_AREA_CHANNEL) == 0 && maps->area != NULL) {
+        memcpy(image->channels[next], maps->area, n * sizeof(float));
+    }
+    free(dirt);
+    free(initial);
+    free(hits);
     // The input dirt map's header travels with it (kept when the map was read).
     for (int a = 0; a < maps->dirt_attr_count && image->attr_count < WX_IMAGE_MAX_ATTRS; ++a) {
         image->attrs[image->attr_count++] = maps->dirt_attrs[a];
@@ -59,6 +126,39 @@ static wx_result write_one(const wx_scene *scene, const wx_run_def *opts, const 
     image->zip_level = 1;           // the pipeline's own intermediate: the fastest zlib
     r = wx_exr_write(path, image, err);
     wx_image_free(image);
+    return r;
+}
+
+// Frame `frame` of the mask's image sequence from the simulation's state now:
+// the input maps' depth and normal borrowed, the dirt planes made for it.
+static wx_result write_frame(const wx_scene *scene, const wx_run_def *opts, const wx_sim *sim,
+                             const wx_maps *maps, const wx_maps *out_maps, int frame,
+                             wx_error *err)
+{
+    int n = wx_sim_input_count(sim);
+    wx_maps *view = calloc((size_t)n + 1, sizeof *view);
+    if (view == NULL) {
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (frame)");
+    }
+    wx_result r = WX_OK;
+    for (int c = 0; c < n && r == WX_OK; ++c) {
+        view[c].width = maps[c].width;
+        view[c].height = maps[c].height;
+        view[c].substances = maps[c].substances;
+        view[c].depth = maps[c].depth;
+        view[c].normal = maps[c].normal;
+        r = gather_planes(sim, &maps[c], c, &view[c].dirt, &view[c].initial_dirt, &view[c].hits,
+                          err);
+    }
+    if (r == WX_OK) {
+        r = wx_gather_frame(scene, opts, view, out_maps, frame, NULL, err);
+    }
+    for (int c = 0; c < n; ++c) {
+        free(view[c].dirt);
+        free(view[c].initial_dirt);
+        free(view[c].hits);
+    }
+    free(view);
     return r;
 }
 
@@ -83,7 +183,8 @@ wx_result wx_write_dirt_maps(const wx_scene *scene, const wx_run_def *opts, cons
 }
 
 wx_result wx_simulate_maps(const wx_scene *scene, const wx_run_def *opts, wx_maps *maps,
-                           wx_sim_stats *stats, wx_phase_detail *detail, wx_error *err)
+                           const wx_maps *out_maps, wx_sim_stats *stats, wx_phase_detail *detail,
+                           wx_error *err)
 {
     wx_phase_detail local;
     detail = detail != NULL ? detail : &local;
@@ -99,45 +200,63 @@ wx_result wx_simulate_maps(const wx_scene *scene, const wx_run_def *opts, wx_map
     if (r != WX_OK) {
         return r;
     }
+    // Frames of the mask's image sequence (docs/design.md section 10) need the
+    // output camera's maps: those a run kept, or read here.
+    const wx_scene_camera *out = scene->output_index >= 0 ? &scene->cameras[scene->output_index]
+                                                          : NULL;
+    int every = out != NULL ? out->every : 0;
+    wx_maps read_out;
+    memset(&read_out, 0, sizeof read_out);
+    if (every > 0 && out_maps == NULL) {
+        r = wx_maps_load(&read_out, WX_MAPS_DEPTH | WX_MAPS_NORMAL, opts->threads,
+                         out->depth_path, out->normal_path, NULL, NULL, err);
+        if (r != WX_OK) {
+            wx_error_prefix(err, "output camera '%s'", out->name);
+        }
+        out_maps = &read_out;
+    }
+    double frames_s = 0.0;
+    int64_t iterations = scene->iterations > 1 ? scene->iterations : 1;
+    int64_t total = scene->steps * iterations;
     wx_progress progress;
-    wx_progress_begin(&progress, "simulate", scene->steps, opts->quiet);
-    for (int64_t s = 0; s < scene->steps && r == WX_OK; ++s) {
+    wx_progress_begin(&progress, "simulate", total, opts->quiet);
+    for (int64_t s = 0; s < total && r == WX_OK; ++s) {
         r = wx_sim_step(sim, err);
         wx_progress_update(&progress, s + 1);
+        int64_t done = wx_sim_iterations_done(sim);
+        if (r == WX_OK && every > 0 && (s + 1) % scene->steps == 0 && done % every == 0) {
+            double f0 = wx_now_s();
+            r = write_frame(scene, opts, sim, maps, out_maps, (int)done, err);
+            frames_s += wx_now_s() - f0;
+        }
     }
     wx_progress_end(&progress);
+    wx_maps_free(&read_out);
     double t2 = wx_now_s();
-    detail->compute = t2 - t1;
+    detail->compute = t2 - t1 - frames_s;
     if (r == WX_OK) {
         r = wx_write_dirt_maps(scene, opts, sim, maps, err);
     }
-    detail->write = wx_now_s() - t2;
+    detail->write = wx_now_s() - t2 + frames_s;
     if (stats != NULL) {
         wx_sim_get_stats(sim, stats);
     }
     // What the gather reads, as the written maps hold it (float): the dirt, the
-    // dirt the simulation started from and the hits; the planes only the
+    // amounts without the particles and the hits; the planes only the
     // simulation needed released.
     for (int c = 0; c < wx_sim_input_count(sim) && r == WX_OK; ++c) {
         wx_maps *m = &maps[c];
-        size_t texels = (size_t)m->width * (size_t)m->height;
-        float *initial = m->dirt != NULL ? m->dirt : calloc(texels, sizeof *initial);
-        float *final = malloc(texels * sizeof *final);
-        float *hits = malloc(texels * sizeof *hits);
-        free(m->initial_dirt);
-        free(m->hits);
-        m->initial_dirt = initial;
-        m->dirt = final;
-        m->hits = hits;
-        if (initial == NULL || final == NULL || hits == NULL) {
-            r = wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (dirt maps)");
+        float *dirt = NULL, *initial = NULL, *hits = NULL;
+        r = gather_planes(sim, m, c, &dirt, &initial, &hits, err);
+        if (r != WX_OK) {
             break;
         }
-        const wx_dirt_map *dirt = wx_sim_dirt_map(sim, c);
-        for (size_t t = 0; t < texels; ++t) {
-            final[t] = (float)dirt->texels[t].dirt;
-            hits[t] = dirt->texels[t].hits;
-        }
+        free(m->dirt);
+        free(m->initial_dirt);
+        free(m->hits);
+        m->dirt = dirt;
+        m->initial_dirt = initial;
+        m->hits = hits;
         free(m->impact);
         free(m->deposit);
         free(m->erosion);
@@ -156,7 +275,7 @@ wx_result wx_simulate_scene(const wx_scene *scene, const wx_run_def *opts,
     }
     wx_result r = wx_load_simulation_maps(scene, opts->threads, maps, err);
     if (r == WX_OK) {
-        r = wx_simulate_maps(scene, opts, maps, stats, NULL, err);
+        r = wx_simulate_maps(scene, opts, maps, NULL, stats, NULL, err);
     }
     for (int c = 0; c < scene->input_count; ++c) {
         wx_maps_free(&maps[c]);

@@ -26,7 +26,8 @@ wx_result wx_write_dirt_maps(const wx_scene *scene, const wx_run_def *opts, cons
 /// and leaves in each maps[c].dirt the simulated dirt as written
 /// (impact, deposit and erosion released): what the gather reads next.
 wx_result wx_simulate_maps(const wx_scene *scene, const wx_run_def *opts, wx_maps *maps,
-                           wx_sim_stats *stats, wx_phase_detail *detail, wx_error *err);
+                           const wx_maps *out_maps, wx_sim_stats *stats, wx_phase_detail *detail,
+                           wx_error *err);
 
 /// The `simulate` phase: loads every input camera's maps from the scene's
 /// paths, runs scene->steps steps (progress bar unless opts->quiet), writes

@@ -27,6 +27,7 @@
 #include <string.h>
 
 #include "model/maps.h"
+#include "model/scene.h"
 #include "model/geometry.h"
 #include "model/mesh.h"
 #include "core/matrix.h"
@@ -36,7 +37,7 @@
 enum {
     TARGET_DEPTH_NORMAL, // RGBA32F: d, normal
     TARGET_IMPACT_DIRT,  // RGBA32F: absorption, bounce, deposit, erosion
-    TARGET_DENSITY,      // R32F: initial dirt per square metre
+    TARGET_DENSITY,      // RG32F: initial dirt per square metre, <Surface> index + 1
     TARGET_COUNT,
 };
 
@@ -240,7 +241,7 @@ static wx_result ensure_framebuffer(baker *b, int width, int height, wx_error *e
     if (b->fb_width == width && b->fb_height == height) {
         return WX_OK;
     }
-    static const GLenum formats[TARGET_COUNT + 1] = { GL_RGBA32F, GL_RGBA32F, GL_R32F,
+    static const GLenum formats[TARGET_COUNT + 1] = { GL_RGBA32F, GL_RGBA32F, GL_RG32F,
                                                       GL_DEPTH_COMPONENT32F };
     glBindFramebuffer(GL_FRAMEBUFFER, b->fbo);
     for (int t = 0; t <= TARGET_COUNT; ++t) {
@@ -380,20 +381,33 @@ static void local_matrix(const float wtc[16], const double origin[3], float out[
     }
 }
 
-// Fills 2 RGBA texels per material of a mesh from its matched <Surface>:
-// (absorption, bounce, dirt, deposit), (erosion, colour use, 0, 0).
-static void material_props(const wx_mesh *mesh, const wx_geometry_mesh *g, float *props)
+// The substance the renderer's dirt target carries (the one vertex colours may
+// give): "dirt", or the first substance of a scene without it. The others are
+// looked up from each texel's <Surface> (fill_substances).
+static int rendered_substance(const wx_scene *scene)
 {
+    return scene->dirt_substance >= 0 ? scene->dirt_substance : 0;
+}
+
+// Fills 2 RGBA texels per material of a mesh from its matched <Surface>:
+// (absorption, bounce, dirt, deposit), (erosion, colour use, surface index + 1, 0).
+static void material_props(const wx_scene *scene, int mesh_index, const wx_geometry_mesh *g,
+                           float *props)
+{
+    const wx_mesh *mesh = &scene->meshes[mesh_index];
+    int base = wx_scene_surface_base(scene, mesh_index);
+    int s = rendered_substance(scene);
     for (int m = 0; m < g->data.material_count; ++m) {
         const wx_surface *match = &mesh->surfaces[g->surface[m]];
         float *p = &props[8 * m];
         p[0] = match->absorption;
         p[1] = match->bounce;
-        p[2] = match->dirt;
-        p[3] = match->deposit;
-        p[4] = match->erosion;
+        p[2] = match->initial[s];
+        p[3] = match->deposit[s];
+        p[4] = match->erosion[s];
         p[5] = (float)match->colors; // 0 none, 1 impact, 2 dirt (bake_frag.glsl)
-        p[6] = p[7] = 0.0f;
+        p[6] = (float)(base + g->surface[m] + 1);
+        p[7] = 0.0f;
     }
 }
 
@@ -461,7 +475,7 @@ static wx_result load_meshes(baker *b, wx_geometry *geometry, wx_error *err)
         if (props == NULL) {
             r = wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "bake: out of memory");
         } else {
-            material_props(mesh, g, props);
+            material_props(scene, i, g, props);
             survey_vertices(b, mesh, data);
             r = upload_mesh(b, data, props, &b->meshes[b->mesh_count], err);
             b->mesh_count++; // counted even when incomplete, so that it is deleted
@@ -568,7 +582,7 @@ static wx_result read_target(baker *b, int target, int channels, const plane_out
         }
     }
     glReadBuffer((GLenum)(GL_COLOR_ATTACHMENT0 + target));
-    GLenum format = channels == 4 ? GL_RGBA : GL_RED;
+    GLenum format = channels == 4 ? GL_RGBA : channels == 2 ? GL_RG : GL_RED;
     for (int y0 = 0; y0 < height; y0 += rows) {
         int n = height - y0 < rows ? height - y0 : rows;
         glReadPixels(0, y0, width, n, format, GL_FLOAT, b->strip);
@@ -632,7 +646,7 @@ typedef struct other_view {
 // depth agrees with p's within 1.5 texels' worth of the surface's depth slope
 // in k (plus 0.1 texel and float rounding).
 static bool other_owns(const other_view *k, int c, const double p[3], const float n[3],
-                       float cos_c)
+                       float cos_c, bool slack)
 {
     float cos_k = fabsf(n[0] * k->view[0] + n[1] * k->view[1] + n[2] * k->view[2]);
     bool better = cos_k > cos_c + TIE_COSINE || (cos_k >= cos_c - TIE_COSINE && k->index < c);
@@ -645,21 +659,44 @@ static bool other_owns(const other_view *k, int c, const double p[3], const floa
     if (!wx_map_texel(k->width, k->height, (float)uvd[0], (float)uvd[1], &i, &j)) {
         return false;
     }
-    float stored = k->depth[(size_t)j * (size_t)k->width + (size_t)i];
-    if (!isfinite(stored)) {
-        return false;
-    }
     float ck = cos_k > MIN_COSINE ? cos_k : MIN_COSINE;
     float slope = sqrtf(fmaxf(0.0f, 1.0f - ck * ck)) / ck;
-    double tol = k->texel_ws * (1.5 * fmin(slope, 1e3) + 0.1) +
-                 4e-6 * (fabs(uvd[2]) + fabs(stored));
-    return fabs(uvd[2] - stored) <= tol;
+    float stored = k->depth[(size_t)j * (size_t)k->width + (size_t)i];
+    if (isfinite(stored)) {
+        double tol = k->texel_ws * (1.5 * fmin(slope, 1e3) + 0.1) +
+                     4e-6 * (fabs(uvd[2]) + fabs(stored));
+        return fabs(uvd[2] - stored) <= tol;
+    }
+    if (!slack) {
+        return false;
+    }
+    // At a surface's outline k's texel may be empty while its neighbour holds
+    // the point: a neighbour that agrees (one texel more of tolerance) owns it,
+    // so that points along an outline are not counted by two cameras.
+    for (int dj = -1; dj <= 1; ++dj) {
+        for (int di = -1; di <= 1; ++di) {
+            int ni = i + di, nj = j + dj;
+            if (ni < 0 || nj < 0 || ni >= k->width || nj >= k->height) {
+                continue;
+            }
+            float s = k->depth[(size_t)nj * (size_t)k->width + (size_t)ni];
+            double tol = k->texel_ws * (2.5 * fmin(slope, 1e3) + 0.1) +
+                         4e-6 * (fabs(uvd[2]) + fabs(s));
+            if (isfinite(s) && fabs(uvd[2] - s) <= tol) {
+                return true;
+            }
+        }
+    }
+    return false;
 }
 
-// Turns the density plane of camera c into dirt amounts: density x texel area /
-// |N.view| where c owns the patch, 0 elsewhere.
+// Turns the density planes of camera c (one per substance) into amounts:
+// density x texel area / |N.view| where c owns the patch, 0 elsewhere; `area`
+// (may be NULL) receives texel area / |N.view| where c owns the patch, 0
+// elsewhere (what Grow multiplies).
 static wx_result compute_initial_dirt(baker *b, int c, const float *depth,
-                                      const wx_image *normal, float *dirt, wx_error *err)
+                                      const wx_image *normal, float *const *planes, int count,
+                                      float *area, wx_error *err)
 {
     const wx_scene *scene = b->scene;
     const wx_scene_camera *sc = &scene->cameras[c];
@@ -694,16 +731,24 @@ static wx_result compute_initial_dirt(baker *b, int c, const float *depth,
     for (int j = 0; j < height; ++j) {
         for (int i = 0; i < width; ++i) {
             size_t t = (size_t)j * (size_t)width + (size_t)i;
-            float density = dirt[t];
+            bool any = area != NULL;
+            for (int s = 0; s < count; ++s) {
+                any = any || planes[s][t] != 0.0f;
+            }
             float d = depth[t];
-            if (density == 0.0f || !isfinite(d)) {
-                dirt[t] = 0.0f;
+            if (!any || !isfinite(d)) {
+                for (int s = 0; s < count; ++s) {
+                    planes[s][t] = 0.0f;
+                }
+                if (area != NULL) {
+                    area[t] = 0.0f;
+                }
                 continue;
             }
             float n[3] = { normal->channels[0][t], normal->channels[1][t],
                            normal->channels[2][t] };
             float cos_c = fabsf(n[0] * view[0] + n[1] * view[1] + n[2] * view[2]);
-            bool owner = true;
+            bool owner = true, area_owner = true;
             if (other_count > 0) {
                 float u, v;
                 wx_map_texel_center(width, height, i, j, &u, &v);
@@ -711,10 +756,20 @@ static wx_result compute_initial_dirt(baker *b, int c, const float *depth,
                 const double uvd[3] = { u, v, d };
                 wx_matrix_apply_affine(sc->camera.ctw, uvd, p);
                 for (int k = 0; k < other_count && owner; ++k) {
-                    owner = !other_owns(&others[k], c, p, n, cos_c);
+                    owner = !other_owns(&others[k], c, p, n, cos_c, false);
+                }
+                // Grow's area (new in version 2) takes outlines into account;
+                // initial amounts keep version 1's rule and bytes.
+                for (int k = 0; k < other_count && area_owner && area != NULL; ++k) {
+                    area_owner = !other_owns(&others[k], c, p, n, cos_c, true);
                 }
             }
-            dirt[t] = owner ? density * texel_area / fmaxf(cos_c, MIN_COSINE) : 0.0f;
+            for (int s = 0; s < count; ++s) {
+                planes[s][t] = owner ? planes[s][t] * texel_area / fmaxf(cos_c, MIN_COSINE) : 0.0f;
+            }
+            if (area != NULL) {
+                area[t] = area_owner ? texel_area / fmaxf(cos_c, MIN_COSINE) : 0.0f;
+            }
         }
     }
     free(others);
@@ -724,23 +779,73 @@ static wx_result compute_initial_dirt(baker *b, int c, const float *depth,
 // ---------------------------------------------------------------------------
 // The images handed to the caller.
 
-// Makes the set's images W x H: depth (R), normal, impact, dirt (R, G, B).
-static wx_result size_set(map_set *set, int width, int height, int count, wx_error *err)
+// Makes the set's images W x H: depth (R), normal, impact (R, G, B), dirt (the
+// scene's layout, model/maps.h: R, G, B for version 1's one substance).
+static wx_result size_set(const wx_scene *scene, map_set *set, int width, int height, int count,
+                          wx_error *err)
 {
     static const char *const rgb[3] = { "R", "G", "B" };
+    char dirt_names[WX_IMAGE_MAX_CHANNELS][WX_NAME_MAX];
+    const char *dirt[WX_IMAGE_MAX_CHANNELS];
+    int dirt_count = wx_dirt_channels(scene, false, dirt_names);
+    for (int k = 0; k < dirt_count; ++k) {
+        dirt[k] = dirt_names[k];
+    }
     set->count = count;
     for (int k = 0; k < count; ++k) {
         wx_image *img = &set->maps[k];
         if (img->width == width && img->height == height) {
-            continue; // every plane read back is overwritten; impact B stays 0
+            continue; // every plane read back or filled is overwritten; impact B stays 0
         }
         wx_image_free(img);
-        wx_result r = wx_image_alloc(img, width, height, k == 0 ? 1 : 3, rgb, err);
+        wx_result r = k == 3 ? wx_image_alloc(img, width, height, dirt_count, dirt, err)
+                             : wx_image_alloc(img, width, height, k == 0 ? 1 : 3, rgb, err);
         if (r != WX_OK) {
             return r;
         }
     }
     return WX_OK;
+}
+
+// Index of the channel called `name` in `image`, or -1.
+static int channel_index(const wx_image *image, const char *name)
+{
+    for (int c = 0; c < image->channel_count; ++c) {
+        if (strcmp(image->channel_names[c], name) == 0) {
+            return c;
+        }
+    }
+    return -1;
+}
+
+// The substances the renderer does not carry, from each texel's <Surface>
+// (surface index + 1 in `surface`): their initial density (turned into amounts
+// with the rendered one), deposit and erosion.
+static void fill_substances(const wx_scene *scene, const float *surface, wx_image *dirt,
+                            size_t texels)
+{
+    const wx_surface *by_index[1024];
+    int known = 0;
+    for (int m = 0; m < scene->mesh_count; ++m) {
+        for (int k = 0; k < scene->meshes[m].surface_count && known < 1024; ++k) {
+            by_index[known++] = &scene->meshes[m].surfaces[k];
+        }
+    }
+    int rendered = rendered_substance(scene);
+    for (int s = 0; s < scene->substance_count; ++s) {
+        if (s == rendered) {
+            continue;
+        }
+        float *amount = dirt->channels[3 * s], *deposit = dirt->channels[3 * s + 1],
+              *erosion = dirt->channels[3 * s + 2];
+        for (size_t t = 0; t < texels; ++t) {
+            int id = (int)surface[t] - 1;
+            const wx_surface *sf = id >= 0 && id < known ? by_index[id] : NULL;
+            amount[t] = sf != NULL ? sf->initial[s] : 0.0f;
+            deposit[t] = sf != NULL ? sf->deposit[s] : 0.0f;
+            erosion[t] = sf != NULL ? sf->erosion[s] : 0.0f;
+        }
+    }
 }
 
 // ---------------------------------------------------------------------------
@@ -778,7 +883,7 @@ static wx_result bake_camera(baker *b, int c, wx_error *err)
     wx_progress_begin(&progress, label, 4, b->def->quiet);
 
     map_set *set = &b->set;
-    wx_result r = size_set(set, sc->camera.width, sc->camera.height, input ? 4 : 2, err);
+    wx_result r = size_set(b->scene, set, sc->camera.width, sc->camera.height, input ? 4 : 2, err);
     wx_image *maps = set->maps;
     double t0 = wx_now_s();
     if (r == WX_OK) {
@@ -792,22 +897,53 @@ static wx_result bake_camera(baker *b, int c, wx_error *err)
                              { maps[1].channels[2] } };
         r = read_target(b, TARGET_DEPTH_NORMAL, 4, out, err);
     }
+    // The dirt image's planes: the rendered substance's at 3g (3g+1, 3g+2), the
+    // surface record and Grow's area when the scene's layout has them.
+    const wx_scene *scene = b->scene;
+    int g = b->scene->substances_declared ? rendered_substance(scene) : 0;
+    int S = b->scene->substances_declared ? scene->substance_count : 1;
+    int surface_channel = input ? channel_index(&maps[3], WX_SURFACE_CHANNEL) : -1;
+    int area_channel = input ? channel_index(&maps[3], WX_AREA_CHANNEL) : -1;
+    float *surface = NULL;
+    if (r == WX_OK && input && (S > 1 || surface_channel >= 0)) {
+        surface = surface_channel >= 0 ? maps[3].channels[surface_channel]
+                                       : malloc((size_t)sc->camera.width *
+                                                (size_t)sc->camera.height * sizeof *surface);
+        if (surface == NULL) {
+            r = wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "bake: out of memory");
+        }
+    }
     if (r == WX_OK && input) {
         plane_out out[4] = { { maps[2].channels[0] },
                              { maps[2].channels[1] },
-                             { maps[3].channels[1] },
-                             { maps[3].channels[2] } };
+                             { maps[3].channels[3 * g + 1] },
+                             { maps[3].channels[3 * g + 2] } };
         r = read_target(b, TARGET_IMPACT_DIRT, 4, out, err);
-        if (r == WX_OK) {
-            plane_out density[1] = { { maps[3].channels[0] } };
+        if (r == WX_OK && surface == NULL) {
+            plane_out density[1] = { { maps[3].channels[3 * g] } };
             r = read_target(b, TARGET_DENSITY, 1, density, err);
+        } else if (r == WX_OK) {
+            plane_out density[2] = { { maps[3].channels[3 * g] }, { surface } };
+            r = read_target(b, TARGET_DENSITY, 2, density, err);
         }
     }
     double t1 = wx_now_s();
     b->stats->render_s += t1 - t0;
     wx_progress_update(&progress, 2);
     if (r == WX_OK && input) {
-        r = compute_initial_dirt(b, c, maps[0].channels[0], &maps[1], maps[3].channels[0], err);
+        size_t texels = (size_t)sc->camera.width * (size_t)sc->camera.height;
+        if (S > 1) {
+            fill_substances(scene, surface, &maps[3], texels);
+        }
+        float *planes[WX_MAX_SUBSTANCES];
+        for (int s = 0; s < S; ++s) {
+            planes[s] = maps[3].channels[3 * s];
+        }
+        r = compute_initial_dirt(b, c, maps[0].channels[0], &maps[1], planes, S,
+                                 area_channel >= 0 ? maps[3].channels[area_channel] : NULL, err);
+    }
+    if (surface_channel < 0) {
+        free(surface);
     }
     b->stats->dirt_s += wx_now_s() - t1;
     wx_progress_update(&progress, 3);
@@ -954,7 +1090,7 @@ wx_result wx_bake_render(const wx_bake_def *def, wx_bake_stats *stats, wx_error 
     for (int c = 0; c < scene->camera_count; ++c) {
         input_cameras += !scene->cameras[c].is_output;
     }
-    bool visibility = b->has_dirt && input_cameras > 1;
+    bool visibility = (b->has_dirt || wx_scene_has_grow(scene)) && input_cameras > 1;
     double cameras_start = wx_now_s();
     for (int c = 0; c < scene->camera_count && r == WX_OK && visibility; ++c) {
         if (scene->cameras[c].is_output) {

@@ -7,6 +7,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/limits.h"
+
 static float unit_clamp(float v)
 {
     if (!(v > 0.0f)) {
@@ -15,26 +17,32 @@ static float unit_clamp(float v)
     return v < 1.0f ? v : 1.0f;
 }
 
-wx_result wx_dirt_map_init(wx_dirt_map *map, int width, int height, const float *dirt,
-                           const float *deposit, const float *erosion, float D, float E,
-                           const float *depth, wx_error *err)
+wx_result wx_dirt_map_init(wx_dirt_map *map, int width, int height, int substances,
+                           const float *dirt, const float *deposit, const float *erosion,
+                           float D, float E, const float *depth, wx_error *err)
 {
     memset(map, 0, sizeof *map);
     size_t texels = (size_t)width * (size_t)height;
-    map->texels = malloc(texels * sizeof *map->texels);
+    size_t S = substances > 0 ? (size_t)substances : 1;
+    map->texels = malloc(texels * S * sizeof *map->texels);
     if (map->texels == NULL) {
         return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (dirt map %d x %d)", width,
                        height);
     }
     map->width = width;
     map->height = height;
+    map->substances = (int)S;
     map->depth = depth;
-    for (size_t t = 0; t < texels; ++t) {
-        float s = dirt != NULL ? dirt[t] : 0.0f;
-        map->texels[t].dirt = isfinite(s) ? s : 0.0;
-        map->texels[t].deposit = unit_clamp(D * (deposit != NULL ? deposit[t] : 0.0f));
-        map->texels[t].erosion = unit_clamp(E * (erosion != NULL ? erosion[t] : 0.0f));
-        map->texels[t].hits = 0.0f;
+    for (size_t s = 0; s < S; ++s) {
+        size_t plane = s * texels;
+        for (size_t t = 0; t < texels; ++t) {
+            wx_dirt_texel *x = &map->texels[t * S + s];
+            float v = dirt != NULL ? dirt[plane + t] : 0.0f;
+            x->dirt = isfinite(v) ? v : 0.0;
+            x->deposit = unit_clamp(D * (deposit != NULL ? deposit[plane + t] : 0.0f));
+            x->erosion = unit_clamp(E * (erosion != NULL ? erosion[plane + t] : 0.0f));
+            x->hits = 0.0f;
+        }
     }
     return WX_OK;
 }
@@ -45,30 +53,38 @@ void wx_dirt_map_free(wx_dirt_map *map)
     memset(map, 0, sizeof *map);
 }
 
-double wx_dirt_map_total(const wx_dirt_map *map)
+double wx_dirt_map_total(const wx_dirt_map *map, int s)
 {
     double sum = 0.0;
     size_t texels = (size_t)map->width * (size_t)map->height;
+    size_t S = (size_t)map->substances;
     for (size_t t = 0; t < texels; ++t) {
-        sum += map->texels[t].dirt;
+        sum += map->texels[t * S + (size_t)s].dirt;
     }
     return sum;
 }
 
 void wx_dirt_map_exchange(wx_dirt_map *map, uint32_t texel, double *load)
 {
-    wx_dirt_texel *t = &map->texels[texel];
-    double dep = t->deposit * *load;
-    double ero = t->erosion * t->dirt;
-    *load += ero - dep;
-    t->dirt += dep - ero;
+    int S = map->substances;
+    wx_dirt_texel *t = &map->texels[(size_t)texel * (size_t)S];
+    for (int s = 0; s < S; ++s) {
+        double dep = t[s].deposit * load[s];
+        double ero = t[s].erosion * t[s].dirt;
+        load[s] += ero - dep;
+        t[s].dirt += dep - ero;
+    }
     t->hits += 1.0f;
 }
 
 void wx_dirt_map_deposit_all(wx_dirt_map *map, uint32_t texel, double *load)
 {
-    map->texels[texel].dirt += *load;
-    *load = 0.0;
+    int S = map->substances;
+    wx_dirt_texel *t = &map->texels[(size_t)texel * (size_t)S];
+    for (int s = 0; s < S; ++s) {
+        t[s].dirt += load[s];
+        load[s] = 0.0;
+    }
 }
 
 // Bresenham's walk (thesis 3.5, Algorithm 1, generalised to every octant).
@@ -145,7 +161,13 @@ void wx_dirt_map_exchange_line(wx_dirt_map *map, uint32_t from, uint32_t to, dou
         wx_dirt_map_exchange(map, to, load);
         return;
     }
-    double p = *load, share = 1.0 / n, change = 0.0;
+    int S = map->substances;
+    double p[WX_MAX_SUBSTANCES], change[WX_MAX_SUBSTANCES];
+    for (int s = 0; s < S; ++s) {
+        p[s] = load[s];
+        change[s] = 0.0;
+    }
+    double share = 1.0 / n;
     float hit_share = 1.0f / (float)n;
     line_begin(&w, x0, y0, x1, y1);
     for (line_next(&w); !w.done; line_next(&w)) {
@@ -153,12 +175,16 @@ void wx_dirt_map_exchange_line(wx_dirt_map *map, uint32_t from, uint32_t to, dou
         if (!has_surface(map, texel)) {
             continue;
         }
-        wx_dirt_texel *t = &map->texels[texel];
-        double dep = t->deposit * p * share;
-        double ero = t->erosion * t->dirt * share;
-        t->dirt += dep - ero;
+        wx_dirt_texel *t = &map->texels[texel * (size_t)S];
+        for (int s = 0; s < S; ++s) {
+            double dep = t[s].deposit * p[s] * share;
+            double ero = t[s].erosion * t[s].dirt * share;
+            t[s].dirt += dep - ero;
+            change[s] += ero - dep;
+        }
         t->hits += hit_share;
-        change += ero - dep;
     }
-    *load = p + change;
+    for (int s = 0; s < S; ++s) {
+        load[s] = p[s] + change[s];
+    }
 }

@@ -25,40 +25,47 @@ typedef struct wx_dirt_texel {
     float hits;
 } wx_dirt_texel;
 
+/// The substances of a map (docs/design.md section 9): texel t's substance s is
+/// texels[t * substances + s]; `hits` is counted in substance 0's entry only.
+/// With one substance the layout is version 1's.
 typedef struct wx_dirt_map {
     int width;
     int height;
-    wx_dirt_texel *texels; ///< W*H, row 0 at the top
+    int substances;        ///< 1..WX_MAX_SUBSTANCES
+    wx_dirt_texel *texels; ///< W*H*substances, row 0 at the top
     const float *depth;    ///< W*H (borrowed): streaks skip texels without surface
 } wx_dirt_map;
 
-/// Builds the map from the dirt planes (any may be NULL: zeros) and the
-/// collider's D and E. `depth` (borrowed, may be NULL) marks the texels with a
-/// surface (finite depth). Fails with WX_FAIL when out of memory.
-wx_result wx_dirt_map_init(wx_dirt_map *map, int width, int height, const float *dirt,
-                           const float *deposit, const float *erosion, float D, float E,
-                           const float *depth, wx_error *err);
+/// Builds the map from the planes of `substances` substances, each plane
+/// W*H floats one after the other (plane s at s*W*H; any of the three may be
+/// NULL: zeros), and the collider's D and E. `depth` (borrowed, may be NULL)
+/// marks the texels with a surface (finite depth). Fails with WX_FAIL when out
+/// of memory.
+wx_result wx_dirt_map_init(wx_dirt_map *map, int width, int height, int substances,
+                           const float *dirt, const float *deposit, const float *erosion,
+                           float D, float E, const float *depth, wx_error *err);
 
 /// Frees the texels; the struct is zeroed.
 void wx_dirt_map_free(wx_dirt_map *map);
 
-/// Sum of the dirt of every texel, in texel order.
-double wx_dirt_map_total(const wx_dirt_map *map);
+/// Sum of substance s over every texel, in texel order.
+double wx_dirt_map_total(const wx_dirt_map *map, int s);
 
-/// One impact at `texel`: dep = deposit*p, ero = erosion*s, then p += ero - dep,
-/// s += dep - ero (thesis 4.8.4.3, as pinned in docs/design.md section 4); the
-/// texel counts one hit.
+/// One impact at `texel`, for every substance s with load[s]: dep =
+/// deposit*p, ero = erosion*s, then p += ero - dep, s += dep - ero (thesis
+/// 4.8.4.3, as pinned in docs/design.md section 4); the texel counts one hit.
 void wx_dirt_map_exchange(wx_dirt_map *map, uint32_t texel, double *load);
 
 /// A slide that follows a slide: the same exchange spread evenly over the
 /// surface texels of the Bresenham line from `from` to `to`, without `from` (it
 /// took its share at the previous hit): each of the n texels exchanges with
 /// dep_k = deposit_k*p/n and ero_k = erosion_k*s_k/n, p being the load on
-/// arrival; each counts 1/n of a hit. With no surface texel on the line, a
-/// plain exchange at `to`.
+/// arrival, for every substance; each counts 1/n of a hit. With no surface
+/// texel on the line, a plain exchange at `to`.
 void wx_dirt_map_exchange_line(wx_dirt_map *map, uint32_t from, uint32_t to, double *load);
 
-/// Deposits all of *load at `texel` (absorbed and settled particles).
+/// Deposits all of every substance's load at `texel` (absorbed and settled
+/// particles).
 void wx_dirt_map_deposit_all(wx_dirt_map *map, uint32_t texel, double *load);
 
 /// Bresenham's line from (x0, y0) to (x1, y1), both ends included (thesis 3.5):

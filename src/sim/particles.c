@@ -47,6 +47,7 @@ bool wx_particles_reserve(wx_particles *p, int64_t needed)
     }
     capacity = (capacity + WX_PARTICLE_BLOCK - 1) / WX_PARTICLE_BLOCK * WX_PARTICLE_BLOCK;
     int64_t old = p->capacity;
+    int64_t S = p->substances > 1 ? p->substances : 1;
     // Each array grows on its own: on failure the grown ones are merely larger.
     bool ok = grow((void **)&p->x, old, capacity, sizeof *p->x) &&
               grow((void **)&p->y, old, capacity, sizeof *p->y) &&
@@ -56,7 +57,7 @@ bool wx_particles_reserve(wx_particles *p, int64_t needed)
               grow((void **)&p->vz, old, capacity, sizeof *p->vz) &&
               (p->inv_mass == NULL ||
                grow((void **)&p->inv_mass, old, capacity, sizeof *p->inv_mass)) &&
-              grow((void **)&p->load, old, capacity, sizeof *p->load) &&
+              grow((void **)&p->load, old * S, capacity * S, sizeof *p->load) &&
               grow((void **)&p->id, old, capacity, sizeof *p->id) &&
               grow((void **)&p->collisions_left, old, capacity, sizeof *p->collisions_left) &&
               grow((void **)&p->last_slide, old, capacity, sizeof *p->last_slide);
@@ -92,7 +93,7 @@ static bool accept_inv_mass(wx_particles *p, float inv)
 }
 
 int64_t wx_particles_push(wx_particles *p, const float pos[3], const float vel[3], float mass,
-                          double load, uint64_t id, uint32_t max_collisions)
+                          const double *load, uint64_t id, uint32_t max_collisions)
 {
     float inv = 1.0f / mass;
     if (!accept_inv_mass(p, inv)) {
@@ -108,7 +109,10 @@ int64_t wx_particles_push(wx_particles *p, const float pos[3], const float vel[3
     if (p->inv_mass != NULL) {
         p->inv_mass[i] = inv;
     }
-    p->load[i] = load;
+    int S = p->substances > 1 ? p->substances : 1;
+    for (int s = 0; s < S; ++s) {
+        p->load[i * S + s] = load[s];
+    }
     p->id[i] = id;
     p->collisions_left[i] = max_collisions;
     p->last_slide[i] = WX_NO_SLIDE;
@@ -130,7 +134,10 @@ void wx_particles_remove(wx_particles *p, int64_t i)
     if (p->inv_mass != NULL) {
         p->inv_mass[i] = p->inv_mass[last];
     }
-    p->load[i] = p->load[last];
+    int S = p->substances > 1 ? p->substances : 1;
+    for (int s = 0; s < S; ++s) {
+        p->load[i * S + s] = p->load[last * S + s];
+    }
     p->id[i] = p->id[last];
     p->collisions_left[i] = p->collisions_left[last];
     p->last_slide[i] = p->last_slide[last];

@@ -34,7 +34,8 @@ typedef struct wx_particles {
     float *inv_mass; ///< 1/mass per particle, or NULL while all share inv_mass_block[0]
     float inv_mass_block[WX_PARTICLE_BLOCK]; ///< the shared 1/mass, once per lane
     // Cold: touched on emission, collision and removal.
-    double *load;             ///< dirt carried
+    int substances;           ///< loads per particle, >= 1 (set before the first reserve)
+    double *load;             ///< substance s of particle i at load[i * substances + s]
     uint64_t *id;             ///< emitter index << 48 | serial number within it
     uint32_t *collisions_left; ///< hits before the particle settles (>= 1 while alive)
     /// Where a slide hit of the previous step was, numbered over the texels of
@@ -43,14 +44,16 @@ typedef struct wx_particles {
     uint32_t *last_slide;
 } wx_particles;
 
-/// Bytes stored per particle slot (all arrays), with a 1/mass array.
+/// Bytes stored per particle slot (all arrays), with a 1/mass array and one
+/// substance; each further substance adds one double.
 #define WX_PARTICLE_BYTES (7 * 4 + 8 + 8 + 4 + 4)
 
 /// Bytes stored per particle slot now: WX_PARTICLE_BYTES less the 1/mass array
-/// while all particles share one mass.
+/// while all particles share one mass, plus 8 per substance beyond the first.
 static inline int wx_particles_slot_bytes(const wx_particles *p)
 {
-    return WX_PARTICLE_BYTES - (p->inv_mass == NULL ? (int)sizeof(float) : 0);
+    int extra = p->substances > 1 ? 8 * (p->substances - 1) : 0;
+    return WX_PARTICLE_BYTES + extra - (p->inv_mass == NULL ? (int)sizeof(float) : 0);
 }
 
 /// 1/mass of particle i.
@@ -66,10 +69,11 @@ void wx_particles_free(wx_particles *p);
 /// false when out of memory (the particles are unchanged).
 bool wx_particles_reserve(wx_particles *p, int64_t needed);
 
-/// Appends one particle (capacity must be reserved). Returns its index, or -1
-/// when out of memory (a first particle of a new mass needs the 1/mass array).
+/// Appends one particle carrying load[0..substances) (capacity must be
+/// reserved). Returns its index, or -1 when out of memory (a first particle of
+/// a new mass needs the 1/mass array).
 int64_t wx_particles_push(wx_particles *p, const float pos[3], const float vel[3], float mass,
-                          double load, uint64_t id, uint32_t max_collisions);
+                          const double *load, uint64_t id, uint32_t max_collisions);
 
 /// Removes particle i by moving the last particle into its slot.
 void wx_particles_remove(wx_particles *p, int64_t i);

@@ -115,6 +115,15 @@ struct wx_sim {
     int *input_camera; ///< scene camera index of each input camera
     const wx_maps *maps;
     wx_dirt_map *dirt;
+    int substances;     ///< loads per particle, substances per texel
+    /// Ageing (docs/design.md section 9): per input camera, the amounts the
+    /// surface would hold without the particles, aged like the real ones
+    /// (NULL without rules: the initial planes are that), and the area each
+    /// texel grows on (NULL without Grow rules).
+    double **baseline;
+    float **grow_area;
+    const float **surface_of; ///< the maps' surface planes (NULL entries: none)
+    int64_t iterations_done;
     int camera_order[WX_MAX_INPUT_CAMERAS]; ///< coarse test order (speed only)
     /// Texel numbering for the particles' last slide: input camera c's texel t
     /// is slide_base[c] + t; slide_base[input_count] is the total.
@@ -448,15 +457,16 @@ static void record_hit(wx_sim *sim, const sim_event *e)
 static void apply_chunk(wx_sim *sim, const sim_chunk *ch)
 {
     double *load = sim->particles.load;
+    int64_t S = sim->substances;
     for (int64_t k = 0; k < ch->event_count; ++k) {
         if (k + 8 < ch->event_count) {
             const sim_event *ahead = &ch->events[k + 8];
-            __builtin_prefetch(&sim->dirt[ahead->camera].texels[ahead->texel]);
-            __builtin_prefetch(&load[ahead->index]);
+            __builtin_prefetch(&sim->dirt[ahead->camera].texels[(int64_t)ahead->texel * S]);
+            __builtin_prefetch(&load[ahead->index * S]);
         }
         const sim_event *e = &ch->events[k];
         wx_dirt_map *map = &sim->dirt[e->camera];
-        double *p = &load[e->index];
+        double *p = &load[e->index * S];
         if (e->flags & EVENT_LINE) {
             wx_dirt_map_exchange_line(map, e->from, e->texel, p);
         } else {
@@ -587,7 +597,10 @@ static void remove_dead(wx_sim *sim)
             if (ch->dead[k] & 1) {
                 int64_t i = ch->dead[k] >> 1;
                 sim->stats.escaped++;
-                sim->stats.dirt_escaped += sim->particles.load[i];
+                for (int s = 0; s < sim->substances; ++s) {
+                    sim->stats.substance[s].escaped +=
+                        sim->particles.load[i * sim->substances + s];
+                }
                 // An emitter's particle that escapes with all its collisions left
                 // never hit anything (spawned particles are not counted).
                 uint64_t e = sim->particles.id[i] >> 48;
@@ -613,11 +626,28 @@ static uint32_t max_collisions_of(int value)
     return value >= 1 ? (uint32_t)value : 1u;
 }
 
-static wx_result emit(wx_sim *sim, double t, wx_error *err)
+// How many particles emitter `em` has emitted after global step `step`: every
+// iteration emits as start and end say, measured from the iteration's start
+// (docs/design.md section 9); after the last iteration nothing more.
+static int64_t emitted_after(const wx_sim *sim, const wx_emitter *em, int64_t step)
+{
+    const wx_scene *scene = sim->scene;
+    int64_t steps = scene->steps > 0 ? scene->steps : 1;
+    int64_t iterations = scene->iterations > 1 ? scene->iterations : 1;
+    int64_t done = step > 0 ? (step - 1) / steps : 0; // whole iterations before this step's
+    if (done >= iterations) {
+        done = iterations - 1;
+        step = iterations * steps;
+    }
+    int64_t per_iteration = done > 0 ? wx_emitter_count_at(em, (double)steps * sim->dt) : 0;
+    return done * per_iteration + wx_emitter_count_at(em, (double)(step - done * steps) * sim->dt);
+}
+
+static wx_result emit(wx_sim *sim, int64_t step, wx_error *err)
 {
     for (int e = 0; e < sim->emitter_count; ++e) {
         const wx_emitter *em = &sim->emitters[e];
-        int64_t target = wx_emitter_count_at(em, t);
+        int64_t target = emitted_after(sim, em, step);
         int64_t count = target - sim->emitted[e];
         if (count <= 0) {
             continue;
@@ -630,18 +660,124 @@ static wx_result emit(wx_sim *sim, double t, wx_error *err)
             uint64_t id = wx_particle_id((uint32_t)e, (uint64_t)(sim->emitted[e] + k));
             float pos[3], vel[3];
             wx_emitter_sample(em, sim->seed, id, pos, vel);
-            if (wx_particles_push(&sim->particles, pos, vel, em->mass, em->dirt, id,
+            double load[WX_MAX_SUBSTANCES];
+            for (int s = 0; s < sim->substances; ++s) {
+                load[s] = em->load[s];
+            }
+            if (wx_particles_push(&sim->particles, pos, vel, em->mass, load, id,
                                   max_collisions_of(em->max_collisions)) < 0) {
                 sim->emitted[e] += k;
                 sim->stats.particles_emitted += k;
                 return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (particle masses)");
             }
-            sim->stats.dirt_emitted += em->dirt;
+            for (int s = 0; s < sim->substances; ++s) {
+                sim->stats.substance[s].emitted += em->load[s];
+            }
         }
         sim->emitted[e] = target;
         sim->stats.particles_emitted += count;
     }
     return WX_OK;
+}
+
+// --- ageing -----------------------------------------------------------------------
+
+// Runs `rules` on one texel's amounts a[] (and its baseline b[], may be NULL),
+// in order, each seeing the result of the one before (docs/design.md section 9);
+// `area` is the surface the texel grows on.
+static void run_rules(const wx_rule *rules, int count, double *a, double *b, double area,
+                      wx_substance_ledger *ledger)
+{
+    for (int k = 0; k < count; ++k) {
+        const wx_rule *r = &rules[k];
+        int s = r->substance;
+        switch (r->kind) {
+        case WX_RULE_TRANSFER: {
+            double t = (double)r->rate * a[s];
+            a[s] -= t;
+            a[r->to] += t;
+            ledger[s].transferred_out += t;
+            ledger[r->to].transferred_in += t;
+            if (b != NULL) {
+                double tb = (double)r->rate * b[s];
+                b[s] -= tb;
+                b[r->to] += tb;
+            }
+            break;
+        }
+        case WX_RULE_DECAY: {
+            double d = (double)r->rate * a[s];
+            a[s] -= d;
+            ledger[s].decayed += d;
+            if (b != NULL) {
+                b[s] -= (double)r->rate * b[s];
+            }
+            break;
+        }
+        case WX_RULE_GROW: {
+            double g = (double)r->amount * area;
+            a[s] += g;
+            ledger[s].grown += g;
+            if (b != NULL) {
+                b[s] += g;
+            }
+            break;
+        }
+        }
+    }
+}
+
+// After an iteration's last step: the global rules, then the texel's own
+// surface's, on every surface texel of every input camera, in texel order (one
+// thread: the ledger's sums are the same for any thread count).
+static void age(wx_sim *sim)
+{
+    const wx_scene *scene = sim->scene;
+    bool surface_rules = wx_scene_has_surface_rules(scene);
+    if (scene->rule_count == 0 && !surface_rules) {
+        return;
+    }
+    // Surface rules by global surface index.
+    const wx_surface *by_index[1024];
+    int surface_total = wx_scene_surface_count(scene);
+    int known = surface_total < 1024 ? surface_total : 1024;
+    for (int m = 0, g = 0; m < scene->mesh_count; ++m) {
+        for (int k = 0; k < scene->meshes[m].surface_count; ++k, ++g) {
+            if (g < known) {
+                by_index[g] = &scene->meshes[m].surfaces[k];
+            }
+        }
+    }
+    int S = sim->substances;
+    for (int c = 0; c < sim->input_count; ++c) {
+        wx_dirt_map *map = &sim->dirt[c];
+        size_t n = (size_t)map->width * (size_t)map->height;
+        const float *depth = map->depth;
+        const float *surface = sim->surface_of[c];
+        const float *area = sim->grow_area[c];
+        double *baseline = sim->baseline[c];
+        for (size_t t = 0; t < n; ++t) {
+            if (depth != NULL && !isfinite(depth[t])) {
+                continue;
+            }
+            wx_dirt_texel *x = &map->texels[t * (size_t)S];
+            double a[WX_MAX_SUBSTANCES];
+            for (int s = 0; s < S; ++s) {
+                a[s] = x[s].dirt;
+            }
+            double *b = baseline != NULL ? &baseline[t * (size_t)S] : NULL;
+            double grow = area != NULL ? (double)area[t] : 0.0;
+            run_rules(scene->rules, scene->rule_count, a, b, grow, sim->stats.substance);
+            int id = surface != NULL ? (int)surface[t] - 1 : -1;
+            if (id >= 0 && id < known) {
+                run_rules(by_index[id]->rules, by_index[id]->rule_count, a, b, grow,
+                          sim->stats.substance);
+            }
+            for (int s = 0; s < S; ++s) {
+                x[s].dirt = a[s];
+            }
+        }
+    }
 }
 
 wx_result wx_sim_step(wx_sim *sim, wx_error *err)
@@ -663,7 +799,19 @@ wx_result wx_sim_step(wx_sim *sim, wx_error *err)
         reorder_cameras(sim);
     }
     sim->step++;
-    return emit(sim, (double)sim->step * sim->dt, err);
+    wx_result r = emit(sim, sim->step, err);
+    const wx_scene *scene = sim->scene;
+    if (r == WX_OK && scene->steps > 0 && sim->step % scene->steps == 0 &&
+        sim->iterations_done < (scene->iterations > 1 ? scene->iterations : 1)) {
+        age(sim);
+        sim->iterations_done++;
+    }
+    return r;
+}
+
+int64_t wx_sim_iterations_done(const wx_sim *sim)
+{
+    return sim->iterations_done;
 }
 
 // --- creation --------------------------------------------------------------------
@@ -690,6 +838,52 @@ static wx_result start_pool(wx_sim *sim, wx_error *err)
     return WX_OK;
 }
 
+// Input camera c's ageing state: the baseline (amounts without the particles)
+// when the scene has rules, and the area Grow multiplies: the bake's record of
+// the area the camera owns or, for maps the bake did not write, the area every
+// surface texel covers (texel area / |N.view|, clamped as the bake clamps it).
+static wx_result setup_ageing(wx_sim *sim, int c, wx_error *err)
+{
+    const wx_scene *scene = sim->scene;
+    const wx_maps *m = &sim->maps[c];
+    size_t n = (size_t)m->width * (size_t)m->height;
+    int S = sim->substances;
+    sim->surface_of[c] = m->surface;
+    if (scene->rule_count == 0 && !wx_scene_has_surface_rules(scene)) {
+        return WX_OK;
+    }
+    sim->baseline[c] = malloc((n > 0 ? n : 1) * (size_t)S * sizeof(double));
+    if (sim->baseline[c] == NULL) {
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (ageing)");
+    }
+    for (size_t t = 0; t < n * (size_t)S; ++t) {
+        sim->baseline[c][t] = sim->dirt[c].texels[t].dirt;
+    }
+    if (!wx_scene_has_grow(scene)) {
+        return WX_OK;
+    }
+    if (m->area != NULL) {
+        sim->grow_area[c] = m->area;
+        return WX_OK;
+    }
+    float *area = malloc((n > 0 ? n : 1) * sizeof *area);
+    if (area == NULL) {
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (ageing)");
+    }
+    const wx_camera *cam = &scene->cameras[sim->input_camera[c]].camera;
+    float view[3], fw, fh;
+    wx_camera_view_dir(cam, view);
+    wx_camera_frame_size(cam, &fw, &fh);
+    float texel_area = (fw / (float)m->width) * (fh / (float)m->height);
+    for (size_t t = 0; t < n; ++t) {
+        const float *nn = &m->normal[3 * t];
+        float cosine = fabsf(nn[0] * view[0] + nn[1] * view[1] + nn[2] * view[2]);
+        area[t] = wx_depth_is_empty(m->depth[t]) ? 0.0f : texel_area / fmaxf(cosine, 1e-3f);
+    }
+    sim->grow_area[c] = area;
+    return WX_OK;
+}
+
 wx_result wx_sim_create(const wx_scene *scene, const wx_sim_def *config, wx_sim **out,
                         wx_error *err)
 {
@@ -708,6 +902,9 @@ wx_result wx_sim_create(const wx_scene *scene, const wx_sim_def *config, wx_sim 
     }
     sim->emitter_count = scene->emitter_count;
     sim->emitters = scene->emitters;
+    sim->substances = scene->substance_count > 1 ? scene->substance_count : 1;
+    sim->particles.substances = sim->substances;
+    sim->stats.substance_count = sim->substances;
     sim->thread_count = config->threads > 0 ? config->threads : wx_cpu_count();
     sim->hit_capacity = config->hit_capacity > 0 ? config->hit_capacity : DEFAULT_HIT_CAPACITY;
     int64_t chunk = config->chunk_particles > 0 ? config->chunk_particles : DEFAULT_CHUNK;
@@ -748,7 +945,11 @@ wx_result wx_sim_create(const wx_scene *scene, const wx_sim_def *config, wx_sim 
     if (r == WX_OK) {
         cameras = calloc((size_t)(sim->input_count + 1), sizeof *cameras);
         sim->dirt = calloc((size_t)(sim->input_count + 1), sizeof *sim->dirt);
-        if (cameras == NULL || sim->dirt == NULL) {
+        sim->baseline = calloc((size_t)(sim->input_count + 1), sizeof *sim->baseline);
+        sim->grow_area = calloc((size_t)(sim->input_count + 1), sizeof *sim->grow_area);
+        sim->surface_of = calloc((size_t)(sim->input_count + 1), sizeof *sim->surface_of);
+        if (cameras == NULL || sim->dirt == NULL || sim->baseline == NULL ||
+            sim->grow_area == NULL || sim->surface_of == NULL) {
             r = wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (simulation)");
         }
     }
@@ -777,11 +978,21 @@ wx_result wx_sim_create(const wx_scene *scene, const wx_sim_def *config, wx_sim 
     }
     for (int c = 0; r == WX_OK && c < sim->input_count; ++c) {
         const wx_maps *m = &sim->maps[c];
-        r = wx_dirt_map_init(&sim->dirt[c], m->width, m->height, m->dirt, m->deposit,
-                             m->erosion, scene->collider.deposit, scene->collider.erosion,
-                             sim->collider.cameras[c].depth, err);
+        if (wx_maps_substances(m) != sim->substances) {
+            r = wx_fail(err, WX_CAUSE_BAD_ARGUMENT,
+                        "simulation: the maps of camera '%s' hold %d substances, the scene %d",
+                        scene->cameras[sim->input_camera[c]].name, wx_maps_substances(m),
+                        sim->substances);
+            break;
+        }
+        r = wx_dirt_map_init(&sim->dirt[c], m->width, m->height, sim->substances, m->dirt,
+                             m->deposit, m->erosion, scene->collider.deposit,
+                             scene->collider.erosion, sim->collider.cameras[c].depth, err);
         if (r == WX_OK) {
-            sim->stats.dirt_initial_surface += wx_dirt_map_total(&sim->dirt[c]);
+            for (int s = 0; s < sim->substances; ++s) {
+                sim->stats.substance[s].initial_surface += wx_dirt_map_total(&sim->dirt[c], s);
+            }
+            r = setup_ageing(sim, c, err);
         }
     }
     if (r == WX_OK) {
@@ -818,6 +1029,18 @@ void wx_sim_destroy(wx_sim *sim)
         }
         free(sim->dirt);
     }
+    for (int c = 0; c < sim->input_count; ++c) {
+        if (sim->baseline != NULL) {
+            free(sim->baseline[c]);
+        }
+        if (sim->grow_area != NULL && sim->grow_area[c] != NULL &&
+            sim->grow_area[c] != sim->maps[c].area) {
+            free(sim->grow_area[c]);
+        }
+    }
+    free(sim->baseline);
+    free(sim->grow_area);
+    free(sim->surface_of);
     wx_collider_free(&sim->collider);
     wx_forces_free(&sim->forces);
     wx_particles_free(&sim->particles);
@@ -870,14 +1093,36 @@ void wx_sim_get_stats(const wx_sim *sim, wx_sim_stats *stats)
 {
     *stats = sim->stats;
     stats->alive = sim->particles.count;
-    stats->dirt_final_surface = 0.0;
-    for (int c = 0; c < sim->input_count; ++c) {
-        stats->dirt_final_surface += wx_dirt_map_total(&sim->dirt[c]);
+    stats->iterations = sim->iterations_done;
+    int S = sim->substances;
+    for (int s = 0; s < S; ++s) {
+        wx_substance_ledger *l = &stats->substance[s];
+        l->final_surface = 0.0;
+        for (int c = 0; c < sim->input_count; ++c) {
+            l->final_surface += wx_dirt_map_total(&sim->dirt[c], s);
+        }
+        l->in_flight = 0.0;
+        for (int64_t i = 0; i < sim->particles.count; ++i) {
+            l->in_flight += sim->particles.load[i * S + s];
+        }
     }
-    stats->dirt_in_flight = 0.0;
-    for (int64_t i = 0; i < sim->particles.count; ++i) {
-        stats->dirt_in_flight += sim->particles.load[i];
+    int d = sim->scene->dirt_substance;
+    stats->dirt_index = d;
+    for (int s = 0; s < S; ++s) {
+        snprintf(stats->substance_names[s], sizeof stats->substance_names[s], "%s",
+                 sim->scene->substances[s]);
     }
+    const wx_substance_ledger *dirt = d >= 0 && d < S ? &stats->substance[d] : NULL;
+    stats->dirt_initial_surface = dirt != NULL ? dirt->initial_surface : 0.0;
+    stats->dirt_emitted = dirt != NULL ? dirt->emitted : 0.0;
+    stats->dirt_final_surface = dirt != NULL ? dirt->final_surface : 0.0;
+    stats->dirt_in_flight = dirt != NULL ? dirt->in_flight : 0.0;
+    stats->dirt_escaped = dirt != NULL ? dirt->escaped : 0.0;
+}
+
+const double *wx_sim_baseline(const wx_sim *sim, int input)
+{
+    return sim->baseline[input];
 }
 
 int wx_sim_input_count(const wx_sim *sim)
@@ -905,12 +1150,13 @@ wx_result wx_sim_spawn(wx_sim *sim, const float position[3], const float velocit
         return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (particles)");
     }
     uint64_t id = wx_particle_id(PSEUDO_EMITTER, sim->spawned);
-    if (wx_particles_push(&sim->particles, position, velocity, mass, load, id,
+    double loads[WX_MAX_SUBSTANCES] = { load };
+    if (wx_particles_push(&sim->particles, position, velocity, mass, loads, id,
                           max_collisions_of(max_collisions)) < 0) {
         return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (particle masses)");
     }
     sim->spawned++;
     sim->stats.particles_emitted++;
-    sim->stats.dirt_emitted += load;
+    sim->stats.substance[0].emitted += load;
     return WX_OK;
 }

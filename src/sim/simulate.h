@@ -94,12 +94,23 @@ int wx_sim_recent_hits(const wx_sim *sim, wx_hit_sample *out, int max);
 /// current surface total and particle loads).
 void wx_sim_get_stats(const wx_sim *sim, wx_sim_stats *stats);
 
+/// Iterations completed so far (each ends with the ageing rules; at most the
+/// scene's `iterations`).
+int64_t wx_sim_iterations_done(const wx_sim *sim);
+
+/// Input camera `input`'s amounts without the particles' exchanges (W*H*S
+/// doubles, the dirt map's layout), aged like the real amounts: what the
+/// gather must not smooth. NULL when the scene has no ageing rules (the
+/// initial amounts are that).
+const double *wx_sim_baseline(const wx_sim *sim, int input);
+
 /// Input cameras and their dirt (index 0 = the scene's first input camera).
 int wx_sim_input_count(const wx_sim *sim);
 const wx_dirt_map *wx_sim_dirt_map(const wx_sim *sim, int input);
 
-/// Adds one particle by hand (tests, the viewer): it counts as emitted. Its
-/// random stream is that of a pseudo-emitter after the scene's emitters.
+/// Adds one particle by hand (tests, the viewer) carrying `load` of the first
+/// substance: it counts as emitted. Its random stream is that of a
+/// pseudo-emitter after the scene's emitters.
 wx_result wx_sim_spawn(wx_sim *sim, const float position[3], const float velocity[3],
                        float mass, double load, int max_collisions, wx_error *err);
 
