@@ -1,0 +1,127 @@
+// bench_substances.c: several substances cost little (issue 16). The rusty
+// tank (xml_scenes/rusty_tank.xml) simulated with its four substances and with
+// the same rain carrying one, ten iterations without frames: the simulate
+// phase's stepping (--stats simulate_seconds.steps) with four substances must
+// run at least 70% as fast as with one. Median of 3 runs each, alternating.
+#define _XOPEN_SOURCE 700 // realpath
+#include <limits.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "bench_report.h"
+#include "ensure.h"
+
+static char dir[PATH_MAX];
+static char program[PATH_MAX];
+
+static double steps_seconds(const char *scene)
+{
+    char cmd[3 * PATH_MAX];
+    snprintf(cmd, sizeof cmd,
+             "cd '%s' && rm -f stats.json && '%s' run '%s' --out out -q --stats stats.json", dir,
+             program, scene);
+    if (system(cmd) != 0) {
+        fprintf(stderr, "bench_substances: failed: %s\n", cmd);
+        return NAN;
+    }
+    char path[PATH_MAX + 16];
+    snprintf(path, sizeof path, "%s/stats.json", dir);
+    char *json = ensure_read_file(path);
+    const char *at = json != NULL ? strstr(json, "\"steps\": ") : NULL;
+    double s = at != NULL ? atof(at + 9) : NAN;
+    free(json);
+    return s;
+}
+
+static double median3(double a, double b, double c)
+{
+    return fmax(fmin(a, b), fmin(fmax(a, b), c));
+}
+
+// `text` with every `from` replaced by `to`, written to dir/name.
+static bool write_variant(const char *text, const char *const *pairs, int n, const char *name)
+{
+    char *out = malloc(strlen(text) * 2 + 4096);
+    if (out == NULL) {
+        return false;
+    }
+    strcpy(out, text);
+    for (int k = 0; k < n; ++k) {
+        char *at = strstr(out, pairs[2 * k]);
+        if (at == NULL) {
+            fprintf(stderr, "bench_substances: '%s' not in the scene\n", pairs[2 * k]);
+            free(out);
+            return false;
+        }
+        size_t from = strlen(pairs[2 * k]), to = strlen(pairs[2 * k + 1]);
+        memmove(at + to, at + from, strlen(at + from) + 1);
+        memcpy(at, pairs[2 * k + 1], to);
+    }
+    char path[PATH_MAX + 64];
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    FILE *f = fopen(path, "w");
+    bool ok = f != NULL && fputs(out, f) >= 0;
+    ok = f != NULL && fclose(f) == 0 && ok;
+    free(out);
+    return ok;
+}
+
+int main(void)
+{
+    const char *build = getenv("WX_BUILD") != NULL ? getenv("WX_BUILD") : "build";
+    char path[PATH_MAX];
+    snprintf(path, sizeof path, "%s/weathering", build);
+    if (realpath(path, program) == NULL) {
+        fprintf(stderr, "bench_substances: no %s\n", path);
+        return 1;
+    }
+    char cmd[2 * PATH_MAX];
+    snprintf(cmd, sizeof cmd, "mkdir -p '%s/tmp/bench_substances/meshes'", build);
+    snprintf(path, sizeof path, "%s/tmp/bench_substances", build);
+    if (system(cmd) != 0 || realpath(path, dir) == NULL) {
+        return 1;
+    }
+    snprintf(cmd, sizeof cmd, "cp xml_scenes/meshes/tank.obj xml_scenes/meshes/tank.mtl '%s/meshes/'",
+             dir);
+    char *scene = ensure_read_file("xml_scenes/rusty_tank.xml");
+    if (system(cmd) != 0 || scene == NULL) {
+        fprintf(stderr, "bench_substances: run from the repository's root\n");
+        return 1;
+    }
+    // Four substances, no frames; and one substance (version 1's dirt), the same rain.
+    const char *four[] = { "every=\"1\"", "every=\"0\"" };
+    const char *one[] = {
+        "every=\"1\"", "every=\"0\"",
+        "<Substance name=\"water\"/>\n    <Substance name=\"dirt\"/>\n    <Substance name=\"rust\"/>\n"
+        "    <Substance name=\"moss\"/>",
+        "<Substance name=\"dirt\"/>",
+        "<Load substance=\"water\" amount=\"1\"/>", "",
+        "<Decay substance=\"water\" rate=\"0.5\"/>", "<Decay substance=\"dirt\" rate=\"0.5\"/>",
+        "<Exchange substance=\"water\" deposit=\"0.3\" erosion=\"0.05\"/>", "",
+        "<Transfer from=\"water\" to=\"rust\" rate=\"0.2\"/>", "",
+        "<Exchange substance=\"water\" deposit=\"0.8\" erosion=\"0.02\"/>", "",
+        "<Transfer from=\"water\" to=\"moss\" rate=\"0.1\"/>", "",
+    };
+    if (!write_variant(scene, four, 1, "four.xml") || !write_variant(scene, one, 8, "one.xml")) {
+        return 1;
+    }
+    free(scene);
+    double t1[3], t4[3];
+    for (int k = 0; k < 3; ++k) {
+        t1[k] = steps_seconds("one.xml");
+        t4[k] = steps_seconds("four.xml");
+    }
+    double s1 = median3(t1[0], t1[1], t1[2]), s4 = median3(t4[0], t4[1], t4[2]);
+    double share = s1 / s4;
+    printf("substances: rusty tank, 600000 particles over 10 iterations, simulate steps "
+           "(median of 3)\n");
+    printf("  1 substance  %.2f s\n  4 substances %.2f s\n  speed with 4 / with 1: %.0f%%\n", s1,
+           s4, 100 * share);
+    bench_row("substances", "simulate steps", s1, "s", NULL, false, "1 substance");
+    bench_row("substances", "simulate steps", s4, "s", NULL, false, "4 substances");
+    bench_row("substances", "speed 4 / 1 substances", 100 * share, "%", ">= 70", share >= 0.7,
+              "rusty tank");
+    return isfinite(share) ? 0 : 1;
+}
