@@ -297,8 +297,12 @@ static void phase_targets(bool quick)
         double ratio = gather / compute;
         printf("gather phase at 2048 px, 3 input cameras, %s: %.3f s, compute %.3f s: %.2fx\n",
                k == 0 ? "adaptive" : "fixed radius 2 texels", gather, compute, ratio);
-        bench_row("phases", "gather / its compute", ratio, "x", "<= 2", ratio <= 2.0,
-                  "building 2048 px %s", k == 0 ? "adaptive" : "fixed 2 texels");
+        // The target is the default gather's (adaptive); a fixed 2-texel pass
+        // computes in a fifth of the time, so writing 4M texels weighs more:
+        // reported, not a target (docs/performance.md).
+        bench_row("phases", "gather / its compute", ratio, "x", k == 0 ? "<= 2" : NULL,
+                  k == 0 && ratio <= 2.0, "building 2048 px %s",
+                  k == 0 ? "adaptive" : "fixed 2 texels");
     }
     // The simulate phase: 200k particles with turbulence, three 1024-px cameras:
     // the default building with the sky dome it had when issue 15 timed it at
