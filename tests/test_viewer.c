@@ -8,6 +8,11 @@
 // The viewer's GL-free parts are compiled in here and checked against numbers
 // worked out by hand: the geometry drawn for the thesis scene, when maps must
 // be baked again, the nearest-point-per-pixel filter and the initial view.
+// With several substances (the thesis scene with <Substances> water, dirt,
+// rust): S walks through them and wraps, particles are coloured by their load
+// of the shown one (scaled by its emitter load), depth samples by its amount
+// on their texel, and a screenshot shows particles in the shown substance's
+// colour.
 #include <fcntl.h>
 #include <png.h>
 #include <stdint.h>
@@ -40,14 +45,64 @@ static bool have_xvfb(void)
     return false;
 }
 
-// Runs the viewer on the thesis scene for `frames` frames and saves `png`.
-static int screenshot(const char *png, int frames)
+// Runs the viewer on a scene (the thesis scene when NULL) for `frames` frames
+// and saves `png`; `extra` adds options.
+static int screenshot_of(const char *scene, const char *png, int frames, const char *extra)
 {
     const char *tmp = ensure_tmpdir();
     return ensure_shell(out, sizeof out,
-                        "xvfb-run -a %s/weathering-viewer xml_scenes/thesis_box.xml --out %s/out "
-                        "--screenshot %s/%s --frames %d",
-                        ensure_build_dir(), tmp, tmp, png, frames);
+                        "xvfb-run -a %s/weathering-viewer %s --out %s/out "
+                        "--screenshot %s/%s --frames %d %s",
+                        ensure_build_dir(), scene != NULL ? scene : "xml_scenes/thesis_box.xml",
+                        tmp, tmp, png, frames, extra);
+}
+
+static int screenshot(const char *png, int frames)
+{
+    return screenshot_of(NULL, png, frames, "");
+}
+
+// The thesis scene with three substances: its emitter carries 2 of water and
+// 0.25 of dirt, none of rust (the thesis' maps are substance dirt's). Written
+// once into the temporary folder, with the maps' absolute paths.
+static const char *substance_scene(void)
+{
+    static const char *path;
+    if (path != NULL) {
+        return path;
+    }
+    char *text = ensure_read_file("xml_scenes/thesis_box.xml");
+    char maps[4200], *cwd = getcwd(NULL, 0);
+    snprintf(maps, sizeof maps, "%s/maps/", cwd);
+    free(cwd);
+    static char scene[65536];
+    size_t n = 0;
+    for (const char *p = text; *p != '\0' && n + 4300 < sizeof scene;) {
+        if (strncmp(p, "../maps/", 8) == 0) {
+            n += (size_t)snprintf(scene + n, sizeof scene - n, "%s", maps);
+            p += 8;
+        } else if (strncmp(p, "<Solver>", 8) == 0) {
+            n += (size_t)snprintf(scene + n, sizeof scene - n,
+                                  "<Substances><Substance name=\"water\"/>"
+                                  "<Substance name=\"dirt\"/><Substance name=\"rust\"/>"
+                                  "</Substances>\n  <Solver>");
+            p += 8;
+        } else if (strncmp(p, "dirt=\"1\" maxCollisions=\"50\"/>", 29) == 0) {
+            n += (size_t)snprintf(scene + n, sizeof scene - n,
+                                  "dirt=\"0.25\" maxCollisions=\"50\">"
+                                  "<Load substance=\"water\" amount=\"2\"/></PointEmitter>");
+            p += 29;
+        } else {
+            scene[n++] = *p++;
+        }
+    }
+    scene[n] = '\0';
+    free(text);
+    if (strstr(scene, "<Load substance") == NULL || strstr(scene, "../maps/") != NULL) {
+        return NULL; // thesis_box.xml changed: the test must follow
+    }
+    path = ensure_write_file(ensure_tmpdir(), "substances.xml", scene);
+    return path;
 }
 
 typedef struct image {
@@ -139,6 +194,38 @@ TEST(screenshot_is_reproducible)
     ENSURE(same);
 }
 
+// The thesis scene with three substances, water shown: its particles carry
+// water 2, the largest water load, so they are drawn in water's colour, and
+// none in dirt's brown; with --substance dirt, the other way round.
+TEST(screenshot_shows_the_chosen_substance)
+{
+    ENSURE(have_xvfb());
+    const char *scene = substance_scene();
+    ENSURE(scene != NULL);
+    int status = screenshot_of(scene, "water.png", 30, "--substance water");
+    if (status != 0) {
+        fprintf(stderr, "%s", out);
+    }
+    ENSURE(status == 0);
+    ENSURE(screenshot_of(scene, "dirt.png", 30, "--substance dirt") == 0);
+    image water, dirt;
+    ENSURE(read_png("water.png", &water));
+    if (!read_png("dirt.png", &dirt)) {
+        free(water.rgb);
+        ENSURE(false);
+    }
+    long water_blue = count_color(&water, VW_SUBSTANCE_COLORS[0], 1);
+    long water_brown = count_color(&water, VW_PARTICLE_DIRTY_COLOR, 1);
+    long dirt_blue = count_color(&dirt, VW_SUBSTANCE_COLORS[0], 1);
+    long dirt_brown = count_color(&dirt, VW_PARTICLE_DIRTY_COLOR, 1);
+    free(water.rgb);
+    free(dirt.rgb);
+    ENSURE(water_blue >= 20);
+    ENSURE(water_brown == 0);
+    ENSURE(dirt_brown >= 20);
+    ENSURE(dirt_blue == 0);
+}
+
 // Bad input is found before any window opens: no display needed.
 static int viewer_without_display(const char *args)
 {
@@ -167,6 +254,9 @@ TEST(bad_usage_exits_2)
     ENSURE(viewer_without_display("xml_scenes/thesis_box.xml --bogus") == 2);
     ENSURE(ensure_contains(out, "unknown option '--bogus'"));
     ENSURE(viewer_without_display("xml_scenes/thesis_box.xml --size 10x") == 2);
+    ENSURE(viewer_without_display("xml_scenes/thesis_box.xml --substance") == 2);
+    ENSURE(viewer_without_display("xml_scenes/thesis_box.xml --substance rust") == 2);
+    ENSURE(ensure_contains(out, "no such substance (it has dirt)"));
 }
 
 // A <View> camera without maps: the viewer runs `weathering bake` in a child
@@ -420,16 +510,190 @@ TEST(initial_view_frames_the_box)
     ENSURE_NEAR(orbit.distance, before * 0.85f, 1e-4 * before);
 }
 
+// Without <Substances>: the one substance dirt, as before.
+TEST(one_substance_is_dirt)
+{
+    vw_settings settings = thesis_settings();
+    static vw_world w;
+    wx_error err;
+    ENSURE(vw_world_parse(&w, &settings, &err) == WX_OK);
+    ENSURE(vw_world_finish(&w, &settings, &err) == WX_OK);
+    ENSURE(vw_world_substance_count(&w) == 1);
+    ENSURE(strcmp(vw_world_substance_name(&w), "dirt") == 0);
+    ENSURE(vw_world_next_substance(&w) == 0);
+    ENSURE_NEAR(w.load_scale, 1, 0);
+    ENSURE(!vw_world_shows_deposits(&w)); // depth samples keep their camera's colour
+    float c[3];
+    vw_world_substance_color(&w, 0, c);
+    ENSURE(c[0] == 150 / 255.0f && c[1] == 100 / 255.0f && c[2] == 50 / 255.0f);
+    ENSURE(vw_world_total_steps(&w) == w.scene.steps);
+    vw_world_free(&w);
+}
+
+static int cmp_float(const void *a, const void *b)
+{
+    float x = *(const float *)a, y = *(const float *)b;
+    return x < y ? -1 : x > y;
+}
+
+TEST(substances_cycle_and_colour_by_the_shown_one)
+{
+    const char *scene = substance_scene();
+    ENSURE(scene != NULL);
+    vw_settings settings = thesis_settings();
+    settings.scene_path = scene;
+    static vw_world w;
+    wx_error err;
+    ENSURE(vw_world_parse(&w, &settings, &err) == WX_OK);
+    ENSURE(vw_world_finish(&w, &settings, &err) == WX_OK);
+    ENSURE(vw_world_substance_count(&w) == 3);
+    ENSURE(vw_world_shows_deposits(&w));
+    // The first is shown first; S walks water, dirt, rust and wraps. The scale
+    // is the shown substance's largest emitter load; nobody emits rust, so the
+    // largest load of any substance.
+    ENSURE(w.substance == 0 && strcmp(vw_world_substance_name(&w), "water") == 0);
+    ENSURE_NEAR(w.load_scale, 2, 0);
+    ENSURE(vw_world_next_substance(&w) == 1 && strcmp(vw_world_substance_name(&w), "dirt") == 0);
+    ENSURE_NEAR(w.load_scale, 0.25, 0);
+    ENSURE(vw_world_next_substance(&w) == 2 && strcmp(vw_world_substance_name(&w), "rust") == 0);
+    ENSURE_NEAR(w.load_scale, 2, 0);
+    ENSURE(vw_world_next_substance(&w) == 0);
+    ENSURE_NEAR(w.load_scale, 2, 0);
+    // A reload keeps the shown substance by name, else shows the first.
+    vw_world_keep_substance(&w, "rust");
+    ENSURE(w.substance == 2);
+    vw_world_keep_substance(&w, "moss");
+    ENSURE(w.substance == 0);
+    ENSURE(vw_world_find_substance(&w, "dirt") == 1 && vw_world_find_substance(&w, "Y") == -1);
+    // Substance dirt keeps the brown of version 1; water is the palette's first.
+    float rgb[3];
+    vw_world_substance_color(&w, 1, rgb);
+    ENSURE(rgb[0] == 150 / 255.0f && rgb[2] == 50 / 255.0f);
+    vw_world_substance_color(&w, 0, rgb);
+    ENSURE(rgb[0] == VW_SUBSTANCE_COLORS[0][0] / 255.0f &&
+           rgb[2] == VW_SUBSTANCE_COLORS[0][2] / 255.0f);
+
+    // Ten steps of 200 particles, falling from 6 m: nothing has hit the box
+    // yet, so every particle still carries what it was emitted with, at
+    // load[i * 3 + s].
+    for (int k = 0; k < 10; ++k) {
+        ENSURE(wx_sim_step(w.sim, &err) == WX_OK);
+    }
+    wx_particle_view view;
+    wx_sim_particles(w.sim, &view);
+    ENSURE(view.count > 1000);
+    static const double want[3] = { 2, 0.25, 0 };
+    for (int s = 0; s < 3; ++s) {
+        vw_world_show_substance(&w, s);
+        int wrong = 0;
+        for (int64_t i = 0; i < view.count; ++i) {
+            wrong += vw_particle_load(&w, &view, i) != want[s];
+        }
+        ENSURE(wrong == 0);
+    }
+
+    // After 150 steps particles have landed. A depth sample's deposit is the
+    // amount of the shown substance on the texel it was made from, found
+    // again here from its position: texel t's substance s at texels[t * 3 + s].
+    for (int k = 10; k < 150; ++k) {
+        ENSURE(wx_sim_step(w.sim, &err) == WX_OK);
+    }
+    int wrong = 0, out_samples = 0;
+    double water_total = 0.0;
+    for (int c = 0; c < w.scene.camera_count; ++c) {
+        vw_range r = w.camera_points[c];
+        for (int i = r.first; i < r.first + r.count; ++i) {
+            if (w.scene.cameras[c].is_output) {
+                vw_world_show_substance(&w, 0);
+                out_samples += vw_world_deposit(&w, i) == -1.0;
+                continue;
+            }
+            const wx_dirt_map *map = wx_sim_dirt_map(w.sim, w.camera_maps[c]);
+            ENSURE(map->substances == 3);
+            float uvd[3];
+            int ti = -1, tj = -1;
+            wx_camera_world_to_map(&w.scene.cameras[c].camera, w.points[i].position, uvd);
+            ENSURE(wx_map_texel(map->width, map->height, uvd[0], uvd[1], &ti, &tj));
+            size_t t = (size_t)tj * (size_t)map->width + (size_t)ti;
+            for (int s = 0; s < 3; ++s) {
+                vw_world_show_substance(&w, s);
+                wrong += vw_world_deposit(&w, i) != map->texels[t * 3 + s].dirt;
+            }
+            water_total += map->texels[t * 3].dirt;
+        }
+    }
+    ENSURE(wrong == 0);
+    ENSURE(out_samples == w.camera_points[2].count);
+    ENSURE(water_total > 0.0); // water has landed
+
+    // Deposit colours of every sample of the input cameras, water shown: full
+    // colour (times the sample's shading) at and above the 95% quantile of the
+    // non-zero amounts, the camera's colour where there is none.
+    vw_world_show_substance(&w, 0);
+    size_t n = (size_t)(w.camera_points[0].count + w.camera_points[1].count);
+    uint32_t *picked = malloc(n * sizeof *picked);
+    float *scratch = malloc(n * sizeof *scratch), *sorted = malloc(n * sizeof *sorted);
+    vw_vertex *colored = malloc(n * sizeof *colored);
+    ENSURE(picked != NULL && scratch != NULL && sorted != NULL && colored != NULL);
+    size_t nonzero = 0;
+    for (size_t k = 0; k < n; ++k) {
+        picked[k] = (uint32_t)(w.camera_points[0].first + (int)k); // inputs' samples come first
+        double a = vw_world_deposit(&w, (int)picked[k]);
+        if (a > 0.0) {
+            sorted[nonzero++] = (float)a;
+        }
+    }
+    ENSURE(nonzero > 100);
+    qsort(sorted, nonzero, sizeof *sorted, cmp_float);
+    float scale = vw_world_deposit_scale(&w, picked, n, scratch);
+    ENSURE(scale == sorted[(size_t)((double)(nonzero - 1) * VW_DEPOSIT_QUANTILE)]);
+    vw_world_deposit_colors(&w, picked, n, scratch, colored);
+    float water[3];
+    vw_world_substance_color(&w, 0, water);
+    int full = 0, clean = 0, bad = 0;
+    for (size_t k = 0; k < n; ++k) {
+        const vw_vertex *src = &w.points[picked[k]];
+        double a = vw_world_deposit(&w, (int)picked[k]);
+        float shade = w.samples[picked[k]].shade;
+        bad += memcmp(colored[k].position, src->position, sizeof src->position) != 0;
+        if (a >= scale) {
+            full++;
+            for (int ch = 0; ch < 3; ++ch) {
+                bad += fabsf(colored[k].color[ch] - water[ch] * shade) > 1e-6f;
+            }
+        } else if (!(a > 0.0)) {
+            clean++;
+            bad += memcmp(colored[k].color, src->color, sizeof src->color) != 0;
+        } else {
+            float t = sqrtf((float)a / scale);
+            for (int ch = 0; ch < 3; ++ch) {
+                float expect = src->color[ch] + t * (water[ch] * shade - src->color[ch]);
+                bad += fabsf(colored[k].color[ch] - expect) > 1e-6f;
+            }
+        }
+    }
+    free(picked);
+    free(scratch);
+    free(sorted);
+    free(colored);
+    ENSURE(bad == 0);
+    ENSURE(full >= (int)(nonzero / 20) && clean > 0);
+    vw_world_free(&w);
+}
+
 int main(void)
 {
     RUN(thesis_scene_geometry);
     RUN(maps_are_baked_again_when_needed);
     RUN(nearest_point_per_pixel_in_tile_order);
     RUN(initial_view_frames_the_box);
+    RUN(one_substance_is_dirt);
+    RUN(substances_cycle_and_colour_by_the_shown_one);
     RUN(bad_usage_exits_2);
     RUN(bad_scene_exits_2_and_names_the_file);
     RUN(failed_bake_exits_2);
     RUN(screenshot_shows_cameras_and_particles);
     RUN(screenshot_is_reproducible);
+    RUN(screenshot_shows_the_chosen_substance);
     return ensure_summary();
 }

@@ -245,11 +245,10 @@ static wx_result update_depth_samples(vw_draw *draw, const vw_world *world, cons
 {
     bool deposits = vw_world_shows_deposits(world);
     if (depth_samples_current(draw, show, mvp, width, height)) {
-        if (deposits || !draw->depth_uploaded) {
+        if (deposits) {
             vw_world_deposit_colors(world, draw->depth_picked, (size_t)draw->depth_count,
-                                    draw->vertices);
+                                    draw->staging, draw->vertices);
             upload(draw->depth_vbo, draw->vertices, (size_t)draw->depth_count * sizeof(vw_vertex));
-            draw->depth_uploaded = true;
         }
         return WX_OK;
     }
@@ -275,10 +274,9 @@ static wx_result update_depth_samples(vw_draw *draw, const vw_world *world, cons
         draw->vertices[k] = world->points[i];
     }
     if (deposits) {
-        vw_world_deposit_colors(world, draw->depth_picked, n, draw->vertices);
+        vw_world_deposit_colors(world, draw->depth_picked, n, draw->staging, draw->vertices);
     }
     upload(draw->depth_vbo, draw->vertices, n * sizeof(vw_vertex));
-    draw->depth_uploaded = true;
     draw->depth_count = (int)n;
     memcpy(draw->depth_mvp, mvp, sizeof draw->depth_mvp);
     draw->depth_width = width;

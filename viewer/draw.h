@@ -38,7 +38,6 @@ typedef struct vw_draw {
     int depth_width, depth_height;
     bool *depth_cameras;           ///< cameras shown when they were picked
     uint32_t *depth_picked;        ///< the picked samples (indices into world->points)
-    bool depth_uploaded;           ///< depth_vbo holds the picked samples' colours
     int camera_count;
 
     GLuint particle_vao, particle_vbo; ///< x, y, z, load per particle

@@ -2,7 +2,8 @@
 // docs/design.md sections 1 and 6; docs/viewer.md is the user's guide).
 //
 //   weathering-viewer SCENE.xml [--out DIR] [--threads N] [--size WxH]
-//                     [--screenshot FILE.png] [--frames N] [--steps-per-frame K] [-v]
+//                     [--screenshot FILE.png] [--frames N] [--steps-per-frame K]
+//                     [--substance NAME] [-v]
 //
 // The scene is read (and baked, by `weathering bake` in a child process) before
 // any window opens, so bad input is reported with exit status 2 even without a
@@ -57,6 +58,7 @@ typedef struct app {
     int frames;             ///< --frames: run this many frames and exit (0 = until closed)
     int steps_per_frame;    ///< with --frames
     bool gather_at_end;     ///< --gather: gather after the last of --frames
+    const char *substance;  ///< --substance: shown first, or NULL (the first)
     int width, height;
 
     vw_world *world;        ///< the running scene
@@ -100,6 +102,7 @@ static const char *const KEY_HELP[] = {
     "1-9      camera 1-9 on / off (scene order)",
     "D        depth samples on / off",
     "P        particles on / off",
+    "S        next substance: what particles and deposits show",
     "+ / -    simulation speed x2 / /2",
     "Backspace  start the simulation again",
     "Home     frame the cameras again",
@@ -111,7 +114,9 @@ enum { KEY_HELP_COUNT = sizeof KEY_HELP / sizeof KEY_HELP[0] };
 static const char *const COLOUR_HELP[] = {
     "colours: input cameras blue, green, magenta, yellow, cyan, orange, ...;",
     "  output camera white; depth samples in their camera's colour;",
-    "  particles pale blue (clean) to brown (carrying dirt);",
+    "  particles pale blue (clean) to brown (carrying dirt), or to the",
+    "  colour of the substance shown (S); with <Substances>, depth samples",
+    "  tinted towards it where it lies on their surface;",
     "  hits red absorbed, pale yellow bounced, pale green slid;",
     "  emitters pink; bounding box grey",
 };
@@ -135,6 +140,7 @@ static void print_usage(FILE *out)
             "  --frames N            run N frames and exit (default with --screenshot: 1)\n"
             "  --steps-per-frame K   simulation steps per frame with --frames (default 1)\n"
             "  --gather              with --frames: save the dirt maps and the mask at the end\n"
+            "  --substance NAME      show this substance first (default: the first)\n"
             "  -v, --verbose         timing at exit on stderr\n"
             "  -h, --help            this help\n"
             "\n"
@@ -202,7 +208,8 @@ static int parse_args(int argc, char **argv, app *a)
         const char *value = i + 1 < argc ? argv[i + 1] : NULL;
         bool takes_value = strcmp(arg, "--out") == 0 || strcmp(arg, "--threads") == 0 ||
                            strcmp(arg, "--size") == 0 || strcmp(arg, "--screenshot") == 0 ||
-                           strcmp(arg, "--frames") == 0 || strcmp(arg, "--steps-per-frame") == 0;
+                           strcmp(arg, "--frames") == 0 || strcmp(arg, "--steps-per-frame") == 0 ||
+                           strcmp(arg, "--substance") == 0;
         if (takes_value && value == NULL) {
             return usage_error("%s needs a value", arg);
         }
@@ -239,6 +246,11 @@ static int parse_args(int argc, char **argv, app *a)
                 return usage_error("%s needs a file name", arg);
             }
             a->screenshot = value;
+        } else if (strcmp(arg, "--substance") == 0) {
+            if (value[0] == '\0') {
+                return usage_error("%s needs a substance name", arg);
+            }
+            a->substance = value;
         } else if (strcmp(arg, "--frames") == 0) {
             if (!parse_int(value, 1, 100000000, &a->frames)) {
                 return usage_error("--frames takes a whole number from 1, not '%s'", value);
@@ -299,6 +311,7 @@ static void reset_rates(app *a)
 static void adopt_world(app *a, vw_world *world)
 {
     int old_cameras = a->world->scene.camera_count;
+    vw_world_keep_substance(world, vw_world_substance_name(a->world));
     vw_world_free(a->world);
     free(a->world);
     a->world = world;
@@ -397,6 +410,17 @@ static int load_first_world(app *a)
         fprintf(stderr, "weathering-viewer: %s\n", err.message);
         return r;
     }
+    int substance = a->substance != NULL ? vw_world_find_substance(a->world, a->substance) : 0;
+    if (substance < 0) {
+        const wx_scene *scene = &a->world->scene;
+        fprintf(stderr, "weathering-viewer: --substance %s: %s has no such substance (it has",
+                a->substance, scene->path);
+        for (int s = 0; s < scene->substance_count; ++s) {
+            fprintf(stderr, "%s %s", s > 0 ? "," : "", scene->substances[s]);
+        }
+        fprintf(stderr, ")\n");
+        return WX_BAD_INPUT;
+    }
     if (vw_world_needs_bake(a->world, NULL)) {
         fprintf(stderr, "weathering-viewer: baking the maps of %s into %s\n",
                 a->world->scene.path, a->world->opts.out_dir);
@@ -419,6 +443,7 @@ static int load_first_world(app *a)
         fprintf(stderr, "weathering-viewer: %s\n", err.message);
         return r;
     }
+    vw_world_show_substance(a->world, substance);
     return -1;
 }
 
@@ -521,10 +546,22 @@ static void status_line(const app *a, bool live, char *out, size_t cap)
     wx_particle_view view;
     wx_sim_particles(w->sim, &view);
     const char *state = vw_world_finished(w) ? "finished" : a->playing ? "playing" : "paused";
-    int n = snprintf(out, cap, "%s  t %.3f s  step %" PRId64 "/%" PRId64 "  %" PRId64
-                               " particles  %s",
-                     w->scene.name, wx_sim_time(w->sim), wx_sim_step_count(w->sim),
-                     w->scene.steps, view.count, state);
+    int n = snprintf(out, cap, "%s  t %.3f s  step %" PRId64 "/%" PRId64, w->scene.name,
+                     wx_sim_time(w->sim), wx_sim_step_count(w->sim), vw_world_total_steps(w));
+    if (w->scene.iterations > 1 && n > 0 && (size_t)n < cap) {
+        int64_t done = wx_sim_iterations_done(w->sim);
+        n += snprintf(out + n, cap - (size_t)n, "  iteration %" PRId64 "/%d",
+                      done < w->scene.iterations ? done + 1 : done, w->scene.iterations);
+    }
+    if (n > 0 && (size_t)n < cap) {
+        n += snprintf(out + n, cap - (size_t)n, "  %" PRId64 " particles  %s", view.count, state);
+    }
+    // The substance shown, in scenes that declare theirs (without, it is dirt).
+    if (w->scene.substances_declared && n > 0 && (size_t)n < cap) {
+        n += snprintf(out + n, cap - (size_t)n, "  substance %s %d/%d",
+                      vw_world_substance_name(w), w->substance + 1,
+                      vw_world_substance_count(w));
+    }
     if (live && n > 0 && (size_t)n < cap) {
         snprintf(out + n, cap - (size_t)n, " x%g  %.0f steps/s  %.0f fps", a->speed,
                  a->steps_per_s, a->frames_per_s);
@@ -551,6 +588,20 @@ static void toggle_camera(app *a, int c)
     a->camera_visible[c] = !a->camera_visible[c];
     const wx_scene_camera *cam = &a->world->scene.cameras[c];
     report(a, false, "camera %d '%s' %s", c + 1, cam->name, a->camera_visible[c] ? "on" : "off");
+}
+
+static void next_substance(app *a)
+{
+    vw_world *w = a->world;
+    int count = vw_world_substance_count(w);
+    if (count == 1) {
+        report(a, false, "the scene has one substance, %s", vw_world_substance_name(w));
+        return;
+    }
+    vw_world_next_substance(w);
+    report(a, false,
+           "showing substance %d/%d, %s: on particles (full colour at load %g) and deposits",
+           w->substance + 1, count, vw_world_substance_name(w), (double)w->load_scale);
 }
 
 static void on_key(GLFWwindow *window, int key, int scancode, int action, int mods)
@@ -591,6 +642,7 @@ static void on_key(GLFWwindow *window, int key, int scancode, int action, int mo
         a->show.particles = !a->show.particles;
         report(a, false, "particles %s", a->show.particles ? "on" : "off");
         break;
+    case GLFW_KEY_S: next_substance(a); break;
     case GLFW_KEY_EQUAL:
     case GLFW_KEY_KP_ADD:
         a->speed = a->speed * 2.0 < MAX_SPEED ? a->speed * 2.0 : MAX_SPEED;

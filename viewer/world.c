@@ -2,6 +2,7 @@
 #include "world.h"
 
 #include <math.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -607,24 +608,68 @@ double vw_world_deposit(const vw_world *world, int point)
     return map->texels[(size_t)sample->texel * (size_t)S + (size_t)s].dirt;
 }
 
-void vw_world_deposit_colors(const vw_world *world, const uint32_t *picked, size_t n,
-                             vw_vertex *out)
+// The k-th smallest of a[0..n) (0-based, n > 0; a is reordered): Hoare's
+// selection.
+static float select_kth(float *a, size_t n, size_t k)
 {
-    double most = 0.0;
+    ptrdiff_t lo = 0, hi = (ptrdiff_t)n - 1, want = (ptrdiff_t)k;
+    while (lo < hi) {
+        float pivot = a[lo + (hi - lo) / 2];
+        ptrdiff_t i = lo, j = hi;
+        while (i <= j) {
+            while (a[i] < pivot) {
+                i++;
+            }
+            while (a[j] > pivot) {
+                j--;
+            }
+            if (i <= j) {
+                float t = a[i];
+                a[i++] = a[j];
+                a[j--] = t;
+            }
+        }
+        if (want <= j) {
+            hi = j;
+        } else if (want >= i) {
+            lo = i;
+        } else {
+            break;
+        }
+    }
+    return a[want];
+}
+
+float vw_world_deposit_scale(const vw_world *world, const uint32_t *picked, size_t n,
+                             float *scratch)
+{
+    size_t m = 0;
     for (size_t k = 0; k < n; ++k) {
         double a = vw_world_deposit(world, (int)picked[k]);
-        most = a > most ? a : most;
+        if (a > 0.0) {
+            scratch[m++] = (float)a;
+        }
     }
+    if (m == 0) {
+        return 0.0f;
+    }
+    return select_kth(scratch, m, (size_t)((double)(m - 1) * VW_DEPOSIT_QUANTILE));
+}
+
+void vw_world_deposit_colors(const vw_world *world, const uint32_t *picked, size_t n,
+                             float *scratch, vw_vertex *out)
+{
+    float scale = vw_world_deposit_scale(world, picked, n, scratch);
     float color[3];
     vw_world_substance_color(world, world->substance, color);
     for (size_t k = 0; k < n; ++k) {
         const int i = (int)picked[k];
         out[k] = world->points[i];
-        double a = most > 0.0 ? vw_world_deposit(world, i) : 0.0;
+        double a = scale > 0.0f ? vw_world_deposit(world, i) : 0.0;
         if (!(a > 0.0)) {
             continue;
         }
-        float t = sqrtf((float)(a < most ? a / most : 1.0));
+        float t = sqrtf(a < scale ? (float)a / scale : 1.0f);
         float shade = world->samples[i].shade;
         for (int c = 0; c < 3; ++c) {
             out[k].color[c] += t * (color[c] * shade - out[k].color[c]);
@@ -644,9 +689,14 @@ wx_result vw_world_restart(vw_world *world, const vw_settings *settings, wx_erro
     return WX_OK;
 }
 
+int64_t vw_world_total_steps(const vw_world *world)
+{
+    return world->scene.steps * (int64_t)(world->scene.iterations > 1 ? world->scene.iterations : 1);
+}
+
 bool vw_world_finished(const vw_world *world)
 {
-    return world->sim != NULL && wx_sim_step_count(world->sim) >= world->scene.steps;
+    return world->sim != NULL && wx_sim_step_count(world->sim) >= vw_world_total_steps(world);
 }
 
 wx_result vw_world_gather(vw_world *world, char saved[WX_PATH_MAX], wx_error *err)

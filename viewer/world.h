@@ -100,7 +100,11 @@ wx_result vw_world_finish(vw_world *world, const vw_settings *settings, wx_error
 /// one is kept.
 wx_result vw_world_restart(vw_world *world, const vw_settings *settings, wx_error *err);
 
-/// True when the simulation has run the scene's number of steps.
+/// Steps of the whole simulation: the scene's steps times its iterations.
+int64_t vw_world_total_steps(const vw_world *world);
+
+/// True when the simulation has run the scene's number of steps in every
+/// iteration (docs/design.md section 9).
 bool vw_world_finished(const vw_world *world);
 
 /// Writes <camera>_dirt.exr for every input camera and, when the scene has an
@@ -150,12 +154,25 @@ static inline double vw_particle_load(const vw_world *world, const wx_particle_v
 /// or -1 for a sample of the output camera (it has no dirt map).
 double vw_world_deposit(const vw_world *world, int point);
 
+/// Depth samples show the amount at this quantile of the non-zero amounts
+/// among those drawn, and above, in full colour: surface amounts are
+/// heavy-tailed (a few texels where streaks end hold a hundred times the
+/// typical amount), so the largest would leave the rest unseen.
+#define VW_DEPOSIT_QUANTILE 0.95
+
+/// The amount of the shown substance drawn in full colour on depth samples
+/// picked[0..n): VW_DEPOSIT_QUANTILE of their non-zero amounts, 0 when there
+/// is none. `scratch` holds n floats.
+float vw_world_deposit_scale(const vw_world *world, const uint32_t *picked, size_t n,
+                             float *scratch);
+
 /// Copies depth samples picked[0..n) into out, coloured by the deposits of the
 /// shown substance: from their camera's shaded colour towards the substance's
-/// shaded colour by sqrt(amount / largest amount among them); output-camera
-/// samples and surfaces without any keep their colour.
+/// shaded colour by sqrt(amount / vw_world_deposit_scale), at most 1;
+/// output-camera samples and surfaces without any keep their colour.
+/// `scratch` holds n floats.
 void vw_world_deposit_colors(const vw_world *world, const uint32_t *picked, size_t n,
-                             vw_vertex *out);
+                             float *scratch, vw_vertex *out);
 
 /// Frees everything; the struct is zeroed.
 void vw_world_free(vw_world *world);
