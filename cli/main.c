@@ -223,7 +223,40 @@ static const char *field_name(wx_field_kind kind)
     return "?";
 }
 
-static void print_camera(const wx_scene_camera *sc)
+// The rule as the scene writes it: "Transfer water -> rust 0.2", "Decay water
+// 0.5", "Grow moss 2 per m^2".
+static void print_rule(const wx_scene *scene, const wx_rule *rule)
+{
+    const char *name = rule->substance >= 0 && rule->substance < scene->substance_count
+                           ? scene->substances[rule->substance]
+                           : "?";
+    switch (rule->kind) {
+    case WX_RULE_TRANSFER:
+        printf("Transfer %s -> %s %g", name,
+               rule->to >= 0 && rule->to < scene->substance_count ? scene->substances[rule->to]
+                                                                  : "?",
+               rule->rate);
+        break;
+    case WX_RULE_DECAY: printf("Decay %s %g", name, rule->rate); break;
+    case WX_RULE_GROW: printf("Grow %s %g per m^2", name, rule->amount); break;
+    }
+}
+
+// The rules in document order, separated by commas.
+static void print_rules(const wx_scene *scene, const wx_rule *rules, int count)
+{
+    for (int r = 0; r < count; ++r) {
+        printf("%s", r ? ", " : "");
+        print_rule(scene, &rules[r]);
+    }
+}
+
+static int scene_iterations(const wx_scene *scene)
+{
+    return scene->iterations > 1 ? scene->iterations : 1;
+}
+
+static void print_camera(const wx_scene *scene, const wx_scene_camera *sc)
 {
     const wx_camera *cam = &sc->camera;
     float w_ws, h_ws, dir[3], center[3];
@@ -249,6 +282,34 @@ static void print_camera(const wx_scene_camera *sc)
                sc->output_width, sc->output_height, sc->radius,
                sc->second_pass == WX_SECOND_PASS_SUM ? "thesis sum" : "weighted mean",
                sc->normalize ? ", normalised to [0,1]" : "");
+    }
+    // The mask's channels (one per substance) and its image sequence.
+    if (sc->is_output && (scene->substances_declared || sc->every > 0)) {
+        char names[WX_IMAGE_MAX_CHANNELS][WX_NAME_MAX];
+        int channels = wx_mask_channels(scene, names);
+        printf("  %-12s        channel%s", "", channels > 1 ? "s" : "");
+        for (int c = 0; c < channels; ++c) {
+            printf("%s %s", c ? "," : "", names[c]);
+        }
+        int iterations = scene_iterations(scene);
+        int frames = sc->every > 0 ? iterations / sc->every : 0;
+        if (frames > 0) {
+            char first[WX_OUTPUT_NAME_MAX], last[WX_OUTPUT_NAME_MAX];
+            wx_frame_name(sc->output_file, sc->every, first, sizeof first);
+            wx_frame_name(sc->output_file, frames * sc->every, last, sizeof last);
+            if (frames == 1) {
+                printf("; frame '%s' after iteration %d", first, sc->every);
+            } else if (sc->every == 1) {
+                printf("; frames '%s' to '%s', one after every iteration", first, last);
+            } else {
+                printf("; frames '%s' to '%s', one after every %d iterations", first, last,
+                       sc->every);
+            }
+        } else if (sc->every > 0) {
+            printf("; no frame: every=\"%d\" is more than the %d iteration%s", sc->every,
+                   iterations, iterations == 1 ? "" : "s");
+        }
+        printf("\n");
     }
 }
 
@@ -280,19 +341,33 @@ static int command_info(const cli_args *args)
         return r;
     }
     printf("scene %s\n", scene.path);
+    int iterations = scene_iterations(&scene);
     printf("solver: bounding box %g m centred at (%g, %g, %g); %" PRId64
-           " steps of %g s (%g s simulated); seed %" PRIu64 "\n",
+           " steps of %g s (%g s simulated)",
            scene.bbox_size, scene.bbox_center[0], scene.bbox_center[1], scene.bbox_center[2],
-           scene.steps, scene.time_step, wx_scene_duration(&scene), opts.seed);
+           scene.steps, scene.time_step, wx_scene_duration(&scene));
+    if (iterations > 1) {
+        printf(" in each of %d iterations (%" PRId64 " steps, %g s in all)", iterations,
+               scene.steps * iterations, wx_scene_duration(&scene) * iterations);
+    }
+    printf("; seed %" PRIu64 "\n", opts.seed);
+    // Substances (docs/design.md section 9): without <Substances> the one "dirt".
+    printf("substances (%d):", scene.substance_count);
+    for (int k = 0; k < scene.substance_count; ++k) {
+        printf("%s %s", k ? "," : "", scene.substances[k]);
+    }
+    printf("%s\n", scene.substances_declared ? "" : " (default)");
     printf("cameras (%d input, %d output):\n", scene.input_count, scene.output_index >= 0 ? 1 : 0);
     for (int c = 0; c < scene.camera_count; ++c) {
-        print_camera(&scene.cameras[c]);
+        print_camera(&scene, &scene.cameras[c]);
     }
     printf("emitters (%d):\n", scene.emitter_count);
     double duration = wx_scene_duration(&scene);
     for (int e = 0; e < scene.emitter_count; ++e) {
         const wx_emitter *em = &scene.emitters[e];
-        int64_t count = wx_emitter_count_at(em, duration);
+        // The emitters emit again in every iteration.
+        int64_t per_iteration = wx_emitter_count_at(em, duration);
+        int64_t count = per_iteration * iterations;
         if (em->kind == WX_EMITTER_BOX) {
             printf("  %-12s %-10s (%g, %g, %g) to (%g, %g, %g), direction (%g, %g, %g)",
                    em->name[0] ? em->name : "(unnamed)", "box", em->box_min[0], em->box_min[1],
@@ -310,7 +385,8 @@ static int command_info(const cli_args *args)
                 shadow += fabs((double)em->dir[k]) * a * b;
             }
             if (shadow > 0.0) {
-                printf(" (%.4g particles per square metre across it)", (double)count / shadow);
+                printf(" (%.4g particles per square metre across it%s)",
+                       (double)per_iteration / shadow, iterations > 1 ? " in each iteration" : "");
             }
         } else {
             printf("  %-12s %-10s at (%g, %g, %g)", em->name[0] ? em->name : "(unnamed)",
@@ -320,10 +396,28 @@ static int command_info(const cli_args *args)
         if (em->kind == WX_EMITTER_HEMISPHERE) {
             printf(" radius %g", em->radius);
         }
-        printf(", %g/s from %g to %g s (%lld particles), speed %g, mass %g, dirt %g, "
-               "max collisions %d\n",
-               em->rate, em->start, em->end, (long long)count, em->speed, em->mass, em->load[0],
-               em->max_collisions);
+        printf(", %g/s from %g to %g s", em->rate, em->start, em->end);
+        if (iterations > 1) {
+            printf(" of each iteration (%lld particles per iteration, %lld in all)",
+                   (long long)per_iteration, (long long)count);
+        } else {
+            printf(" (%lld particles)", (long long)count);
+        }
+        printf(", speed %g, mass %g, ", em->speed, em->mass);
+        if (!scene.substances_declared) {
+            printf("dirt %g", em->load[0]); // version 1's one substance
+        } else {
+            // The load of each substance a particle carries (the others: 0).
+            int shown = 0;
+            printf("loads");
+            for (int k = 0; k < scene.substance_count; ++k) {
+                if (em->load[k] != 0.0f) {
+                    printf("%s %s %g", shown++ ? "," : "", scene.substances[k], em->load[k]);
+                }
+            }
+            printf("%s", shown ? "" : " none");
+        }
+        printf(", max collisions %d\n", em->max_collisions);
     }
     printf("force fields (%d):\n", scene.field_count);
     for (int f = 0; f < scene.field_count; ++f) {
@@ -344,17 +438,49 @@ static int command_info(const cli_args *args)
     const wx_collider_def *col = &scene.collider;
     printf("collider: resilience %g, friction %g, adherence %g, deposit %g, erosion %g\n",
            col->resilience, col->friction, col->adherence, col->deposit, col->erosion);
+    // The global ageing rules, run on every surface texel after each iteration
+    // before the texel's own surface's.
+    bool ageing = wx_scene_has_ageing(&scene);
+    if (ageing && scene.rule_count == 0) {
+        printf("ageing: no global rule\n");
+    } else if (ageing) {
+        printf("ageing: %d global rule%s after each of the %d iteration%s: ", scene.rule_count,
+               scene.rule_count == 1 ? "" : "s", iterations, iterations == 1 ? "" : "s");
+        print_rules(&scene, scene.rules, scene.rule_count);
+        printf("\n");
+    }
     printf("meshes (%d):\n", scene.mesh_count);
     for (int m = 0; m < scene.mesh_count; ++m) {
         const wx_mesh *mesh = &scene.meshes[m];
         printf("  %s:", mesh->path);
-        for (int s = 0; s < mesh->surface_count; ++s) {
+        for (int s = 0; s < mesh->surface_count && !ageing; ++s) {
+            // Version 1's one substance: every surface on the mesh's line.
             const wx_surface *sf = &mesh->surfaces[s];
             printf("%s material '%s' absorption %g bounce %g dirt %g deposit %g erosion %g",
                    s ? ";" : "", sf->material, sf->absorption, sf->bounce, sf->initial[0],
                    sf->deposit[0], sf->erosion[0]);
         }
         printf("\n");
+        for (int s = 0; s < mesh->surface_count && ageing; ++s) {
+            // A line per surface: its exchange with each substance it trades
+            // (the others: initial, deposit and erosion 0), and its own rules.
+            const wx_surface *sf = &mesh->surfaces[s];
+            printf("    material '%s' absorption %g bounce %g; exchanges", sf->material,
+                   sf->absorption, sf->bounce);
+            int shown = 0;
+            for (int k = 0; k < scene.substance_count; ++k) {
+                if (sf->initial[k] != 0.0f || sf->deposit[k] != 0.0f || sf->erosion[k] != 0.0f) {
+                    printf("%s %s initial %g deposit %g erosion %g", shown++ ? "," : "",
+                           scene.substances[k], sf->initial[k], sf->deposit[k], sf->erosion[k]);
+                }
+            }
+            printf("%s", shown ? "" : " none");
+            if (sf->rule_count > 0) {
+                printf("; rules ");
+                print_rules(&scene, sf->rules, sf->rule_count);
+            }
+            printf("\n");
+        }
         if (imported) {
             const wx_geometry_mesh *g = &geometry.meshes[m];
             char shown[WX_ERROR_MAX];
@@ -378,12 +504,17 @@ static int command_info(const cli_args *args)
     wx_memory_estimate(&scene, WX_PHASE_ALL, &need);
     double available = wx_memory_available();
     const double mib = 1024.0 * 1024.0;
+    char frame[96] = "";
+    if (need.frame_bytes > 0.0) {
+        snprintf(frame, sizeof frame, " and %.0f for a frame of the mask's sequence",
+                 need.frame_bytes / mib);
+    }
     printf("memory: about %.0f MiB at the peak (the %s: program %.0f, bake %.0f with %.0f for "
            "the meshes, simulation %.0f with %.0f for %lld particles if all were alive at "
-           "once, gather %.0f; MiB)",
+           "once%s, gather %.0f; MiB)",
            need.total_bytes / mib, need.phase, need.baseline_bytes / mib, need.bake_bytes / mib,
            need.mesh_bytes / mib, (need.sim_map_bytes + need.particle_bytes) / mib,
-           need.particle_bytes / mib, (long long)need.particles, need.gather_bytes / mib);
+           need.particle_bytes / mib, (long long)need.particles, frame, need.gather_bytes / mib);
     if (available >= 0.0) {
         printf(" of %.0f MiB available%s", available / (1024.0 * 1024.0),
                need.total_bytes > available ? ": too much, a run would be refused" : "");

@@ -76,6 +76,114 @@ TEST(info_summarises_the_default_scene)
     ENSURE(ensure_contains(out, "600000 particles"));
     ENSURE(ensure_contains(out, "seed 7"));
     ENSURE(ensure_contains(out, "output folder: /tmp/x"));
+    // Version 1's one substance, in version 1's words.
+    ENSURE(ensure_contains(out, "substances (1): dirt (default)\n"));
+    ENSURE(ensure_contains(out, "mass 1, dirt 0.05, max collisions 150"));
+    ENSURE(ensure_contains(out, "material 'wall' absorption 0 bounce 0.1 dirt 0 deposit 0.03 "
+                                "erosion 0.02;"));
+    ENSURE(!ensure_contains(out, "ageing:"));
+    ENSURE(!ensure_contains(out, "iterations"));
+}
+
+// info on a scene with substances and ageing (docs/design.md section 9) lists
+// the substances, each emitter's loads, each surface's exchanges and rules, the
+// global rules, the iterations and the mask's channels and frames (issue 16).
+TEST(info_lists_substances_loads_exchanges_and_rules)
+{
+    char dir[4200];
+    snprintf(dir, sizeof dir, "%s/info_substances", ensure_tmpdir());
+    ENSURE(ensure_shell(NULL, 0, "mkdir -p '%s'", dir) == 0);
+    ensure_write_file(dir, "plane.obj",
+                      "mtllib plane.mtl\n"
+                      "v -1 0 -1\nv 0 0 -1\nv 0 0 1\nv -1 0 1\nv 1 0 -1\nv 1 0 1\n"
+                      "vn 0 1 0\n"
+                      "usemtl iron\nf 1//1 4//1 3//1 2//1\n"
+                      "usemtl stone\nf 2//1 3//1 6//1 5//1\n");
+    ensure_write_file(dir, "plane.mtl", "newmtl iron\nKd 0.5 0.5 0.5\nnewmtl stone\nKd 1 1 1\n");
+    const char *path = ensure_write_file(
+        dir, "s.xml",
+        "<Weathering>\n"
+        "  <Substances>\n"
+        "    <Substance name=\"water\"/>\n"
+        "    <Substance name=\"dirt\"/>\n"
+        "    <Substance name=\"rust\"/>\n"
+        "    <Substance name=\"moss\"/>\n"
+        "  </Substances>\n"
+        "  <Solver>\n"
+        "    <BoundingBox size=\"8\"/>\n"
+        "    <Simulation timeStep=\"0.01\" steps=\"50\" iterations=\"4\"/>\n"
+        "  </Solver>\n"
+        "  <Emitters>\n"
+        "    <BoxEmitter name=\"rain\" minX=\"-1\" minY=\"1\" minZ=\"-1\" maxX=\"1\" "
+        "maxY=\"1\" maxZ=\"1\" rate=\"1000\" end=\"0.5\" dirt=\"0.05\">\n"
+        "      <Load substance=\"water\" amount=\"1\"/>\n"
+        "      <Load substance=\"moss\" amount=\"0\"/>\n"
+        "    </BoxEmitter>\n"
+        "  </Emitters>\n"
+        "  <Collider>\n"
+        "    <ProjectedMaps>\n"
+        "      <Ortho cameraName=\"top\">\n"
+        "        <View eye=\"0 3 0\" target=\"0 0 0\" up=\"0 0 -1\" width=\"2.4\" "
+        "height=\"2.4\" resolution=\"64\"/>\n"
+        "      </Ortho>\n"
+        "      <Ortho cameraName=\"shot\" out=\"true\">\n"
+        "        <View eye=\"0 3 0\" target=\"0 0 0\" up=\"0 0 -1\" width=\"2.4\" "
+        "height=\"2.4\" resolution=\"32\"/>\n"
+        "        <OutputMap file=\"mask.exr\" width=\"32\" height=\"32\" every=\"2\"/>\n"
+        "      </Ortho>\n"
+        "    </ProjectedMaps>\n"
+        "  </Collider>\n"
+        "  <Ageing>\n"
+        "    <Decay substance=\"water\" rate=\"0.5\"/>\n"
+        "    <Grow substance=\"moss\" amount=\"2\"/>\n"
+        "  </Ageing>\n"
+        "  <Geometry>\n"
+        "    <Mesh file=\"plane.obj\">\n"
+        "      <Surface material=\"iron\" absorption=\"0.1\" bounce=\"0.2\" dirt=\"0\" "
+        "deposit=\"0.5\" erosion=\"0.1\">\n"
+        "        <Exchange substance=\"water\" deposit=\"0.8\" erosion=\"0.1\"/>\n"
+        "        <Transfer from=\"water\" to=\"rust\" rate=\"0.2\"/>\n"
+        "        <Decay substance=\"water\" rate=\"0.25\"/>\n"
+        "      </Surface>\n"
+        "      <Surface material=\"stone\" absorption=\"0.6\" bounce=\"0.1\" dirt=\"0\" "
+        "deposit=\"0\" erosion=\"0\">\n"
+        "        <Exchange substance=\"water\" initial=\"0.5\" deposit=\"0.3\"/>\n"
+        "        <Decay substance=\"rust\" rate=\"1\"/>\n"
+        "      </Surface>\n"
+        "    </Mesh>\n"
+        "  </Geometry>\n"
+        "</Weathering>\n");
+    ENSURE(path != NULL);
+    char args[4400];
+    snprintf(args, sizeof args, "info '%s'", path);
+    int status = weathering(args);
+    if (status != 0) {
+        fprintf(stderr, "        status %d: %s", status, out);
+    }
+    ENSURE(status == 0);
+    ENSURE(ensure_contains(out, "substances (4): water, dirt, rust, moss\n"));
+    ENSURE(ensure_contains(out, "50 steps of 0.01 s (0.5 s simulated) in each of 4 iterations "
+                                "(200 steps, 2 s in all);"));
+    // 1000/s for 0.5 s in each of the 4 iterations; the loads that are not 0.
+    ENSURE(ensure_contains(out, "(500 particles per iteration, 2000 in all)"));
+    ENSURE(ensure_contains(out, "mass 1, loads water 1, dirt 0.05, max collisions"));
+    ENSURE(!ensure_contains(out, "moss 0"));
+    // The global rules, then each surface's exchanges and rules, in document order.
+    ENSURE(ensure_contains(out, "ageing: 2 global rules after each of the 4 iterations: "
+                                "Decay water 0.5, Grow moss 2 per m^2\n"));
+    ENSURE(ensure_contains(out, "    material 'iron' absorption 0.1 bounce 0.2; exchanges water "
+                                "initial 0 deposit 0.8 erosion 0.1, dirt initial 0 deposit 0.5 "
+                                "erosion 0.1; rules Transfer water -> rust 0.2, Decay water "
+                                "0.25\n"));
+    ENSURE(ensure_contains(out, "    material 'stone' absorption 0.6 bounce 0.1; exchanges water "
+                                "initial 0.5 deposit 0.3 erosion 0; rules Decay rust 1\n"));
+    // The mask's channel per substance and its frames after iterations 2 and 4.
+    ENSURE(ensure_contains(out, "channels water.Y, dirt.Y, rust.Y, moss.Y; frames "
+                                "'mask.0002.exr' to 'mask.0004.exr', one after every 2 "
+                                "iterations\n"));
+    // The memory estimate counts the particles of every iteration and the frames.
+    ENSURE(ensure_contains(out, "for 2000 particles if all were alive at once and "));
+    ENSURE(ensure_contains(out, "for a frame of the mask's sequence"));
 }
 
 TEST(info_on_a_bad_scene_gives_file_line_and_status_2)
@@ -306,6 +414,7 @@ int main(void)
     RUN(option_values_are_checked);
     RUN(missing_scene_names_the_file);
     RUN(info_summarises_the_default_scene);
+    RUN(info_lists_substances_loads_exchanges_and_rules);
     RUN(info_on_a_bad_scene_gives_file_line_and_status_2);
     RUN(stats_never_overwrites_anything);
     RUN(stale_cleanup_and_default_folder_stay_in_their_place);

@@ -10,6 +10,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "model/maps.h"
 #include "pipeline/outputs.h"
 #include "sim/emitter.h"
 
@@ -18,9 +19,27 @@ void wx_memory_estimate(const wx_scene *scene, unsigned phases, wx_memory_need *
     memset(need, 0, sizeof *need);
     need->baseline_bytes = WX_MEMORY_BASELINE;
     need->camera_line = wx_has_path(scene->path) ? 1 : 0;
+    // Substances and ageing (docs/design.md section 9): the planes per substance,
+    // the rules' baseline and records, the channels of the dirt maps.
+    int S = scene->substance_count > 1 ? scene->substance_count : 1;
+    need->substances = S;
+    double iterations = scene->iterations > 1 ? (double)scene->iterations : 1.0;
+    bool surface_rules = wx_scene_has_surface_rules(scene);
+    bool rules = scene->rule_count > 0 || surface_rules;
+    bool grow = wx_scene_has_grow(scene);
+    char names[WX_IMAGE_MAX_CHANNELS][WX_NAME_MAX];
+    double baked_extra = fmax(0.0, (double)wx_dirt_channels(scene, false, names) - 3.0);
+    double simulated_extra = fmax(0.0, (double)wx_dirt_channels(scene, true, names) - 5.0);
+    const wx_scene_camera *out =
+        scene->output_index >= 0 && scene->output_index < scene->camera_count
+            ? &scene->cameras[scene->output_index]
+            : NULL;
+
     double largest = -1.0, input_texels = 0.0, largest_input = 0.0, output_texels = 0.0;
     double framebuffer = 0.0, images = 0.0, baked_inputs = 0.0;
     bool bake = (phases & WX_PHASE_BAKE) && wx_scene_needs_bake(scene);
+    double input_image =
+        WX_BAKE_INPUT_IMAGE_BYTES_PER_TEXEL + WX_PLANE_BYTES_PER_TEXEL * baked_extra;
     for (int c = 0; c < scene->camera_count; ++c) {
         const wx_scene_camera *sc = &scene->cameras[c];
         double texels = (double)sc->camera.width * (double)sc->camera.height;
@@ -37,7 +56,7 @@ void wx_memory_estimate(const wx_scene *scene, unsigned phases, wx_memory_need *
         if (bake && sc->has_view && !wx_has_path(sc->depth_path)) {
             framebuffer = fmax(framebuffer, WX_BAKE_FRAMEBUFFER_BYTES_PER_TEXEL * texels);
             images = fmax(images, texels * (sc->is_output ? WX_BAKE_OUTPUT_IMAGE_BYTES_PER_TEXEL
-                                                          : WX_BAKE_INPUT_IMAGE_BYTES_PER_TEXEL));
+                                                          : input_image));
             baked_inputs += sc->is_output ? 0.0 : texels;
         }
     }
@@ -58,29 +77,56 @@ void wx_memory_estimate(const wx_scene *scene, unsigned phases, wx_memory_need *
                            4.0 * (input_texels > baked_inputs ? input_texels : baked_inputs) +
                            4.0 * 1024.0 * 1024.0 + need->mesh_bytes;
     }
+    // The mask: the gather's planes per output texel, one plane per substance.
+    double gather_out = WX_GATHER_BYTES_PER_OUTPUT_TEXEL + WX_PLANE_BYTES_PER_TEXEL * (S - 1);
     if (phases & WX_PHASE_SIMULATE) {
-        need->sim_map_bytes = WX_SIM_BYTES_PER_INPUT_TEXEL * input_texels +
-                              WX_SIM_WRITE_BYTES_PER_TEXEL * largest_input;
+        double per_input = WX_SIM_BYTES_PER_INPUT_TEXEL +
+                           WX_SIM_BYTES_PER_SUBSTANCE_TEXEL * (S - 1) +
+                           (rules ? WX_SIM_BASELINE_BYTES_PER_SUBSTANCE_TEXEL * S : 0.0) +
+                           (surface_rules ? WX_PLANE_BYTES_PER_TEXEL : 0.0) +
+                           (grow ? WX_PLANE_BYTES_PER_TEXEL : 0.0);
+        // The planes taken from the simulation for the gather: amount and
+        // baseline per substance, and the hits.
+        double planes = WX_PLANE_BYTES_PER_TEXEL * (2.0 * S + 1.0);
+        double write =
+            (WX_SIM_WRITE_BYTES_PER_TEXEL + WX_PLANE_BYTES_PER_TEXEL * simulated_extra + planes) *
+            largest_input;
+        // A frame (<OutputMap every="k">) gathers the mask in the middle of the
+        // simulation: those planes of every input camera and the gather's own,
+        // with the output camera's maps (kept from the bake or read).
+        if (out != NULL && out->every > 0 && iterations >= (double)out->every) {
+            need->frame_bytes = planes * input_texels + gather_out * output_texels;
+        }
+        // Without frames, a run that bakes keeps the output camera's depth and
+        // normal through the simulation for its gather.
+        double kept = need->frame_bytes == 0.0 && bake && (phases & WX_PHASE_GATHER)
+                          ? WX_BAKE_OUTPUT_IMAGE_BYTES_PER_TEXEL * output_texels
+                          : 0.0;
+        need->sim_map_bytes = per_input * input_texels + fmax(write, need->frame_bytes) + kept;
         largest = -1.0;
         double duration = wx_scene_duration(scene);
         for (int e = 0; e < scene->emitter_count; ++e) {
-            double n = (double)wx_emitter_count_at(&scene->emitters[e], duration);
+            // The emitters emit again in every iteration (docs/design.md section 9).
+            double n = iterations * (double)wx_emitter_count_at(&scene->emitters[e], duration);
             need->particles += n;
             if (n > largest) {
                 largest = n;
                 need->emitter_line = scene->emitters[e].line;
             }
         }
-        need->particle_bytes = need->particles * WX_BYTES_PER_PARTICLE;
+        need->bytes_per_particle = WX_BYTES_PER_PARTICLE + WX_BYTES_PER_PARTICLE_LOAD * (S - 1);
+        need->particle_bytes = need->particles * need->bytes_per_particle;
     }
     if (phases & WX_PHASE_GATHER) {
-        need->gather_bytes = WX_GATHER_BYTES_PER_INPUT_TEXEL * input_texels +
-                             WX_GATHER_BYTES_PER_OUTPUT_TEXEL * output_texels;
+        need->gather_bytes =
+            (WX_GATHER_BYTES_PER_INPUT_TEXEL + WX_PLANE_BYTES_PER_TEXEL * simulated_extra) *
+                input_texels +
+            gather_out * output_texels;
     }
     // The renderer leaves part of its memory behind for the phases after it.
     double residue = need->bake_bytes > 0.0 ? WX_BAKE_RESIDUE_BYTES : 0.0;
-    double sim = need->sim_map_bytes + need->particle_bytes +
-                 ((phases & WX_PHASE_SIMULATE) ? residue : 0.0);
+    double sim =
+        need->sim_map_bytes + need->particle_bytes + ((phases & WX_PHASE_SIMULATE) ? residue : 0.0);
     double gather = need->gather_bytes + ((phases & WX_PHASE_GATHER) ? residue : 0.0);
     double peak = need->bake_bytes;
     need->phase = "bake";
@@ -195,20 +241,21 @@ wx_result wx_memory_check(const wx_scene *scene, unsigned phases, wx_error *err)
         return wx_fail(err, WX_CAUSE_MEMORY_LIMIT,
                        "%s:%d: the emitters would emit %.4g particles: with the maps that "
                        "needs about %.3g GiB (%.0f bytes per particle, %.3g GiB of maps), "
-                       "but only %.3g GiB of memory is available; lower the rate or the "
-                       "duration (see docs/reliability.md)",
+                       "but only %.3g GiB of memory is available; lower the rate%s the "
+                       "duration%s (see docs/reliability.md)",
                        scene->path, need.emitter_line, need.particles, gib(need.total_bytes),
-                       WX_BYTES_PER_PARTICLE, gib(need.sim_map_bytes), gib(available));
+                       need.bytes_per_particle, gib(need.sim_map_bytes), gib(available),
+                       scene->iterations > 1 ? "," : " or",
+                       scene->iterations > 1 ? " or the iterations" : "");
     }
     if (strcmp(need.phase, "bake") == 0 && need.mesh_bytes > need.bake_bytes - need.mesh_bytes) {
         return wx_fail(err, WX_CAUSE_MEMORY_LIMIT,
-                            "%s:%d: importing and baking the meshes needs about %.3g GiB (%.3g "
-                            "GiB to import %.0f MiB of mesh files), but only %.3g GiB of memory "
-                            "is available (see docs/reliability.md)",
-                            scene->path, need.mesh_line, gib(need.total_bytes),
-                            gib(need.mesh_bytes),
-                            need.mesh_bytes / WX_MESH_BYTES_PER_FILE_BYTE / (1024.0 * 1024.0),
-                            gib(available));
+                       "%s:%d: importing and baking the meshes needs about %.3g GiB (%.3g "
+                       "GiB to import %.0f MiB of mesh files), but only %.3g GiB of memory "
+                       "is available (see docs/reliability.md)",
+                       scene->path, need.mesh_line, gib(need.total_bytes), gib(need.mesh_bytes),
+                       need.mesh_bytes / WX_MESH_BYTES_PER_FILE_BYTE / (1024.0 * 1024.0),
+                       gib(available));
     }
     return wx_fail(err, WX_CAUSE_MEMORY_LIMIT,
                    "%s:%d: the maps need about %.3g GiB at the peak (the %s), but only %.3g "
@@ -216,4 +263,3 @@ wx_result wx_memory_check(const wx_scene *scene, unsigned phases, wx_error *err)
                    scene->path, need.camera_line, gib(need.total_bytes), need.phase,
                    gib(available));
 }
-

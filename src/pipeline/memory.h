@@ -13,18 +13,22 @@
 /// alone (docs/reliability.md): the program itself, plus the largest of its
 /// phases (they run one after the other; each frees what the next does not use).
 typedef struct wx_memory_need {
-    double baseline_bytes; ///< the program and its libraries (WX_MEMORY_BASELINE)
-    double mesh_bytes;     ///< importing the meshes: WX_MESH_BYTES_PER_FILE_BYTE x their files
-    double bake_bytes;     ///< the bake: GL context, framebuffer, images being written, meshes
-    double sim_map_bytes;  ///< the simulation's maps, collider and dirt (without particles)
-    double particles;      ///< particles the emitters emit over the simulation
-    double particle_bytes; ///< as if every particle emitted were alive at once
-    double gather_bytes;   ///< the gather: the maps it reads, its planes, the files it writes
-    double total_bytes;    ///< baseline + the largest phase
-    const char *phase;     ///< the largest phase: "bake", "simulation" or "gather"
-    int camera_line;       ///< scene line of the camera with the largest maps
-    int emitter_line;      ///< scene line of the emitter with the most particles
-    int mesh_line;         ///< scene line of the largest mesh file
+    double baseline_bytes;     ///< the program and its libraries (WX_MEMORY_BASELINE)
+    double mesh_bytes;         ///< importing the meshes: WX_MESH_BYTES_PER_FILE_BYTE x their files
+    double bake_bytes;         ///< the bake: GL context, framebuffer, images being written, meshes
+    double sim_map_bytes;      ///< the simulation's maps, collider and dirt (without particles)
+    double frame_bytes;        ///< part of sim_map_bytes: a frame of the mask's sequence
+    double particles;          ///< particles the emitters emit over all the iterations
+    double bytes_per_particle; ///< WX_BYTES_PER_PARTICLE, + WX_BYTES_PER_PARTICLE_LOAD per
+                               ///< substance beyond the first
+    double particle_bytes;     ///< as if every particle emitted were alive at once
+    double gather_bytes;       ///< the gather: the maps it reads, its planes, the files it writes
+    double total_bytes;        ///< baseline + the largest phase
+    const char *phase;         ///< the largest phase: "bake", "simulation" or "gather"
+    int substances;            ///< the scene's substances (1 without <Substances>)
+    int camera_line;           ///< scene line of the camera with the largest maps
+    int emitter_line;          ///< scene line of the emitter with the most particles
+    int mesh_line;             ///< scene line of the largest mesh file
 } wx_memory_need;
 
 /// The program's own memory before any scene data (code, libraries, heaps).
@@ -43,23 +47,46 @@ typedef struct wx_memory_need {
 /// Bytes per texel of the images of one baked camera (depth 1, normal 3, impact
 /// 3, dirt 3 floats; an output camera only depth and normal). One set is alive:
 /// the pipeline writes a camera's files (on_maps) before the next one renders.
+/// A dirt map with more channels than version 1's (three per substance, the
+/// surface and area records of ageing: wx_dirt_channels) holds
+/// WX_PLANE_BYTES_PER_TEXEL more per extra channel.
 #define WX_BAKE_INPUT_IMAGE_BYTES_PER_TEXEL 40.0
 #define WX_BAKE_OUTPUT_IMAGE_BYTES_PER_TEXEL 16.0
-/// Bytes per input texel in the simulation: the maps (depth, normal, impact,
-/// dirt: 9 floats), the collider's depth and pyramid (5), the dirt texel (dirt
-/// in double, its rates and its hits: 24).
+/// One float plane: the bytes per texel of each channel beyond version 1's.
+#define WX_PLANE_BYTES_PER_TEXEL 4.0
+/// Bytes per input texel in the simulation with one substance: the maps (depth,
+/// normal, impact, dirt: 9 floats), the collider's depth and pyramid (5), the
+/// dirt texel (dirt in double, its rates and its hits: 24).
 #define WX_SIM_BYTES_PER_INPUT_TEXEL 65.0
-/// Bytes per texel of the dirt map being written (5 floats).
+/// Bytes per input texel for each substance beyond the first (docs/design.md
+/// section 9): its dirt, deposit and erosion planes in the maps (3 floats) and
+/// its dirt texel (24).
+#define WX_SIM_BYTES_PER_SUBSTANCE_TEXEL 36.0
+/// Bytes per input texel and substance of the ageing rules' baseline (the
+/// amounts without the particles, in double), when the scene has rules; the
+/// surface record (per-surface rules) and the area a Grow multiplies add one
+/// plane each.
+#define WX_SIM_BASELINE_BYTES_PER_SUBSTANCE_TEXEL 8.0
+/// Bytes per texel of the dirt map being written (version 1's 5 floats; one
+/// plane more per channel beyond them), plus the planes the written map and
+/// the gather take from the simulation: per substance its amount and baseline,
+/// and the hits (2 x substances + 1 planes). A frame of the mask's sequence
+/// (<OutputMap every="k">) takes those planes of every input camera at once.
 #define WX_SIM_WRITE_BYTES_PER_TEXEL 20.0
 /// Bytes per particle: WX_PARTICLE_BYTES with room for the arrays to double as
 /// they grow, plus the per-step events and candidates of the workers.
 #define WX_BYTES_PER_PARTICLE 192.0
+/// Bytes per particle for each substance beyond the first: its load in double
+/// (wx_particles_slot_bytes), with the same room to grow (4 x 8).
+#define WX_BYTES_PER_PARTICLE_LOAD 32.0
 /// Bytes per input texel in the gather (depth, normal, and the dirt map's five
-/// channels while it is read) and per output texel (its depth and normal, the
-/// mask, the first pass's three planes, the adaptive smoothing's eight padded
-/// planes, summed-area tables, radii and changes, the preview's sorted values
-/// and pixels, and in a run the output camera's baked depth and normal kept
-/// from the bake; the fixed second pass needs less). Measured: 690 MB for a
+/// channels while it is read; one plane more per channel beyond them) and per
+/// output texel (its depth and normal, the mask, the first pass's three planes,
+/// the adaptive smoothing's eight padded planes, summed-area tables, radii and
+/// changes, the preview's sorted values and pixels, and in a run the output
+/// camera's baked depth and normal kept from the bake; the fixed second pass
+/// needs less). The gather runs once per substance on the same planes; the mask
+/// holds one plane more per substance beyond the first. Measured: 690 MB for a
 /// 2048-px `gather` with three 2048-px input cameras, estimated 920 MB.
 #define WX_GATHER_BYTES_PER_INPUT_TEXEL 36.0
 #define WX_GATHER_BYTES_PER_OUTPUT_TEXEL 112.0
