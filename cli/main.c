@@ -62,7 +62,7 @@ static const command commands[] = {
     { "run", command_run, "bake what needs baking, simulate, gather: the whole job" },
     { "bake", command_bake, "render the maps of <View> cameras from the scene's meshes" },
     { "simulate", command_simulate, "fly the particles; write <camera>_dirt.exr" },
-    { "gather", command_gather, "turn the dirt maps into the output camera's mask" },
+    { "gather", command_gather, "turn the dirt maps into the mask and the TextureMaps" },
     { "info", command_info, "validate a scene and print what it holds" },
 };
 enum { COMMAND_COUNT = sizeof commands / sizeof commands[0] };
@@ -570,10 +570,11 @@ static int run_phases(const cli_args *args, unsigned phases)
     run.times.load = wx_now_s() - start;
     wx_error err;
     wx_result r = WX_OK;
-    if ((phases & WX_PHASE_GATHER) && scene.output_index < 0) {
+    if ((phases & WX_PHASE_GATHER) && scene.output_index < 0 && scene.texture_count == 0) {
         r = wx_fail(&err, WX_CAUSE_MISSING,
-                    "%s: has no output camera (<Ortho out=\"true\">); `%s` needs one", scene.path,
-                    args->command);
+                    "%s: has no output camera (<Ortho out=\"true\">) and no <TextureMap>; `%s` "
+                    "needs one",
+                    scene.path, args->command);
     }
     if (r == WX_OK) {
         r = wx_run_phases(&scene, &opts, phases, &run, &err);

@@ -1,6 +1,7 @@
-// test_scene.c: the scene file (docs/design.md sections 3, 8, 9, 10): defaults, every
-// attribute, camera matrices, substances, loads, exchanges, iterations and ageing
-// rules, the bad scenes of tests/bad/, entity attacks, and the schema.
+// test_scene.c: the scene file (docs/design.md sections 3, 8, 9, 10, 11): defaults,
+// every attribute, camera matrices, substances, loads, exchanges, iterations and
+// ageing rules, texture maps, the bad scenes of tests/bad/, entity attacks, and the
+// schema.
 #include <dirent.h>
 #include <errno.h>
 #include <stdlib.h>
@@ -894,6 +895,120 @@ TEST(substance_errors_at_their_line)
     wx_scene_free(&s);
 }
 
+// --- texture maps (docs/design.md section 11) ---
+
+// Two meshes with three <TextureMap>s: every default, a fixed radius with
+// explicit values, the adaptive smoothing tuned. Line numbers matter.
+static void texture_scene(char *text, size_t cap)
+{
+    snprintf(text, cap,
+             "<Weathering>\n"                                                       // 1
+             "  <Geometry>\n"                                                       // 2
+             "    <Mesh file=\"%s\">\n"                                             // 3
+             "      <Surface material=\"*\" deposit=\"0.5\"/>\n"                   // 4
+             "      <TextureMap file=\"box.exr\"/>\n"                               // 5
+             "    </Mesh>\n"                                                        // 6
+             "    <Mesh file=\"%s\">\n"                                             // 7
+             "      <TextureMap file=\"house_weathering.exr\" resolution=\"2048\"\n"  // 8
+             "                  width=\"512\" padding=\"0\" uv=\"7\" every=\"5\"\n"  // 9
+             "                  radius=\"0.25\"/>\n"                                // 10
+             "      <TextureMap file=\"tall.EXR\" resolution=\"64\" height=\"300\"\n" // 11
+             "                  padding=\"1024\" uv=\"1\" noise=\"0.1\" maxRadius=\"2\"/>\n" // 12
+             "    </Mesh>\n"                                                        // 13
+             "  </Geometry>\n" VIEW_COLLIDER "</Weathering>\n",
+             abs_data_path("box.obj"), abs_data_path("box.obj"));
+}
+
+static bool texture_is(const wx_texture_map *t, int mesh, const char *file, int width,
+                       int height, int padding, int uv, int every, bool adaptive, float radius,
+                       float noise, float max_radius, int line)
+{
+    bool ok = t->mesh == mesh && strcmp(t->file, file) == 0 && t->width == width &&
+              t->height == height && t->padding == padding && t->uv == uv &&
+              t->every == every && t->adaptive == adaptive && t->radius == radius &&
+              t->noise == noise && t->max_radius == max_radius && t->line == line;
+    if (!ok) {
+        fprintf(stderr,
+                "texture at line %d: mesh %d file %s %dx%d padding %d uv %d every %d adaptive %d "
+                "radius %g noise %g maxRadius %g\n",
+                t->line, t->mesh, t->file, t->width, t->height, t->padding, t->uv, t->every,
+                (int)t->adaptive, (double)t->radius, (double)t->noise, (double)t->max_radius);
+    }
+    return ok;
+}
+
+TEST(texture_maps)
+{
+    char text[65536];
+    texture_scene(text, sizeof text);
+    wx_scene s;
+    wx_error err;
+    ENSURE(load_text("texture_maps.xml", text, &s, &err, true) == WX_OK);
+    ENSURE(s.mesh_count == 2 && s.texture_count == 3);
+    ENSURE(s.meshes[0].surface_count == 1 && s.meshes[1].surface_count == 0);
+    // Defaults: 1024 x 1024, padding 8, channel 0, no frames, adaptive with the
+    // default noise and max_radius 0 (16 texels of the camera, chosen later).
+    ENSURE(texture_is(&s.textures[0], 0, "box.exr", 1024, 1024, 8, 0, 0, true, 0.0f,
+                      WX_DEFAULT_NOISE, 0.0f, 5));
+    ENSURE(WX_DEFAULT_TEXTURE_RESOLUTION == 1024 && WX_DEFAULT_TEXTURE_PADDING == 8);
+    // width overrides resolution on its axis only; a radius: not adaptive.
+    // (libxml2 gives an element the line where its start tag ends.)
+    ENSURE(texture_is(&s.textures[1], 1, "house_weathering.exr", 512, 2048, 0, 7, 5, false,
+                      0.25f, WX_DEFAULT_NOISE, 0.0f, 10));
+    ENSURE(texture_is(&s.textures[2], 1, "tall.EXR", 64, 300, 1024, 1, 0, true, 0.0f, 0.1f,
+                      2.0f, 12));
+    // The output camera is unchanged by them.
+    ENSURE(s.output_index == 1 && strcmp(s.cameras[1].output_file, "mask.exr") == 0);
+    wx_scene_free(&s);
+    ENSURE(s.textures == NULL && s.texture_count == 0);
+
+    // A scene with TextureMaps needs no output camera (nor does the loader ask
+    // one of any scene: gather and run do, docs/design.md section 11).
+    snprintf(text, sizeof text,
+             "<Weathering>\n"
+             "  <Geometry><Mesh file=\"%s\">\n"
+             "    <TextureMap file=\"box.exr\" resolution=\"16\"/>\n"
+             "  </Mesh></Geometry>\n"
+             "  <Collider><ProjectedMaps>\n"
+             "    <Ortho cameraName=\"top\">\n"
+             "      <View eye=\"0 10 0\" target=\"0 0 0\" up=\"0 0 -1\" width=\"4\" height=\"4\"\n"
+             "            resolution=\"8\"/>\n"
+             "    </Ortho>\n"
+             "  </ProjectedMaps></Collider>\n"
+             "</Weathering>\n",
+             abs_data_path("box.obj"));
+    ENSURE(load_text("texture_no_output.xml", text, &s, &err, true) == WX_OK);
+    ENSURE(s.output_index == -1 && s.input_count == 1 && s.texture_count == 1);
+    ENSURE(texture_is(&s.textures[0], 0, "box.exr", 16, 16, 8, 0, 0, true, 0.0f,
+                      WX_DEFAULT_NOISE, 0.0f, 3));
+    wx_scene_free(&s);
+
+    // Names the run does not write twice: a frame of another sequence is only a
+    // clash when that frame is written (every 3 of 1 iteration writes none).
+    snprintf(text, sizeof text,
+             "<Weathering>\n"
+             "  <Geometry><Mesh file=\"%s\">\n"
+             "    <TextureMap file=\"mask.0003.exr\"/>\n"
+             "    <TextureMap file=\"mask_out.exr\"/>\n"
+             "    <TextureMap file=\"top_dirt.exr.exr\"/>\n"
+             "  </Mesh></Geometry>\n" VIEW_COLLIDER "</Weathering>\n",
+             abs_data_path("box.obj"));
+    ENSURE(load_text("texture_near_names.xml", text, &s, &err, true) == WX_OK);
+    ENSURE(s.texture_count == 3);
+    wx_scene_free(&s);
+    // With 3 iterations mask.exr every="3" writes mask.0003.exr.
+    char *at = strstr(text, "<Geometry>");
+    ENSURE(at != NULL);
+    char more[65536];
+    snprintf(more, sizeof more, "%.*s<Solver><Simulation iterations=\"3\"/></Solver>%s",
+             (int)(at - text), text, at);
+    ENSURE(load_text("texture_frame.xml", more, &s, &err, false) == WX_BAD_INPUT);
+    ENSURE_CAUSE(err, BAD_SCENE);
+    ENSURE(ensure_contains(err.message, "texture_frame.xml:3: <TextureMap> file=\"mask.0003.exr\" "
+                                        "is frame 3 of the image sequence of 'mask.exr'"));
+    wx_scene_free(&s);
+}
+
 static double seconds_now(void)
 {
     struct timespec ts;
@@ -1114,6 +1229,10 @@ TEST(schema_accepts_good_scenes)
     for (size_t i = 0; i < sizeof good / sizeof good[0]; ++i) {
         failures += !validates(data_path(good[i]));
     }
+    // <TextureMap>s with every attribute (docs/design.md section 11).
+    char text[65536];
+    texture_scene(text, sizeof text);
+    failures += !validates(ensure_write_file(ensure_tmpdir(), "texture_schema.xml", text));
     ENSURE(failures == 0);
 }
 
@@ -1143,6 +1262,10 @@ TEST(schema_rejects_bad_values)
         "transfer_rate_above_one", "decay_rate_negative", "grow_amount_negative",
         "rule_without_rate", "iterations_zero", "iterations_too_many", "iterations_not_integer",
         "every_negative", "child_of_a_leaf_element",
+        // docs/design.md section 11.
+        "texture_map_not_exr", "texture_map_uv_too_large", "texture_map_padding_negative",
+        "texture_map_zero_resolution", "texture_map_width_too_large", "texture_map_without_file",
+        "texture_map_same_file_twice", "texture_map_outside_mesh",
     };
     int failures = 0;
     for (size_t i = 0; i < sizeof invalid / sizeof invalid[0]; ++i) {
@@ -1172,6 +1295,7 @@ int main(void)
     RUN(substance_dirt_index_or_none);
     RUN(substance_limits_accepted);
     RUN(substance_errors_at_their_line);
+    RUN(texture_maps);
     RUN(bad_scenes);
     RUN(entity_bomb_refused_quickly);
     RUN(external_entity_refused);

@@ -48,7 +48,8 @@ typedef enum wx_result {
     X(MEMORY_LIMIT, WX_BAD_INPUT, "a run that needs more memory than is available")          \
     X(OUTPUT_CONFLICT, WX_BAD_INPUT, "an output that would replace an input or a non-file")  \
     X(MISSING_PHASE, WX_BAD_INPUT, "a phase run before the one whose files it reads")        \
-    X(BAD_SCENE, WX_BAD_INPUT, "a scene that is inconsistent as a whole")
+    X(BAD_SCENE, WX_BAD_INPUT, "a scene that is inconsistent as a whole")                   \
+    X(NO_UVS, WX_BAD_INPUT, "a mesh without the texture coordinates a <TextureMap> reads")
 
 /// The causes: WX_CAUSE_NONE, WX_CAUSE_OUT_OF_MEMORY, ...
 typedef enum wx_cause {

@@ -16,6 +16,7 @@
 
 #include "core/limits.h"
 #include "gather/adaptive.h"
+#include "gather/visibility.h"
 #include "core/matrix.h"
 #include "core/parallel.h"
 #include "core/progress.h"
@@ -27,12 +28,7 @@ enum {
     MAX_OFFSETS = 100000, // second-pass neighbourhood limit (radius ~178 texels)
 };
 
-// Normals at right angles (a crease) give weight 0 even when rounding (or a
-// fused multiply-add) leaves their dot product a few ulps above 0.
-#define NORMAL_EPSILON 1e-6f
-
-// Relative depth epsilon added to the visibility tolerance (float rounding of d).
-#define DEPTH_EPSILON_REL 1e-5f
+#define NORMAL_EPSILON WX_VISIBILITY_NORMAL_EPSILON
 
 // ---------------------------------------------------------------------------
 // The mask's header matrices (core/matrix.h: row vectors, composed in double).
@@ -175,23 +171,10 @@ typedef struct tap_sums {
 static inline void add_tap(const input_cam *c, size_t t, float weight, float dp, const float n[3],
                            bool adaptive, tap_sums *s)
 {
-    float depth = c->depth[t];
-    if (wx_depth_is_empty(depth)) {
-        return;
-    }
-    const float *nt = &c->normal[3 * t];
-    float cos_view = fabsf(nt[0] * c->ray[0] + nt[1] * c->ray[1] + nt[2] * c->ray[2]);
-    // Visibility: the point lies on the surface this texel sees. Across a texel
-    // the depth of a surface at slope theta changes by texel * tan(theta), so
-    // the tolerance is tol_world / max(|N.view|, 0.1) (times cos_tol here).
-    float cos_tol = cos_view > WX_GATHER_TOL_MIN_COS ? cos_view : WX_GATHER_TOL_MIN_COS;
-    float epsilon = DEPTH_EPSILON_REL * (1.0f + fabsf(depth));
-    if (!(fabsf(dp - depth) * cos_tol <= c->tol_world + epsilon * cos_tol)) {
-        return;
-    }
-    // Same side of the surface and not across a crease.
-    float agree = n[0] * nt[0] + n[1] * nt[1] + n[2] * nt[2];
-    if (!(agree > NORMAL_EPSILON)) {
+    float cos_view = 0.0f;
+    float agree = wx_visible_agreement(c->depth[t], &c->normal[3 * t], c->ray, c->tol_world,
+                                       WX_GATHER_TOL_MIN_COS, dp, n, &cos_view);
+    if (agree == 0.0f) {
         return;
     }
     float w = weight * agree;
@@ -523,6 +506,23 @@ static wx_result prepare_input(const wx_target *out, const double out_ctw[16],
     cam->initial = simulated ? in->initial : in->dirt;
     cam->hits = simulated ? in->hits : NULL;
 
+    double head_area = 0.0;
+    if (!wx_gather_view_frame(in, cam->ray, &cam->tol_world, &head_area)) {
+        return wx_fail(err, WX_CAUSE_BAD_CAMERA, "gather: input camera %d has a degenerate frame",
+                            index);
+    }
+    cam->inv_head_area = (float)(1.0 / head_area);
+    return WX_OK;
+}
+
+bool wx_gather_view_frame(const wx_gather_view *view, float ray_out[3], float *tol_world,
+                          double *head_area_out)
+{
+    double ctw[16];
+    if (!wx_matrix_to_affine(view->camera->ctw, ctw)) {
+        return false;
+    }
+    const double wi = view->width, hi = view->height;
     double ex[3], ey[3], ray[3], cross[3];
     wx_matrix_row3(ctw, 0, ex);
     wx_matrix_row3(ctw, 1, ey);
@@ -537,15 +537,14 @@ static wx_result prepare_input(const wx_target *out, const double out_ctw[16],
     cross[2] = ex[0] * ey[1] - ex[1] * ey[0];
     double head_area = ray_len > 0.0 ? fabs(wx_dot3(cross, ray)) / ray_len : 0.0;
     if (!(head_area > 0.0) || !isfinite(head_area)) {
-        return wx_fail(err, WX_CAUSE_BAD_CAMERA, "gather: input camera %d has a degenerate frame",
-                            index);
+        return false;
     }
     for (int k = 0; k < 3; ++k) {
-        cam->ray[k] = (float)(ray[k] / ray_len);
+        ray_out[k] = (float)(ray[k] / ray_len);
     }
-    cam->tol_world = (float)(WX_GATHER_DEPTH_TOL_TEXELS * fmax(wx_length3(ex), wx_length3(ey)));
-    cam->inv_head_area = (float)(1.0 / head_area);
-    return WX_OK;
+    *tol_world = (float)(WX_GATHER_DEPTH_TOL_TEXELS * fmax(wx_length3(ex), wx_length3(ey)));
+    *head_area_out = head_area;
+    return true;
 }
 
 // The second-pass neighbourhood of the output camera: every texel offset whose

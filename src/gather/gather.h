@@ -87,6 +87,13 @@ typedef struct wx_gather_stats {
     int64_t capped_texels;
 } wx_gather_stats;
 
+/// The frame of an input camera as the first pass uses it: the unit viewing
+/// direction, the visibility test's depth tolerance (WX_GATHER_DEPTH_TOL_TEXELS
+/// times the texel's larger side) and the area of a texel seen head-on. False
+/// when the camera is not orthographic or its frame is degenerate.
+bool wx_gather_view_frame(const wx_gather_view *view, float ray[3], float *tol_world,
+                          double *head_area);
+
 /// Defaults: no cameras, radius 0, weighted mean, bilinear, 1 thread, quiet.
 wx_gather_def wx_default_gather_def(void);
 

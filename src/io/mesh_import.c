@@ -314,6 +314,9 @@ typedef struct import_state {
     int64_t triangles;
     bool any_colors;
     bool nonfinite_normals; // from the file, or generated from overflowing triangles
+    unsigned uv_channels; // bit c: import UV channel c (refused where a mesh lacks it)
+    unsigned uv_present;  // bit c: some triangle mesh had channel c
+    bool missing_uvs;     // the problem is a missing UV channel
     bool fill;            // false: count and bound; true: fill the arrays
     char problem[PROBLEM_MAX]; // set when the file holds something we refuse
 } import_state;
@@ -398,6 +401,17 @@ static void count_mesh(import_state *st, const struct aiMesh *mesh, const affine
     st->vertices += mesh->mNumVertices;
     st->material_slot[mesh->mMaterialIndex] = 0; // in use; numbered later
     st->any_colors = st->any_colors || mesh->mColors[0] != NULL;
+    for (unsigned c = 0; c < WX_MESH_MAX_UV_CHANNELS; ++c) {
+        if (mesh->mTextureCoords[c] != NULL) {
+            st->uv_present |= 1u << c;
+        } else if (st->uv_channels & (1u << c)) {
+            snprintf(st->problem, sizeof st->problem,
+                     "part '%.64s' of the mesh has no texture coordinates in UV channel %u",
+                     mesh->mName.length > 0 ? mesh->mName.data : "(unnamed)", c);
+            st->missing_uvs = true;
+            return;
+        }
+    }
     wx_mesh_data *out = st->out;
     for (unsigned v = 0; v < mesh->mNumVertices; ++v) {
         const struct aiVector3D *local = &mesh->mVertices[v];
@@ -408,6 +422,17 @@ static void count_mesh(import_state *st, const struct aiMesh *mesh, const affine
                      "(%g, %g, %g, %g)",
                      local->x, local->y, local->z, c->r, c->g, c->b, c->a);
             return;
+        }
+        for (unsigned u = 0; u < WX_MESH_MAX_UV_CHANNELS; ++u) {
+            const struct aiVector3D *t = (st->uv_channels & (1u << u)) ? mesh->mTextureCoords[u]
+                                                                      : NULL;
+            if (t != NULL && !(isfinite(t[v].x) && isfinite(t[v].y))) {
+                snprintf(st->problem, sizeof st->problem,
+                         "the vertex at (%g, %g, %g) has texture coordinates that are not finite "
+                         "numbers (%g, %g)",
+                         local->x, local->y, local->z, t[v].x, t[v].y);
+                return;
+            }
         }
         const struct aiVector3D *n = mesh->mNormals != NULL ? &mesh->mNormals[v] : NULL;
         st->nonfinite_normals = st->nonfinite_normals || (n != NULL && !finite3(n->x, n->y, n->z));
@@ -467,6 +492,12 @@ static void fill_mesh(import_state *st, const struct aiMesh *mesh, const affine 
         double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
         for (int i = 0; i < 3; ++i) {
             out->normals[3 * o + i] = len > 0.0 && isfinite(len) ? (float)(n[i] / len) : 0.0f;
+        }
+        for (int c = 0; c < WX_MESH_MAX_UV_CHANNELS; ++c) {
+            if (out->uvs[c] != NULL) {
+                out->uvs[c][2 * o] = mesh->mTextureCoords[c][v].x;
+                out->uvs[c][2 * o + 1] = mesh->mTextureCoords[c][v].y;
+            }
         }
         if (out->colors != NULL) {
             float *c = &out->colors[4 * o];
@@ -670,7 +701,8 @@ static wx_result build_arrays(import_state *st, const char *path, wx_error *err)
     affine root = { { { u, 0, 0, 0 }, { 0, u, 0, 0 }, { 0, 0, u, 0 } } };
     walk(st, scene->mRootNode, &root, 0);
     if (st->problem[0] != '\0') {
-        return wx_fail(err, WX_CAUSE_BAD_MESH, "%s: %s", path, st->problem);
+        return wx_fail(err, st->missing_uvs ? WX_CAUSE_NO_UVS : WX_CAUSE_BAD_MESH, "%s: %s", path,
+                       st->problem);
     }
     if (st->nonfinite_normals) {
         wx_result r = check_file_normals(path, err);
@@ -702,8 +734,15 @@ static wx_result build_arrays(import_state *st, const char *path, wx_error *err)
     out->indices = malloc(3 * nt * sizeof *out->indices);
     out->materials = malloc(nt * sizeof *out->materials);
     out->colors = st->any_colors ? malloc(4 * nv * sizeof *out->colors) : NULL;
+    bool uvs_ok = true;
+    for (int c = 0; c < WX_MESH_MAX_UV_CHANNELS; ++c) {
+        if (st->uv_channels & (1u << c)) {
+            out->uvs[c] = malloc(2 * nv * sizeof *out->uvs[c]);
+            uvs_ok = uvs_ok && out->uvs[c] != NULL;
+        }
+    }
     if (out->positions == NULL || out->normals == NULL || out->indices == NULL ||
-        out->materials == NULL || (st->any_colors && out->colors == NULL)) {
+        out->materials == NULL || (st->any_colors && out->colors == NULL) || !uvs_ok) {
         return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "%s: out of memory for %lld triangles", path,
                             (long long)nt);
     }
@@ -715,6 +754,12 @@ static wx_result build_arrays(import_state *st, const char *path, wx_error *err)
 }
 
 wx_result wx_mesh_import(const char *path, wx_mesh_data *out, wx_error *err)
+{
+    return wx_mesh_import_uvs(path, 0u, out, err);
+}
+
+wx_result wx_mesh_import_uvs(const char *path, unsigned uv_channels, wx_mesh_data *out,
+                             wx_error *err)
 {
     memset(out, 0, sizeof *out);
     mesh_io io;
@@ -733,7 +778,7 @@ wx_result wx_mesh_import(const char *path, wx_mesh_data *out, wx_error *err)
     const struct aiScene *scene = aiImportFileExWithProperties(path, flags, &io.fio, props);
     aiReleasePropertyStore(props);
     wx_result r;
-    import_state st = { .scene = scene, .out = out };
+    import_state st = { .scene = scene, .out = out, .uv_channels = uv_channels };
     if (scene == NULL || io.refused || io.out_of_memory) {
         r = import_failure(&io, path, err);
     } else if ((r = file_unit_m(scene, path, &st.unit_m, err)) == WX_OK) {

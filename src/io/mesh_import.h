@@ -35,4 +35,13 @@
 /// triangle_count 0. On failure `out` is left empty (safe to free).
 wx_result wx_mesh_import(const char *path, wx_mesh_data *out, wx_error *err);
 
+/// wx_mesh_import, also keeping the texture coordinates of the UV channels
+/// whose bit is set in `uv_channels` (bit c: channel c, below
+/// WX_MESH_MAX_UV_CHANNELS) in out->uvs[c]. WX_BAD_INPUT naming the file when a
+/// part of the mesh that has triangles lacks one of them (WX_CAUSE_NO_UVS:
+/// "part 'Body' of the mesh has no texture coordinates in UV channel 0") or
+/// when a texture coordinate is not a finite number (WX_CAUSE_BAD_MESH).
+wx_result wx_mesh_import_uvs(const char *path, unsigned uv_channels, wx_mesh_data *out,
+                             wx_error *err);
+
 #endif

@@ -1,5 +1,5 @@
 // scene_xml.c: loads and validates a scene file (docs/design.md sections 3, 8,
-// 9 and 10) with libxml2.
+// 9, 10 and 11) with libxml2.
 //
 // The document is parsed without network access, entity substitution or
 // XInclude; any entity declaration stops the parser at once (so an entity bomb
@@ -37,6 +37,7 @@
 #include "core/matrix.h"
 #include "io/exr.h"
 #include "core/input_file.h"
+#include "model/mesh.h"
 
 /// Limits that bound memory before anything else is checked.
 #define SCENE_MAX_BYTES (64L * 1024 * 1024)
@@ -45,6 +46,9 @@
 #define SCENE_MAX_EMITTERS 10000
 #define SCENE_MAX_MESHES 1000
 #define SCENE_MAX_SURFACES 10000
+#define SCENE_MAX_TEXTURES 1000
+/// <TextureMap padding>: texels of island bleed.
+#define SCENE_MAX_PADDING 1024
 #define SCENE_MAX_STEPS 1000000000LL
 #define SCENE_MAX_COLLISIONS 1000000000LL
 /// <Simulation iterations> and <OutputMap every>: a huge count is refused
@@ -74,7 +78,7 @@ typedef struct parser {
     const char *path; ///< the scene file as given, the prefix of every message
     wx_error *err;
     wx_scene *scene;
-    int64_t field_cap, emitter_cap, camera_cap, mesh_cap, rule_cap;
+    int64_t field_cap, emitter_cap, camera_cap, mesh_cap, rule_cap, texture_cap;
     const xmlNode *collider; ///< <Collider>, once seen
     const xmlNode *substances; ///< <Substances>, read before everything else (or NULL)
 } parser;
@@ -2031,6 +2035,7 @@ static const attr_spec surface_attrs[] = {
 
 typedef struct mesh_state {
     wx_mesh *mesh;
+    int index; ///< of the mesh in wx_scene.meshes
     int64_t surface_cap;
 } mesh_state;
 
@@ -2154,12 +2159,95 @@ static wx_result parse_surface(parser *p, const xmlNode *node, void *user)
     return CHILDREN(surface_children, &st, NULL);
 }
 
+// <TextureMap> (docs/design.md section 11): the mask's channels in the mesh's
+// UV layout.
+typedef struct texture_def {
+    char file[256];
+    int resolution, width, height, padding, uv, every;
+    float radius, noise, max_radius;
+} texture_def;
+
+enum { TX_FILE, TX_RESOLUTION, TX_WIDTH, TX_HEIGHT, TX_PADDING, TX_UV, TX_EVERY, TX_RADIUS,
+       TX_NOISE, TX_MAX_RADIUS }; // bits of `present`
+
+static const attr_spec texture_attrs[] = {
+    // Required: a default name would clash between two TextureMaps.
+    [TX_FILE] = { "file", T_NAME, offsetof(texture_def, file),
+                  .size = sizeof(((texture_def *)0)->file), .required = true },
+    [TX_RESOLUTION] = { "resolution", T_INT, offsetof(texture_def, resolution), .lo = 1,
+                        .hi = WX_MAP_MAX_SIDE },
+    [TX_WIDTH] = { "width", T_INT, offsetof(texture_def, width), .lo = 1,
+                   .hi = WX_MAP_MAX_SIDE },
+    [TX_HEIGHT] = { "height", T_INT, offsetof(texture_def, height), .lo = 1,
+                    .hi = WX_MAP_MAX_SIDE },
+    [TX_PADDING] = { "padding", T_INT, offsetof(texture_def, padding), .lo = 0,
+                     .hi = SCENE_MAX_PADDING },
+    [TX_UV] = { "uv", T_INT, offsetof(texture_def, uv), .lo = 0,
+                .hi = WX_MESH_MAX_UV_CHANNELS - 1 },
+    [TX_EVERY] = { "every", T_INT, offsetof(texture_def, every), .lo = 0,
+                   .hi = SCENE_MAX_ITERATIONS },
+    [TX_RADIUS] = { "radius", T_FLOAT, offsetof(texture_def, radius), .range = R_NONNEG },
+    [TX_NOISE] = { "noise", T_FLOAT, offsetof(texture_def, noise), .range = R_POSITIVE },
+    [TX_MAX_RADIUS] = { "maxRadius", T_FLOAT, offsetof(texture_def, max_radius),
+                        .range = R_POSITIVE },
+};
+
+static wx_result parse_texture_map(parser *p, const xmlNode *node, void *user)
+{
+    mesh_state *m = user;
+    wx_scene *s = p->scene;
+    texture_def d = { .resolution = WX_DEFAULT_TEXTURE_RESOLUTION,
+                      .padding = WX_DEFAULT_TEXTURE_PADDING, .noise = WX_DEFAULT_NOISE };
+    unsigned given;
+    wx_result r = LEAF(texture_attrs, &d, &given);
+    if (r != WX_OK) {
+        return r;
+    }
+    size_t len = strlen(d.file);
+    if (len < 5 || strcasecmp(d.file + len - 4, ".exr") != 0) {
+        return fail(p, node, WX_CAUSE_BAD_VALUE, "<TextureMap> file=\"%s\" must end in .exr",
+                    d.file);
+    }
+    int width = given & (1u << TX_WIDTH) ? d.width : d.resolution;
+    int height = given & (1u << TX_HEIGHT) ? d.height : d.resolution;
+    if ((long long)width * height > WX_MAP_MAX_TEXELS) {
+        return fail(p, node, WX_CAUSE_BAD_VALUE,
+                    "<TextureMap> size %dx%d is over %lld texels", width, height,
+                    (long long)WX_MAP_MAX_TEXELS);
+    }
+    // No radius: the adaptive smoothing, which noise and maxRadius tune.
+    bool adaptive = !(given & (1u << TX_RADIUS));
+    if (!adaptive && (given & ((1u << TX_NOISE) | (1u << TX_MAX_RADIUS)))) {
+        return fail(p, node, WX_CAUSE_BAD_SCENE,
+                    "<TextureMap> gives a radius and %s: %s tunes the adaptive smoothing, which "
+                    "a radius replaces; give one or the other",
+                    given & (1u << TX_NOISE) ? "noise" : "maxRadius",
+                    given & (1u << TX_NOISE) ? "noise" : "maxRadius");
+    }
+    r = grow_list(p, node, (void **)&s->textures, s->texture_count, &p->texture_cap,
+                  sizeof *s->textures, SCENE_MAX_TEXTURES, "texture maps");
+    if (r != WX_OK) {
+        return r;
+    }
+    wx_texture_map *t = &s->textures[s->texture_count++];
+    // max_radius 0 without maxRadius: WX_DEFAULT_MAX_RADIUS_TEXELS texels of
+    // the camera the smoothing runs on, known only then.
+    *t = (wx_texture_map){ .mesh = m->index, .width = width, .height = height,
+                           .padding = d.padding, .uv = d.uv, .every = d.every,
+                           .adaptive = adaptive, .radius = adaptive ? 0.0f : d.radius,
+                           .noise = d.noise, .max_radius = d.max_radius,
+                           .line = line_of(node) };
+    memcpy(t->file, d.file, sizeof d.file);
+    return WX_OK;
+}
+
 static const attr_spec mesh_attrs[] = {
     { "file", T_STRING, offsetof(map_def, file), .size = WX_PATH_MAX, .required = true },
 };
 
 static const child_spec mesh_children[] = {
     { "Surface", parse_surface, true },
+    { "TextureMap", parse_texture_map, true },
 };
 
 static wx_result parse_mesh(parser *p, const xmlNode *node, void *user)
@@ -2184,7 +2272,7 @@ static wx_result parse_mesh(parser *p, const xmlNode *node, void *user)
                  cause == WX_CAUSE_FILE_MISSING ? "not found" : why);
     }
     free(file.file);
-    mesh_state m = { .mesh = mesh };
+    mesh_state m = { .mesh = mesh, .index = s->mesh_count - 1 };
     return r != WX_OK ? r : CHILDREN(mesh_children, &m, NULL);
 }
 
@@ -2278,6 +2366,170 @@ static wx_result check_output_name(parser *p)
     return WX_OK;
 }
 
+/// A file the gather writes with its image sequence and previews: the output
+/// camera's mask or a <TextureMap> (docs/design.md sections 10 and 11).
+typedef struct output_entry {
+    const char *file;
+    int every;
+    const wx_scene_camera *camera; ///< the output camera for the mask, else NULL
+    int line;
+} output_entry;
+
+/// The length of `file` without a final ".exr": the BASE of BASE.NNNN.exr and
+/// BASE_NAME.png (as the gather names them, pipeline/gather_phase.c).
+static size_t output_base_length(const char *file)
+{
+    size_t n = strlen(file);
+    return n >= 4 && strcmp(file + n - 4, ".exr") == 0 ? n - 4 : n;
+}
+
+/// The frame number N when `name` is BASE.NNNN.exr of `e`'s image sequence and
+/// the run writes that frame (N a multiple of every, at most the iterations); else 0.
+static int frame_of(const wx_scene *s, const char *name, const output_entry *e)
+{
+    size_t base = output_base_length(e->file);
+    size_t n = strlen(name);
+    if (e->every <= 0 || n < base + 9 || strncmp(name, e->file, base) != 0 ||
+        name[base] != '.' || strcmp(name + n - 4, ".exr") != 0) {
+        return 0;
+    }
+    const char *digits = name + base + 1;
+    size_t count = n - base - 5;
+    long long frame = 0;
+    for (size_t i = 0; i < count; ++i) {
+        if (digits[i] < '0' || digits[i] > '9' || frame > SCENE_MAX_ITERATIONS) {
+            return 0;
+        }
+        frame = frame * 10 + (digits[i] - '0');
+    }
+    char written[32];
+    snprintf(written, sizeof written, "%04lld", frame);
+    if (strlen(written) != count || strncmp(written, digits, count) != 0 || frame < 1 ||
+        frame > s->iterations || frame % e->every != 0) {
+        return 0;
+    }
+    return (int)frame;
+}
+
+/// The previews of `file` (docs/design.md section 10): BASE.png for the one
+/// channel Y of a scene without <Substances>, else BASE_NAME.png per substance
+/// (a TextureMap's seen has none). Returns how many.
+static int preview_names(const wx_scene *s, const char *file,
+                         char names[WX_MAX_SUBSTANCES][WX_OUTPUT_NAME_MAX])
+{
+    if (!s->substances_declared) {
+        const char *dot = strrchr(file, '.');
+        int stem = dot != NULL && dot != file ? (int)(dot - file) : (int)strlen(file);
+        snprintf(names[0], WX_OUTPUT_NAME_MAX, "%.*s.png", stem, file);
+        return 1;
+    }
+    int base = (int)output_base_length(file);
+    for (int k = 0; k < s->substance_count; ++k) {
+        snprintf(names[k], WX_OUTPUT_NAME_MAX, "%.*s_%s.png", base, file, s->substances[k]);
+    }
+    return s->substance_count;
+}
+
+/// "the <OutputMap> of output camera 'out' (line 12)" or "the <TextureMap> at line 30".
+static void describe_output(const output_entry *e, char *out, size_t cap)
+{
+    if (e->camera != NULL) {
+        snprintf(out, cap, "the <OutputMap> of output camera '%s' (line %d)", e->camera->name,
+                 e->camera->line);
+    } else {
+        snprintf(out, cap, "the <TextureMap> at line %d", e->line);
+    }
+}
+
+/// TextureMap `t` against an earlier output `e` (the mask or a TextureMap):
+/// neither file, frame nor preview may be written twice.
+static wx_result check_texture_against(parser *p, const output_entry *t, const output_entry *e)
+{
+    const wx_scene *s = p->scene;
+    char other[128];
+    describe_output(e, other, sizeof other);
+    if (strcmp(t->file, e->file) == 0) {
+        if (e->camera == NULL) {
+            return fail_line(p, t->line, WX_CAUSE_DUPLICATE,
+                             "<TextureMap> file=\"%s\" is used twice (first at line %d)",
+                             t->file, e->line);
+        }
+        return fail_line(p, t->line, WX_CAUSE_BAD_SCENE,
+                         "<TextureMap> file=\"%s\" is the file of %s; choose another", t->file,
+                         other);
+    }
+    int frame = frame_of(s, t->file, e);
+    if (frame > 0) {
+        return fail_line(p, t->line, WX_CAUSE_BAD_SCENE,
+                         "<TextureMap> file=\"%s\" is frame %d of the image sequence of '%s', "
+                         "which %s writes with every=\"%d\"; choose another",
+                         t->file, frame, e->file, other, e->every);
+    }
+    frame = frame_of(s, e->file, t);
+    if (frame > 0) {
+        return fail_line(p, t->line, WX_CAUSE_BAD_SCENE,
+                         "<TextureMap> file=\"%s\" every=\"%d\" writes frame %d as '%s', the "
+                         "file of %s; choose another",
+                         t->file, t->every, frame, e->file, other);
+    }
+    char mine[WX_MAX_SUBSTANCES][WX_OUTPUT_NAME_MAX], theirs[WX_MAX_SUBSTANCES][WX_OUTPUT_NAME_MAX];
+    int n_mine = preview_names(s, t->file, mine);
+    int n_theirs = preview_names(s, e->file, theirs);
+    for (int i = 0; i < n_mine; ++i) {
+        for (int k = 0; k < n_theirs; ++k) {
+            if (strcmp(mine[i], theirs[k]) == 0) {
+                return fail_line(p, t->line, WX_CAUSE_BAD_SCENE,
+                                 "<TextureMap> file=\"%s\" writes the preview '%s', as %s "
+                                 "(file=\"%s\") does; choose another",
+                                 t->file, mine[i], other, e->file);
+            }
+        }
+    }
+    return WX_OK;
+}
+
+/// Every TextureMap writes files of its own (docs/design.md section 11): not a
+/// map that bake or simulate writes, not the mask, not another TextureMap's,
+/// nor their frames or previews.
+static wx_result check_texture_names(parser *p)
+{
+    const wx_scene *s = p->scene;
+    for (int i = 0; i < s->texture_count; ++i) {
+        const wx_texture_map *tex = &s->textures[i];
+        for (int c = 0; c < s->camera_count; ++c) {
+            for (int k = 0; k < MAP_KINDS; ++k) {
+                char name[128];
+                snprintf(name, sizeof name, "%s_%s.exr", s->cameras[c].name, map_kinds[k]);
+                if (strcmp(name, tex->file) == 0) {
+                    return fail_line(p, tex->line, WX_CAUSE_BAD_SCENE,
+                                     "<TextureMap> file=\"%s\" is the name of camera '%s''s %s "
+                                     "map in the output folder; choose another",
+                                     tex->file, s->cameras[c].name, map_kinds[k]);
+                }
+            }
+        }
+        output_entry t = { .file = tex->file, .every = tex->every, .line = tex->line };
+        if (s->output_index >= 0) {
+            const wx_scene_camera *out = &s->cameras[s->output_index];
+            output_entry mask = { .file = out->output_file, .every = out->every, .camera = out,
+                                  .line = out->line };
+            wx_result r = check_texture_against(p, &t, &mask);
+            if (r != WX_OK) {
+                return r;
+            }
+        }
+        for (int j = 0; j < i; ++j) {
+            const wx_texture_map *first = &s->textures[j];
+            output_entry e = { .file = first->file, .every = first->every, .line = first->line };
+            wx_result r = check_texture_against(p, &t, &e);
+            if (r != WX_OK) {
+                return r;
+            }
+        }
+    }
+    return WX_OK;
+}
+
 static wx_result parse_root(parser *p, const xmlNode *node)
 {
     if (node == NULL) {
@@ -2295,7 +2547,8 @@ static wx_result parse_root(parser *p, const xmlNode *node)
     if (p->collider == NULL) {
         return fail(p, node, WX_CAUSE_MISSING, "<Weathering> needs a <Collider> with the cameras");
     }
-    if ((r = finish_emitters(p)) != WX_OK || (r = check_output_name(p)) != WX_OK) {
+    if ((r = finish_emitters(p)) != WX_OK || (r = check_output_name(p)) != WX_OK ||
+        (r = check_texture_names(p)) != WX_OK) {
         return r;
     }
     return check_surface_rules(p);

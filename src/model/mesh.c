@@ -14,6 +14,10 @@ void wx_mesh_data_release_arrays(wx_mesh_data *mesh)
     mesh->positions = mesh->normals = mesh->colors = NULL;
     mesh->indices = NULL;
     mesh->materials = NULL;
+    for (int c = 0; c < WX_MESH_MAX_UV_CHANNELS; ++c) {
+        free(mesh->uvs[c]);
+        mesh->uvs[c] = NULL;
+    }
 }
 
 void wx_mesh_data_free(wx_mesh_data *mesh)

@@ -14,6 +14,9 @@
 #include "core/limits.h"
 
 
+/// UV channels a mesh may carry (Assimp's AI_MAX_NUMBER_OF_TEXTURECOORDS).
+#define WX_MESH_MAX_UV_CHANNELS 8
+
 /// A triangle mesh in world space, as flat arrays.
 typedef struct wx_mesh_data {
     int64_t vertex_count;
@@ -22,6 +25,9 @@ typedef struct wx_mesh_data {
     float *positions;      ///< 3 per vertex: world position minus origin
     float *normals;        ///< 3 per vertex: world-space unit normal (0 when degenerate)
     float *colors;         ///< 4 per vertex (RGBA, first colour set), NULL when the file has none
+    /// 2 per vertex (u, v) per UV channel asked of the import (mesh_import.h),
+    /// NULL for the others.
+    float *uvs[WX_MESH_MAX_UV_CHANNELS];
     uint32_t *indices;     ///< 3 per triangle
     uint16_t *materials;   ///< 1 per triangle: index into material_names
     int material_count;    ///< distinct material names used by triangles, in file order

@@ -121,6 +121,7 @@ void wx_scene_free(wx_scene *scene)
         free(scene->meshes[m].path);
     }
     free(scene->meshes);
+    free(scene->textures);
     for (int c = 0; c < scene->camera_count; ++c) {
         wx_scene_camera *cam = &scene->cameras[c];
         free(cam->depth_path);

@@ -146,6 +146,30 @@ typedef struct wx_surface {
     int line;
 } wx_surface;
 
+/// The defaults of a <TextureMap> (docs/design.md section 11).
+#define WX_DEFAULT_TEXTURE_RESOLUTION 1024
+#define WX_DEFAULT_TEXTURE_PADDING 8
+
+/// A <TextureMap> of a <Mesh>: the mask's channels in the mesh's UV layout
+/// (docs/design.md section 11, docs/texture.md).
+typedef struct wx_texture_map {
+    int mesh;            ///< index into wx_scene.meshes
+    char file[256];      ///< base name in the output folder, ends in .exr
+    int width, height;   ///< texels; `resolution` (default 1024), `width`/`height` override
+    int padding;         ///< texels of island bleed, default 8 (0: none)
+    int uv;              ///< the mesh's UV channel, default 0
+    int every;           ///< write BASE.NNNN.exr after every k-th iteration (0: none)
+    /// Smoothing as the mask's: a radius in world units (0: none) or, without
+    /// one (the default), the adaptive smoothing aiming at `noise` with radii
+    /// up to max_radius world units (0: WX_DEFAULT_MAX_RADIUS_TEXELS texels of
+    /// the input camera the smoothing runs on; docs/texture.md).
+    bool adaptive;
+    float radius;
+    float noise;
+    float max_radius;
+    int line;
+} wx_texture_map;
+
 typedef struct wx_mesh {
     char *path; ///< resolved against the scene's folder (owned)
     wx_surface *surfaces;
@@ -177,6 +201,10 @@ typedef struct wx_scene {
 
     wx_mesh *meshes;
     int mesh_count;
+
+    /// Every <TextureMap>, in document order (owned).
+    wx_texture_map *textures;
+    int texture_count;
 
     /// Substances (docs/design.md section 9): without <Substances> the one
     /// substance "dirt" (substances_declared false).

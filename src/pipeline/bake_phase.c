@@ -181,7 +181,21 @@ wx_result wx_geometry_load(const wx_scene *scene, bool quiet, wx_geometry *out, 
         if (stat(mesh->path, &st) == 0) {
             out->file_bytes += (int64_t)st.st_size;
         }
-        r = wx_mesh_import(mesh->path, &g->data, err);
+        // The UV channels this mesh's <TextureMap>s read (docs/design.md section 11).
+        unsigned uv_channels = 0u;
+        int texture_line = 0;
+        for (int t = 0; t < scene->texture_count; ++t) {
+            if (scene->textures[t].mesh == i) {
+                uv_channels |= 1u << scene->textures[t].uv;
+                texture_line = texture_line > 0 ? texture_line : scene->textures[t].line;
+            }
+        }
+        r = wx_mesh_import_uvs(mesh->path, uv_channels, &g->data, err);
+        if (r != WX_OK && uv_channels != 0u && err->cause == WX_CAUSE_NO_UVS) {
+            wx_error_prefix(err, "%s:%d: <TextureMap> (line %d) needs texture coordinates",
+                            scene->path, mesh->line, texture_line);
+            break;
+        }
         if (r != WX_OK) {
             wx_error_prefix(err, "%s:%d", scene->path, mesh->line);
             break;

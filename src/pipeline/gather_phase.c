@@ -13,6 +13,11 @@
 #include "pipeline/load.h"
 #include "core/progress.h"
 #include "pipeline/outputs.h"
+#include "pipeline/texture_phase.h"
+
+static wx_result write_mask(const wx_scene *scene, const wx_run_def *opts, const wx_maps *in_maps,
+                            const wx_maps *given_out, int frame, wx_phase_detail *detail,
+                            wx_error *err);
 
 wx_result wx_gather_scene(const wx_scene *scene, const wx_run_def *opts, wx_error *err)
 {
@@ -23,7 +28,7 @@ wx_result wx_gather_scene(const wx_scene *scene, const wx_run_def *opts, wx_erro
     }
     wx_result result = wx_load_gather_maps(scene, opts, in_maps, err);
     if (result == WX_OK) {
-        result = wx_gather_maps(scene, opts, in_maps, NULL, NULL, err);
+        result = wx_gather_maps(scene, opts, in_maps, NULL, NULL, NULL, err);
     }
     for (int c = 0; c < input_count; ++c) {
         wx_maps_free(&in_maps[c]);
@@ -54,9 +59,53 @@ wx_result wx_gather_check(const wx_scene *scene, wx_error *err)
 }
 
 wx_result wx_gather_maps(const wx_scene *scene, const wx_run_def *opts, const wx_maps *in_maps,
-                         const wx_maps *given_out, wx_phase_detail *detail, wx_error *err)
+                         const wx_maps *given_out, const wx_textures *textures,
+                         wx_phase_detail *detail, wx_error *err)
 {
-    return wx_gather_frame(scene, opts, in_maps, given_out, 0, detail, err);
+    return wx_gather_frame(scene, opts, in_maps, given_out, textures, 0, detail, err);
+}
+
+bool wx_frame_wanted(const wx_scene *scene, int frame)
+{
+    if (scene->output_index >= 0 && scene->output_index < scene->camera_count) {
+        int every = scene->cameras[scene->output_index].every;
+        if (frame == 0 || (every > 0 && frame % every == 0)) {
+            return true;
+        }
+    }
+    for (int t = 0; t < scene->texture_count; ++t) {
+        if (wx_texture_writes_frame(&scene->textures[t], frame)) {
+            return true;
+        }
+    }
+    return false;
+}
+
+wx_result wx_gather_frame(const wx_scene *scene, const wx_run_def *opts, const wx_maps *in_maps,
+                          const wx_maps *given_out, const wx_textures *textures, int frame,
+                          wx_phase_detail *detail, wx_error *err)
+{
+    wx_phase_detail local;
+    detail = detail != NULL ? detail : &local;
+    memset(detail, 0, sizeof *detail);
+    bool has_output = scene->output_index >= 0 && scene->output_index < scene->camera_count;
+    if (!has_output && (textures == NULL || textures->count == 0)) {
+        return wx_fail(err, WX_CAUSE_MISSING,
+                       "%s: no output camera (an <Ortho out=\"true\">) and no <TextureMap>; "
+                       "gather needs one",
+                       scene->path);
+    }
+    wx_result r = WX_OK;
+    if (has_output) {
+        int every = scene->cameras[scene->output_index].every;
+        if (frame == 0 || (every > 0 && frame % every == 0)) {
+            r = write_mask(scene, opts, in_maps, given_out, frame, detail, err);
+        }
+    }
+    if (r == WX_OK) {
+        r = wx_textures_write(scene, opts, textures, in_maps, frame, detail, err);
+    }
+    return r;
 }
 
 int wx_mask_channels(const wx_scene *scene, char names[][WX_NAME_MAX])
@@ -89,19 +138,12 @@ void wx_channel_preview_name(const char *mask_name, const char *channel, char *o
     snprintf(out, cap, "%.*s_%.*s.png", (int)base, mask_name, (int)len, channel);
 }
 
-wx_result wx_gather_frame(const wx_scene *scene, const wx_run_def *opts, const wx_maps *in_maps,
-                          const wx_maps *given_out, int frame, wx_phase_detail *detail,
-                          wx_error *err)
+// The mask of frame `frame` (0: the final file and its previews).
+static wx_result write_mask(const wx_scene *scene, const wx_run_def *opts, const wx_maps *in_maps,
+                            const wx_maps *given_out, int frame, wx_phase_detail *detail,
+                            wx_error *err)
 {
-    wx_phase_detail local;
-    detail = detail != NULL ? detail : &local;
-    memset(detail, 0, sizeof *detail);
     double t0 = wx_now_s();
-    if (scene->output_index < 0 || scene->output_index >= scene->camera_count) {
-        return wx_fail(err, WX_CAUSE_MISSING,
-                       "%s: no output camera (an <Ortho out=\"true\">); gather needs one",
-                       scene->path);
-    }
     const wx_scene_camera *out = &scene->cameras[scene->output_index];
     char names[WX_IMAGE_MAX_CHANNELS][WX_NAME_MAX];
     const char *channel_names[WX_IMAGE_MAX_CHANNELS];

@@ -10,10 +10,13 @@
 #include "model/stats.h"
 #include "pipeline/pipeline.h"
 
+struct wx_textures; // pipeline/texture_phase.h
+
 /// Checks what the gather would refuse about the scene, before any work: the
 /// output camera's second-pass radius must fit the gather's neighbourhood limit
 /// (WX_CAUSE_BAD_VALUE, "scene.xml:LINE: <OutputMap> of camera 'NAME': ...").
-/// A scene without an output camera passes (the command says it needs one).
+/// A scene without an output camera passes (the command says it needs one or
+/// a TextureMap).
 wx_result wx_gather_check(const wx_scene *scene, wx_error *err);
 
 /// The `gather` phase: loads the output camera's depth and normal maps and, for
@@ -22,22 +25,31 @@ wx_result wx_gather_check(const wx_scene *scene, wx_error *err);
 /// dirt map from the scene, with a note on stderr unless quiet), computes the
 /// mask and writes opts->out_dir/<output_file> (EXR, channel Y, with the camera
 /// in its header) and the PNG preview beside it (extension replaced by .png).
+/// The mask only: TextureMaps need their meshes, which `run` and `gather`
+/// import (wx_run_phases); the viewer, which links no mesh importer, calls this.
 wx_result wx_gather_scene(const wx_scene *scene, const wx_run_def *opts, wx_error *err);
 
 /// The `gather` phase with the input cameras' maps already in memory (one per
 /// input camera in scene order: depth, normal and the dirt to gather): reads
 /// the output camera's maps (or takes `out_maps`, its depth and normal, when
-/// not NULL), computes and writes the mask and its preview;
+/// not NULL), computes and writes the mask and its preview, then every
+/// TextureMap of `textures` (may be NULL: none; texture_phase.h);
 /// `detail` (may be NULL) gets the read, compute and write times.
 wx_result wx_gather_maps(const wx_scene *scene, const wx_run_def *opts, const wx_maps *in_maps,
-                         const wx_maps *out_maps, wx_phase_detail *detail, wx_error *err);
+                         const wx_maps *out_maps, const struct wx_textures *textures,
+                         wx_phase_detail *detail, wx_error *err);
 
 /// wx_gather_maps for frame `frame` of an image sequence (docs/design.md
 /// section 10): frame 0 writes the final BASE.exr and its previews, frame k > 0
-/// BASE.NNNN.exr (k on four digits) without previews.
+/// BASE.NNNN.exr (k on four digits) without previews, for the mask when its
+/// `every` divides k and for each TextureMap whose `every` does.
 wx_result wx_gather_frame(const wx_scene *scene, const wx_run_def *opts, const wx_maps *in_maps,
-                          const wx_maps *out_maps, int frame, wx_phase_detail *detail,
-                          wx_error *err);
+                          const wx_maps *out_maps, const struct wx_textures *textures, int frame,
+                          wx_phase_detail *detail, wx_error *err);
+
+/// Whether frame `frame` writes anything: the mask's or some TextureMap's
+/// `every` divides it (frame 0: always).
+bool wx_frame_wanted(const wx_scene *scene, int frame);
 
 /// The mask's channels (docs/design.md section 10): "Y" for a scene without
 /// <Substances>, else NAME.Y per substance. Returns the count.

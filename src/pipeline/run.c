@@ -14,6 +14,7 @@
 #include "pipeline/memory.h"
 #include "pipeline/outputs.h"
 #include "pipeline/simulate_phase.h"
+#include "pipeline/texture_phase.h"
 
 // Marks the maps of the cameras bake renders as the output folder's own (bake
 // is about to write them there); true when there is any.
@@ -54,7 +55,10 @@ wx_result wx_run_phases(wx_scene *scene, const wx_run_def *opts, unsigned phases
         r = wx_use_baked_maps(scene, opts, err);
     }
     // Everything that can be refused, before any folder or file is made.
-    if (r == WX_OK && bake) {
+    // TextureMaps read their meshes' UV layouts: imported with the bake's, or
+    // for them alone when nothing is baked.
+    bool textures_needed = scene->texture_count > 0 && (phases & (WX_PHASE_SIMULATE | WX_PHASE_GATHER));
+    if (r == WX_OK && (bake || textures_needed)) {
         r = wx_geometry_load(scene, opts->quiet, &geometry, err);
     }
     if (r == WX_OK && (phases & WX_PHASE_GATHER)) {
@@ -68,6 +72,11 @@ wx_result wx_run_phases(wx_scene *scene, const wx_run_def *opts, unsigned phases
     }
     if (r == WX_OK) {
         r = wx_output_prepare(scene, opts, created, err);
+    }
+    wx_textures textures;
+    memset(&textures, 0, sizeof textures);
+    if (r == WX_OK && textures_needed) {
+        r = wx_textures_prepare(scene, &geometry, opts, &textures, err);
     }
     report->times.load += wx_now_s() - start;
 
@@ -91,7 +100,8 @@ wx_result wx_run_phases(wx_scene *scene, const wx_run_def *opts, unsigned phases
         double t1 = wx_now_s();
         if (r == WX_OK) {
             r = wx_simulate_maps(scene, opts, maps,
-                                 output_maps.depth != NULL ? &output_maps : NULL, &report->stats,
+                                 output_maps.depth != NULL ? &output_maps : NULL, &textures,
+                                 &report->stats,
                                  &report->times.simulate_detail, err);
         }
         report->times.simulate_detail.read = t1 - t0;
@@ -118,7 +128,7 @@ wx_result wx_run_phases(wx_scene *scene, const wx_run_def *opts, unsigned phases
         double t0 = wx_now_s();
         if (maps != NULL) {
             r = wx_gather_maps(scene, opts, maps, output_maps.depth != NULL ? &output_maps : NULL,
-                               &report->times.gather_detail, err);
+                               &textures, &report->times.gather_detail, err);
         } else {
             wx_maps *in = calloc((size_t)scene->input_count + 1, sizeof *in);
             r = in != NULL ? wx_load_gather_maps(scene, opts, in, err)
@@ -126,7 +136,7 @@ wx_result wx_run_phases(wx_scene *scene, const wx_run_def *opts, unsigned phases
             double t1 = wx_now_s();
             if (r == WX_OK) {
                 r = wx_gather_maps(scene, opts, in,
-                                   output_maps.depth != NULL ? &output_maps : NULL,
+                                   output_maps.depth != NULL ? &output_maps : NULL, &textures,
                                    &report->times.gather_detail, err);
             }
             report->times.gather_detail.read += t1 - t0;
@@ -136,6 +146,7 @@ wx_result wx_run_phases(wx_scene *scene, const wx_run_def *opts, unsigned phases
     }
     free_maps(maps, scene->input_count);
     wx_maps_free(&output_maps);
+    wx_textures_free(&textures);
     if (r != WX_OK) {
         wx_output_remove_empty(opts->out_dir, created); // a failed run leaves no empty folder
     }

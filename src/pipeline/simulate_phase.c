@@ -12,6 +12,7 @@
 #include "pipeline/gather_phase.h"
 #include "pipeline/load.h"
 #include "pipeline/outputs.h"
+#include "pipeline/texture_phase.h"
 
 // The planes the gather reads from the simulation's state for input camera k
 // (model/maps.h layout: substance s at s*W*H): the amounts, the amounts
@@ -132,8 +133,8 @@ static wx_result write_one(const wx_scene *scene, const wx_run_def *opts, const 
 // Frame `frame` of the mask's image sequence from the simulation's state now:
 // the input maps' depth and normal borrowed, the dirt planes made for it.
 static wx_result write_frame(const wx_scene *scene, const wx_run_def *opts, const wx_sim *sim,
-                             const wx_maps *maps, const wx_maps *out_maps, int frame,
-                             wx_error *err)
+                             const wx_maps *maps, const wx_maps *out_maps,
+                             const wx_textures *textures, int frame, wx_error *err)
 {
     int n = wx_sim_input_count(sim);
     wx_maps *view = calloc((size_t)n + 1, sizeof *view);
@@ -151,7 +152,7 @@ static wx_result write_frame(const wx_scene *scene, const wx_run_def *opts, cons
                           err);
     }
     if (r == WX_OK) {
-        r = wx_gather_frame(scene, opts, view, out_maps, frame, NULL, err);
+        r = wx_gather_frame(scene, opts, view, out_maps, textures, frame, NULL, err);
     }
     for (int c = 0; c < n; ++c) {
         free(view[c].dirt);
@@ -183,8 +184,8 @@ wx_result wx_write_dirt_maps(const wx_scene *scene, const wx_run_def *opts, cons
 }
 
 wx_result wx_simulate_maps(const wx_scene *scene, const wx_run_def *opts, wx_maps *maps,
-                           const wx_maps *out_maps, wx_sim_stats *stats, wx_phase_detail *detail,
-                           wx_error *err)
+                           const wx_maps *out_maps, const wx_textures *textures,
+                           wx_sim_stats *stats, wx_phase_detail *detail, wx_error *err)
 {
     wx_phase_detail local;
     detail = detail != NULL ? detail : &local;
@@ -224,9 +225,10 @@ wx_result wx_simulate_maps(const wx_scene *scene, const wx_run_def *opts, wx_map
         r = wx_sim_step(sim, err);
         wx_progress_update(&progress, s + 1);
         int64_t done = wx_sim_iterations_done(sim);
-        if (r == WX_OK && every > 0 && (s + 1) % scene->steps == 0 && done % every == 0) {
+        if (r == WX_OK && (s + 1) % scene->steps == 0 && done > 0 &&
+            wx_frame_wanted(scene, (int)done)) {
             double f0 = wx_now_s();
-            r = write_frame(scene, opts, sim, maps, out_maps, (int)done, err);
+            r = write_frame(scene, opts, sim, maps, out_maps, textures, (int)done, err);
             frames_s += wx_now_s() - f0;
         }
     }
@@ -275,7 +277,7 @@ wx_result wx_simulate_scene(const wx_scene *scene, const wx_run_def *opts,
     }
     wx_result r = wx_load_simulation_maps(scene, opts->threads, maps, err);
     if (r == WX_OK) {
-        r = wx_simulate_maps(scene, opts, maps, NULL, stats, NULL, err);
+        r = wx_simulate_maps(scene, opts, maps, NULL, NULL, stats, NULL, err);
     }
     for (int c = 0; c < scene->input_count; ++c) {
         wx_maps_free(&maps[c]);

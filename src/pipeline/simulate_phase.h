@@ -11,6 +11,8 @@
 #include "pipeline/pipeline.h"
 #include "sim/simulate.h"
 
+struct wx_textures; // pipeline/texture_phase.h
+
 /// Writes <camera>_dirt.exr for every input camera into the output folder: R
 /// the simulated dirt, G deposit and B erosion as in the input dirt map (the
 /// camera's `maps`, those the simulation ran on), initialDirt the dirt it
@@ -22,12 +24,13 @@ wx_result wx_write_dirt_maps(const wx_scene *scene, const wx_run_def *opts, cons
 /// The `simulate` phase on maps already in memory (one per input camera, scene
 /// order, as wx_load_simulation_maps reads them): runs scene->steps steps,
 /// writes opts->out_dir/<camera>_dirt.exr for each input camera, fills
-/// `stats` and the setup, compute and write times of `detail` (may be NULL),
+/// Frames of image sequences (`every`) write the mask and the TextureMaps of
+/// `textures` (may be NULL). `stats` and the setup, compute and write times of `detail` (may be NULL),
 /// and leaves in each maps[c].dirt the simulated dirt as written
 /// (impact, deposit and erosion released): what the gather reads next.
 wx_result wx_simulate_maps(const wx_scene *scene, const wx_run_def *opts, wx_maps *maps,
-                           const wx_maps *out_maps, wx_sim_stats *stats, wx_phase_detail *detail,
-                           wx_error *err);
+                           const wx_maps *out_maps, const struct wx_textures *textures,
+                           wx_sim_stats *stats, wx_phase_detail *detail, wx_error *err);
 
 /// The `simulate` phase: loads every input camera's maps from the scene's
 /// paths, runs scene->steps steps (progress bar unless opts->quiet), writes

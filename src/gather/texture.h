@@ -1,0 +1,83 @@
+// texture.h: the gather's second kind of target, a mesh's UV layout
+// (docs/design.md section 11, docs/texture.md).
+//
+// The UV raster says which triangle covers each texel of a W x H texture
+// (texel (i, j) has its centre at u = (i + 1/2)/W, v = 1 - (j + 1/2)/H; a
+// texel is covered when its centre lies inside a triangle, edges shared by two
+// triangles going to exactly one of them) and, for the texels within `padding`
+// of a covered one, which covered texel is nearest (island bleed). Each covered
+// texel stands for its triangle's surface point at the texel centre, world
+// position and normal interpolated.
+//
+// Its values are sampled, not gathered again: for every input camera the mask
+// is first computed on that camera's own texels (wx_gather_compute with the
+// camera as target: the same first pass and the same smoothing, in world space
+// along the surface that camera records), and each texel's surface point then
+// reads those planes through the first pass's visibility test. A point on
+// either side of a UV seam reads the same planes at the same place, so the
+// texture has no seam; a point no input camera sees is not `seen`.
+#ifndef WX_TEXTURE_H
+#define WX_TEXTURE_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "core/error.h"
+#include "gather/gather.h"
+#include "model/mesh.h"
+
+/// Which triangle covers each texel, and where padding takes its values.
+typedef struct wx_uv_raster {
+    int width, height;
+    int32_t *triangle; ///< per texel: the covering triangle, -1 where none
+    /// Per texel: the covered texel whose values it holds (itself when covered,
+    /// the nearest covered one within the padding), -1 where none.
+    int32_t *source;
+    int64_t covered;           ///< texels with a triangle
+    int64_t overlapping;       ///< covered texels inside more than one triangle
+    int64_t padded;            ///< texels that take a neighbour's values
+    int64_t triangles_outside; ///< triangles reaching outside the [0,1]^2 tile
+    int64_t triangles_degenerate; ///< triangles of zero area in UV (never cover a texel)
+} wx_uv_raster;
+
+/// Rasterises UV channel `uv` of `mesh` (which must hold it, with positions,
+/// normals and indices) into a width x height raster with `padding` texels of
+/// bleed (0: none). Overlaps go to the triangle of lowest index. WX_FAIL when
+/// out of memory; WX_BAD_ARGUMENT when the channel is missing.
+wx_result wx_uv_raster_build(const wx_mesh_data *mesh, int uv, int width, int height,
+                             int padding, wx_uv_raster *out, wx_error *err);
+
+/// Frees the planes; the struct is zeroed.
+void wx_uv_raster_free(wx_uv_raster *raster);
+
+/// The surface point of covered texel t: world position and unit normal (the
+/// vertex normals interpolated; the triangle's own normal when they cancel).
+/// False when t is not covered.
+bool wx_uv_raster_point(const wx_mesh_data *mesh, int uv, const wx_uv_raster *raster,
+                        size_t t, double position[3], float normal[3]);
+
+/// The sampling of a texture from the planes the mask computed on every input
+/// camera's own texels.
+typedef struct wx_texture_def {
+    const wx_mesh_data *mesh;
+    int uv;
+    const wx_uv_raster *raster;
+    const wx_gather_view *inputs; ///< input cameras: camera, size, depth and normal
+    int input_count;
+    /// smoothed[k * channels + c]: channel c computed on input camera k's
+    /// texels (width*height of that camera).
+    const float *const *smoothed;
+    int channels;
+    int threads;
+} wx_texture_def;
+
+/// Fills out[c] (width*height floats each, c < channels) and seen (the same
+/// size): at a covered texel whose point some input camera sees, the mean of
+/// the seeing cameras' values weighted by |N . view| (a camera that sees the
+/// surface head-on resolves it best), seen 1; at a covered texel no camera
+/// sees, 0 and seen 0; at a padding texel its source's values; elsewhere 0.
+/// `seen_texels` (may be NULL) gets the covered texels that are seen.
+wx_result wx_texture_sample(const wx_texture_def *def, float *const *out, float *seen,
+                            int64_t *seen_texels, wx_error *err);
+
+#endif

@@ -1,0 +1,352 @@
+// texture_phase.c: the scene's <TextureMap>s (texture_phase.h).
+#include "pipeline/texture_phase.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/progress.h"
+#include "gather/gather.h"
+#include "io/exr.h"
+#include "io/png_preview.h"
+#include "model/image.h"
+#include "pipeline/gather_phase.h"
+#include "pipeline/outputs.h"
+
+int wx_texture_channels(const wx_scene *scene, char names[][WX_NAME_MAX])
+{
+    int n = wx_mask_channels(scene, names);
+    snprintf(names[n], WX_NAME_MAX, "seen");
+    return n + 1;
+}
+
+bool wx_texture_writes_frame(const wx_texture_map *t, int frame)
+{
+    return frame == 0 || (t->every > 0 && frame % t->every == 0);
+}
+
+// The arrays the sampling reads, copied: the bake releases the geometry's.
+static wx_result copy_mesh(const wx_mesh_data *from, int uv, wx_mesh_data *to, wx_error *err)
+{
+    memset(to, 0, sizeof *to);
+    size_t nv = (size_t)from->vertex_count, nt = (size_t)from->triangle_count;
+    to->vertex_count = from->vertex_count;
+    to->triangle_count = from->triangle_count;
+    memcpy(to->origin, from->origin, sizeof to->origin);
+    to->positions = malloc(3 * nv * sizeof *to->positions + 1);
+    to->normals = malloc(3 * nv * sizeof *to->normals + 1);
+    to->indices = malloc(3 * nt * sizeof *to->indices + 1);
+    to->uvs[uv] = malloc(2 * nv * sizeof *to->uvs[uv] + 1);
+    if (to->positions == NULL || to->normals == NULL || to->indices == NULL ||
+        to->uvs[uv] == NULL || from->uvs[uv] == NULL) {
+        wx_mesh_data_free(to);
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "texture: out of memory for the mesh");
+    }
+    memcpy(to->positions, from->positions, 3 * nv * sizeof *to->positions);
+    memcpy(to->normals, from->normals, 3 * nv * sizeof *to->normals);
+    memcpy(to->indices, from->indices, 3 * nt * sizeof *to->indices);
+    memcpy(to->uvs[uv], from->uvs[uv], 2 * nv * sizeof *to->uvs[uv]);
+    return WX_OK;
+}
+
+wx_result wx_textures_prepare(const wx_scene *scene, const wx_geometry *geometry,
+                              const wx_run_def *opts, wx_textures *out, wx_error *err)
+{
+    memset(out, 0, sizeof *out);
+    if (scene->texture_count == 0) {
+        return WX_OK;
+    }
+    wx_result r = WX_OK;
+    out->items = calloc((size_t)scene->texture_count, sizeof *out->items);
+    if (r == WX_OK && out->items == NULL) {
+        r = wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (textures)");
+    }
+    for (int i = 0; i < scene->texture_count && r == WX_OK; ++i) {
+        const wx_texture_map *def = &scene->textures[i];
+        wx_texture_target *t = &out->items[i];
+        const wx_mesh *mesh = &scene->meshes[def->mesh];
+        out->count = i + 1;
+        t->def = def;
+        r = copy_mesh(&geometry->meshes[def->mesh].data, def->uv, &t->mesh, err);
+        if (r == WX_OK) {
+            r = wx_uv_raster_build(&t->mesh, def->uv, def->width, def->height, def->padding,
+                                   &t->raster, err);
+        }
+        if (r != WX_OK) {
+            wx_error_prefix(err, "%s:%d: <TextureMap file=\"%s\">", scene->path, def->line,
+                            def->file);
+            break;
+        }
+        const wx_uv_raster *ras = &t->raster;
+        double texels = (double)def->width * (double)def->height;
+        wx_note(opts->quiet,
+                "texture %s: %d x %d texels over UV channel %d of '%s', %.1f%% covered "
+                "(%lld texels), %lld padded",
+                def->file, def->width, def->height, def->uv, wx_mesh_display_name(scene, mesh),
+                100.0 * (double)ras->covered / texels, (long long)ras->covered,
+                (long long)ras->padded);
+        if (ras->overlapping > 0) {
+            wx_warn(opts->quiet,
+                    "%s:%d: texture %s: %lld texels lie in more than one triangle of the UV "
+                    "layout (overlapping UVs): each takes the first triangle's surface point",
+                    scene->path, def->line, def->file, (long long)ras->overlapping);
+        }
+        if (ras->triangles_outside > 0) {
+            wx_warn(opts->quiet,
+                    "%s:%d: texture %s: %lld of %lld triangles reach outside the [0,1] UV tile; "
+                    "only the tile is written",
+                    scene->path, def->line, def->file, (long long)ras->triangles_outside,
+                    (long long)t->mesh.triangle_count);
+        }
+        if (ras->covered == 0) {
+            wx_warn(opts->quiet,
+                    "%s:%d: texture %s: no texel centre lies inside a triangle of the UV layout",
+                    scene->path, def->line, def->file);
+        }
+    }
+    if (r != WX_OK) {
+        wx_textures_free(out);
+    }
+    return r;
+}
+
+void wx_textures_free(wx_textures *textures)
+{
+    for (int i = 0; i < textures->count; ++i) {
+        wx_mesh_data_free(&textures->items[i].mesh);
+        wx_uv_raster_free(&textures->items[i].raster);
+    }
+    free(textures->items);
+    memset(textures, 0, sizeof *textures);
+}
+
+// ---------------------------------------------------------------------------
+// Writing.
+
+// The mask of every channel on every input camera's own texels, for one setting
+// of the smoothing: planes[k * channels + c].
+typedef struct camera_planes {
+    const wx_texture_map *key; // the smoothing of this TextureMap
+    float **planes;
+} camera_planes;
+
+static bool same_smoothing(const wx_texture_map *a, const wx_texture_map *b)
+{
+    return a->adaptive == b->adaptive && a->radius == b->radius && a->noise == b->noise &&
+           a->max_radius == b->max_radius;
+}
+
+static wx_result compute_planes(const wx_scene *scene, const wx_run_def *opts,
+                                const wx_maps *in_maps, wx_gather_view *views, int channels,
+                                const wx_texture_map *key, float **planes, wx_error *err)
+{
+    const int k_count = scene->input_count;
+    wx_result r = WX_OK;
+    int k = 0;
+    for (int cam = 0; cam < scene->camera_count && r == WX_OK; ++cam) {
+        const wx_scene_camera *sc = &scene->cameras[cam];
+        if (sc->is_output) {
+            continue;
+        }
+        const wx_maps *m = &in_maps[k];
+        float frame_w, frame_h;
+        wx_camera_frame_size(&sc->camera, &frame_w, &frame_h);
+        for (int c = 0; c < channels && r == WX_OK; ++c) {
+            for (int v = 0; v < k_count; ++v) {
+                size_t plane = (size_t)c * (size_t)in_maps[v].width * (size_t)in_maps[v].height;
+                views[v].dirt = in_maps[v].dirt != NULL ? in_maps[v].dirt + plane : NULL;
+                views[v].initial =
+                    in_maps[v].initial_dirt != NULL ? in_maps[v].initial_dirt + plane : NULL;
+            }
+            float **plane = &planes[(size_t)k * (size_t)channels + (size_t)c];
+            *plane = malloc((size_t)m->width * (size_t)m->height * sizeof **plane + 1);
+            if (*plane == NULL) {
+                r = wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "texture: out of memory");
+                break;
+            }
+            wx_gather_def def = wx_default_gather_def();
+            def.target = wx_target_from_camera(&sc->camera, m);
+            def.inputs = views;
+            def.input_count = k_count;
+            def.radius = key->radius;
+            def.adaptive = key->adaptive;
+            def.noise = key->noise;
+            // By default the largest radius is as many of this camera's texels as
+            // the mask's default is of output texels.
+            def.max_radius = key->max_radius > 0.0f
+                                 ? key->max_radius
+                                 : WX_DEFAULT_MAX_RADIUS_TEXELS * frame_w / (float)m->width;
+            def.threads = opts->threads;
+            def.quiet = true;
+            r = wx_gather_compute(&def, *plane, NULL, err);
+        }
+        k++;
+    }
+    return r;
+}
+
+static void free_planes(camera_planes *cache, int count, int planes)
+{
+    for (int i = 0; i < count; ++i) {
+        for (int p = 0; cache[i].planes != NULL && p < planes; ++p) {
+            free(cache[i].planes[p]);
+        }
+        free(cache[i].planes);
+    }
+    free(cache);
+}
+
+// One texture: sampled into `image` (its channels allocated) and written with
+// its previews (frame 0).
+static wx_result write_texture(const wx_scene *scene, const wx_run_def *opts,
+                               const wx_texture_target *t, const wx_gather_view *views,
+                               float *const *planes, int frame, char names[][WX_NAME_MAX],
+                               int channels, wx_phase_detail *detail, wx_error *err)
+{
+    const wx_texture_map *def = t->def;
+    const char *channel_names[WX_IMAGE_MAX_CHANNELS];
+    for (int c = 0; c < channels; ++c) {
+        channel_names[c] = names[c];
+    }
+    char path[WX_PATH_MAX], name[WX_OUTPUT_NAME_MAX];
+    wx_frame_name(def->file, frame, name, sizeof name);
+    wx_result r = wx_output_path(scene, opts, frame > 0 ? name : def->file, path, err);
+    wx_image *image = calloc(1, sizeof *image);
+    if (image == NULL) {
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "texture: out of memory");
+    }
+    double t0 = wx_now_s();
+    if (r == WX_OK) {
+        r = wx_image_alloc(image, def->width, def->height, channels, channel_names, err);
+    }
+    if (r == WX_OK) {
+        wx_texture_def td = { .mesh = &t->mesh,
+                              .uv = def->uv,
+                              .raster = &t->raster,
+                              .inputs = views,
+                              .input_count = scene->input_count,
+                              .smoothed = (const float *const *)planes,
+                              .channels = channels - 1,
+                              .threads = opts->threads };
+        r = wx_texture_sample(&td, image->channels, image->channels[channels - 1], NULL, err);
+    }
+    double t1 = wx_now_s();
+    if (r == WX_OK) {
+        wx_image_set_string(image, "weatheringMesh",
+                            wx_mesh_display_name(scene, &scene->meshes[def->mesh]));
+        char uv[16];
+        snprintf(uv, sizeof uv, "%d", def->uv);
+        wx_image_set_string(image, "weatheringUVChannel", uv);
+        image->threads = opts->threads;
+        r = wx_exr_write(path, image, err);
+    }
+    // Previews: transparent where no texel holds a value.
+    float *alpha = NULL;
+    if (r == WX_OK && frame == 0) {
+        size_t texels = (size_t)def->width * (size_t)def->height;
+        alpha = malloc(texels * sizeof *alpha);
+        if (alpha == NULL) {
+            r = wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "texture: out of memory (preview)");
+        }
+        for (size_t i = 0; alpha != NULL && i < texels; ++i) {
+            alpha[i] = t->raster.source[i] >= 0 ? 1.0f : INFINITY;
+        }
+    }
+    for (int c = 0; c + 1 < channels && r == WX_OK && frame == 0; ++c) {
+        if (channels == 2) {
+            wx_preview_name(def->file, name, sizeof name);
+        } else {
+            wx_channel_preview_name(def->file, names[c], name, sizeof name);
+        }
+        r = wx_output_path(scene, opts, name, path, err);
+        if (r == WX_OK) {
+            r = wx_preview_write_png(path, image->channels[c], alpha, def->width, def->height,
+                                     err);
+        }
+    }
+    free(alpha);
+    if (detail != NULL) {
+        detail->compute += t1 - t0;
+        detail->write += wx_now_s() - t1;
+    }
+    wx_image_free(image);
+    free(image);
+    return r;
+}
+
+wx_result wx_textures_write(const wx_scene *scene, const wx_run_def *opts,
+                            const wx_textures *textures, const wx_maps *in_maps, int frame,
+                            wx_phase_detail *detail, wx_error *err)
+{
+    if (textures == NULL || textures->count == 0) {
+        return WX_OK;
+    }
+    char names[WX_IMAGE_MAX_CHANNELS][WX_NAME_MAX];
+    const int channels = wx_texture_channels(scene, names);
+    const int substances = channels - 1;
+    const int planes_per_key = scene->input_count * substances;
+    wx_gather_view *views = calloc((size_t)scene->input_count + 1, sizeof *views);
+    camera_planes *cache = calloc((size_t)textures->count, sizeof *cache);
+    if (views == NULL || cache == NULL) {
+        free(views);
+        free(cache);
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "texture: out of memory");
+    }
+    int k = 0;
+    for (int c = 0; c < scene->camera_count; ++c) {
+        if (!scene->cameras[c].is_output) {
+            views[k] = wx_gather_view_from_maps(&scene->cameras[c].camera, &in_maps[k]);
+            k++;
+        }
+    }
+    int cached = 0;
+    wx_result r = WX_OK;
+    for (int i = 0; i < textures->count && r == WX_OK; ++i) {
+        const wx_texture_target *t = &textures->items[i];
+        if (!wx_texture_writes_frame(t->def, frame)) {
+            continue;
+        }
+        int slot = 0;
+        while (slot < cached && !same_smoothing(cache[slot].key, t->def)) {
+            ++slot;
+        }
+        if (slot == cached) {
+            double t0 = wx_now_s();
+            cache[slot].key = t->def;
+            cache[slot].planes = calloc((size_t)planes_per_key + 1, sizeof *cache[slot].planes);
+            cached++;
+            r = cache[slot].planes != NULL
+                    ? compute_planes(scene, opts, in_maps, views, substances, t->def,
+                                     cache[slot].planes, err)
+                    : wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "texture: out of memory");
+            if (detail != NULL) {
+                detail->compute += wx_now_s() - t0;
+            }
+        }
+        if (r == WX_OK) {
+            r = write_texture(scene, opts, t, views, cache[slot].planes, frame, names, channels,
+                              detail, err);
+        }
+        if (r != WX_OK) {
+            wx_error_prefix(err, "texture %s", t->def->file);
+        }
+    }
+    free_planes(cache, cached, planes_per_key);
+    free(views);
+    return r;
+}
+
+int64_t wx_texture_bytes(const wx_scene *scene, const wx_texture_map *t, int64_t camera_texels)
+{
+    char names[WX_IMAGE_MAX_CHANNELS][WX_NAME_MAX];
+    const int64_t channels = wx_texture_channels(scene, names);
+    const int64_t texels = (int64_t)t->width * t->height;
+    // The raster (triangle and source) and its build's count; the image's
+    // channels and the preview's alpha; the compressed chunks written (at most
+    // the image again); every channel but seen on every input camera, and the
+    // gather's planes for one of them (the adaptive pass's 14 floats a texel).
+    return texels * (4 + 4 + 1) + texels * 4 * (channels + 1) + texels * 4 * channels +
+           camera_texels * 4 * (channels - 1) + camera_texels / (scene->input_count > 0 ?
+                                                                 scene->input_count : 1) * 4 * 14;
+}

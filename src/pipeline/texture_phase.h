@@ -1,0 +1,63 @@
+// texture_phase.h: the <TextureMap>s of a scene (docs/design.md section 11,
+// docs/texture.md): each mesh's UV layout rasterised once per run, and after
+// the simulation (and after every k-th iteration with `every`) the texture
+// written with one channel per mask channel and `seen`, with its previews.
+#ifndef WX_TEXTURE_PHASE_H
+#define WX_TEXTURE_PHASE_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "core/error.h"
+#include "gather/texture.h"
+#include "model/geometry.h"
+#include "model/maps.h"
+#include "model/scene.h"
+#include "model/stats.h"
+#include "pipeline/pipeline.h"
+
+/// One <TextureMap>, ready to be sampled: what its mesh needs of the import
+/// (positions, normals, indices and the UV channel, owned copies) and the raster.
+typedef struct wx_texture_target {
+    const wx_texture_map *def;
+    wx_mesh_data mesh;
+    wx_uv_raster raster;
+} wx_texture_target;
+
+/// Every <TextureMap> of a scene, in scene order.
+typedef struct wx_textures {
+    int count;
+    wx_texture_target *items;
+} wx_textures;
+
+/// Rasterises every <TextureMap> from `geometry` (imported by
+/// wx_geometry_load with the UV channels they read, before the bake releases
+/// its arrays), and says for each what `info` says (coverage, overlaps,
+/// triangles outside the tile) unless quiet. An empty set when the scene has none.
+wx_result wx_textures_prepare(const wx_scene *scene, const wx_geometry *geometry,
+                              const wx_run_def *opts, wx_textures *out, wx_error *err);
+
+/// Frees everything; the struct is zeroed.
+void wx_textures_free(wx_textures *textures);
+
+/// Whether frame `frame` (0: the final files) writes texture `t`.
+bool wx_texture_writes_frame(const wx_texture_map *t, int frame);
+
+/// Writes the textures of frame `frame` from the input cameras' maps in memory
+/// (in_maps: one per input camera in scene order, depth, normal and the dirt
+/// planes a gather reads): frame 0 every texture's BASE.exr and previews,
+/// frame k > 0 BASE.NNNN.exr for those whose `every` divides k. `detail` (may be
+/// NULL) gets the compute and write times added.
+wx_result wx_textures_write(const wx_scene *scene, const wx_run_def *opts,
+                            const wx_textures *textures, const wx_maps *in_maps, int frame,
+                            wx_phase_detail *detail, wx_error *err);
+
+/// The texture's channels: the mask's (section 10) and `seen`. Returns the count.
+int wx_texture_channels(const wx_scene *scene, char names[][WX_NAME_MAX]);
+
+/// What `info` and the memory check count for texture `t` of `scene` whose
+/// smoothing runs on input cameras of `camera_texels` texels in all: bytes at
+/// the peak of writing it.
+int64_t wx_texture_bytes(const wx_scene *scene, const wx_texture_map *t, int64_t camera_texels);
+
+#endif
