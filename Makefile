@@ -113,7 +113,13 @@ $(BUILD)/tests/%: $(BUILD)/obj/tests/%.o $(TEST_SUPPORT_OBJ) $(BUILD)/libweather
 	@mkdir -p $(dir $@)
 	$(CC) $(ALL_CFLAGS) -o $@ $^ $(LIBS)
 
-test: $(BUILD)/weathering $(VIEWER_BIN) $(TEST_BIN)
+# A CPU renderer of a TextureMap through an orthographic camera (the header of
+# tests/tools/render_texture.c), built with the tests so that they can run it.
+$(BUILD)/tools/render_texture: tests/tools/render_texture.c $(BUILD)/libweathering.a | deps
+	@mkdir -p $(dir $@)
+	$(CC) $(filter-out -MMD -MP,$(ALL_CFLAGS)) -o $@ $^ $(LIBS)
+
+test: $(BUILD)/weathering $(VIEWER_BIN) $(TEST_BIN) $(BUILD)/tools/render_texture
 	WX_BUILD=$(BUILD) WX_TESTS=tests tests/run.sh $(BUILD)/tests
 
 # make test-blender: docs/mask.md's Blender recipe run for real (tests/blender/):

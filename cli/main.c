@@ -27,6 +27,7 @@
 #include "pipeline/outputs.h"
 #include "pipeline/pipeline.h"
 #include "pipeline/run.h"
+#include "pipeline/texture_phase.h"
 #include "sim/emitter.h"
 #include "core/limits.h"
 #include "model/camera.h"
@@ -313,6 +314,52 @@ static void print_camera(const wx_scene *scene, const wx_scene_camera *sc)
     }
 }
 
+// A TextureMap: its mesh, size, UV channel and smoothing; its coverage,
+// overlaps and padding estimated on a raster of at most 1024 texels a side;
+// the triangles outside the tile (exact); its memory.
+static void print_texture(const wx_scene *scene, const wx_texture_map *t, const wx_mesh_data *mesh)
+{
+    printf("texture %s of mesh '%s' (line %d): %d x %d texels over UV channel %d, padding %d",
+           t->file, wx_mesh_display_name(scene, &scene->meshes[t->mesh]), t->line, t->width,
+           t->height, t->uv, t->padding);
+    if (t->every > 0) {
+        printf(", a frame every %d iterations", t->every);
+    }
+    if (!t->adaptive) {
+        printf(", smoothing radius %g", (double)t->radius);
+    } else if (t->max_radius > 0.0f) {
+        printf(", adaptive smoothing (noise %g, maxRadius %g)", (double)t->noise,
+               (double)t->max_radius);
+    } else {
+        printf(", adaptive smoothing (noise %g, maxRadius %g texels of each input camera)",
+               (double)t->noise, (double)WX_DEFAULT_MAX_RADIUS_TEXELS);
+    }
+    printf("\n");
+    double scale = fmin(1.0, 1024.0 / (double)(t->width > t->height ? t->width : t->height));
+    int w = (int)fmax(1.0, round(t->width * scale)), h = (int)fmax(1.0, round(t->height * scale));
+    wx_uv_raster r;
+    wx_error err;
+    if (wx_uv_raster_build(mesh, t->uv, w, h, (int)ceil(t->padding * scale), &r, &err) != WX_OK) {
+        printf("    coverage: not estimated (%s)\n", err.message);
+    } else {
+        double n = (double)w * (double)h;
+        printf("    coverage: about %.1f%% of the texels covered, %.2f%% overlapping, %.1f%% "
+               "padding (on %d x %d); %lld of %lld triangles reach outside the [0,1] tile\n",
+               100.0 * (double)r.covered / n, 100.0 * (double)r.overlapping / n,
+               100.0 * (double)r.padded / n, w, h, (long long)r.triangles_outside,
+               (long long)mesh->triangle_count);
+        wx_uv_raster_free(&r);
+    }
+    int64_t input_texels = 0;
+    for (int c = 0; c < scene->camera_count; ++c) {
+        if (!scene->cameras[c].is_output) {
+            input_texels += (int64_t)scene->cameras[c].camera.width * scene->cameras[c].camera.height;
+        }
+    }
+    printf("    memory: about %.0f MiB to write it\n",
+           (double)wx_texture_bytes(scene, t, input_texels) / (1024.0 * 1024.0));
+}
+
 static int command_info(const cli_args *args)
 {
     wx_scene scene;
@@ -326,7 +373,7 @@ static int command_info(const cli_args *args)
     // memory, which it reports), before it prints anything.
     wx_geometry geometry;
     memset(&geometry, 0, sizeof geometry);
-    bool imported = wx_scene_needs_bake(&scene);
+    bool imported = wx_scene_needs_bake(&scene) || scene.texture_count > 0;
     wx_error err;
     wx_result r = wx_gather_check(&scene, &err);
     if (r == WX_OK) {
@@ -494,6 +541,9 @@ static int command_info(const cli_args *args)
                        mesh->surfaces[g->surface[k]].material);
             }
         }
+    }
+    for (int t = 0; t < scene.texture_count; ++t) {
+        print_texture(&scene, &scene.textures[t], &geometry.meshes[scene.textures[t].mesh].data);
     }
     // The pilot uses the geometry up (its arrays go to the renderer).
     wx_pilot_report pilot;

@@ -12,6 +12,7 @@
 
 #include "model/maps.h"
 #include "pipeline/outputs.h"
+#include "pipeline/texture_phase.h"
 #include "sim/emitter.h"
 
 void wx_memory_estimate(const wx_scene *scene, unsigned phases, wx_memory_need *need)
@@ -79,6 +80,18 @@ void wx_memory_estimate(const wx_scene *scene, unsigned phases, wx_memory_need *
     }
     // The mask: the gather's planes per output texel, one plane per substance.
     double gather_out = WX_GATHER_BYTES_PER_OUTPUT_TEXEL + WX_PLANE_BYTES_PER_TEXEL * (S - 1);
+    bool textures = scene->texture_count > 0 && (phases & (WX_PHASE_SIMULATE | WX_PHASE_GATHER));
+    bool texture_frames = false;
+    for (int t = 0; textures && t < scene->texture_count; ++t) {
+        const wx_texture_map *tm = &scene->textures[t];
+        double texels = (double)tm->width * (double)tm->height;
+        need->texture_raster_bytes += WX_TEXTURE_RASTER_BYTES_PER_TEXEL * texels;
+        need->texture_write_bytes = fmax(need->texture_write_bytes,
+                                         (double)wx_texture_bytes(scene, tm,
+                                                                  (int64_t)input_texels) -
+                                             WX_TEXTURE_RASTER_BYTES_PER_TEXEL * texels);
+        texture_frames = texture_frames || (tm->every > 0 && iterations >= (double)tm->every);
+    }
     if (phases & WX_PHASE_SIMULATE) {
         double per_input = WX_SIM_BYTES_PER_INPUT_TEXEL +
                            WX_SIM_BYTES_PER_SUBSTANCE_TEXEL * (S - 1) +
@@ -97,12 +110,17 @@ void wx_memory_estimate(const wx_scene *scene, unsigned phases, wx_memory_need *
         if (out != NULL && out->every > 0 && iterations >= (double)out->every) {
             need->frame_bytes = planes * input_texels + gather_out * output_texels;
         }
+        if (texture_frames) {
+            need->frame_bytes = fmax(need->frame_bytes, planes * input_texels) +
+                                need->texture_write_bytes;
+        }
         // Without frames, a run that bakes keeps the output camera's depth and
         // normal through the simulation for its gather.
         double kept = need->frame_bytes == 0.0 && bake && (phases & WX_PHASE_GATHER)
                           ? WX_BAKE_OUTPUT_IMAGE_BYTES_PER_TEXEL * output_texels
                           : 0.0;
-        need->sim_map_bytes = per_input * input_texels + fmax(write, need->frame_bytes) + kept;
+        need->sim_map_bytes = per_input * input_texels + fmax(write, need->frame_bytes) + kept +
+                              need->texture_raster_bytes;
         largest = -1.0;
         double duration = wx_scene_duration(scene);
         for (int e = 0; e < scene->emitter_count; ++e) {
@@ -121,7 +139,8 @@ void wx_memory_estimate(const wx_scene *scene, unsigned phases, wx_memory_need *
         need->gather_bytes =
             (WX_GATHER_BYTES_PER_INPUT_TEXEL + WX_PLANE_BYTES_PER_TEXEL * simulated_extra) *
                 input_texels +
-            gather_out * output_texels;
+            gather_out * (out != NULL ? output_texels : 0.0) + need->texture_raster_bytes +
+            need->texture_write_bytes;
     }
     // The renderer leaves part of its memory behind for the phases after it.
     double residue = need->bake_bytes > 0.0 ? WX_BAKE_RESIDUE_BYTES : 0.0;

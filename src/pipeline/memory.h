@@ -23,6 +23,11 @@ typedef struct wx_memory_need {
                                ///< substance beyond the first
     double particle_bytes;     ///< as if every particle emitted were alive at once
     double gather_bytes;       ///< the gather: the maps it reads, its planes, the files it writes
+    /// TextureMaps (docs/texture.md): their UV rasters, held from the start of
+    /// the run to its end, and the largest one's writing (its image and the
+    /// mask on every input camera), part of gather_bytes and of a frame's.
+    double texture_raster_bytes;
+    double texture_write_bytes;
     double total_bytes;        ///< baseline + the largest phase
     const char *phase;         ///< the largest phase: "bake", "simulation" or "gather"
     int substances;            ///< the scene's substances (1 without <Substances>)

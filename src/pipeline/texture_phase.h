@@ -55,6 +55,9 @@ wx_result wx_textures_write(const wx_scene *scene, const wx_run_def *opts,
 /// The texture's channels: the mask's (section 10) and `seen`. Returns the count.
 int wx_texture_channels(const wx_scene *scene, char names[][WX_NAME_MAX]);
 
+/// Bytes per texel of a UV raster while it is held (triangle and source).
+#define WX_TEXTURE_RASTER_BYTES_PER_TEXEL 8.0
+
 /// What `info` and the memory check count for texture `t` of `scene` whose
 /// smoothing runs on input cameras of `camera_texels` texels in all: bytes at
 /// the peak of writing it.

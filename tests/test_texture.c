@@ -1,0 +1,537 @@
+// test_texture.c: texture-space output (docs/design.md section 11, docs/texture.md)
+// against answers worked out independently: the UV raster's coverage, tie rule,
+// overlaps and padding counted by brute force; a cube whose six faces are six
+// islands of a known atlas under vertical rain (the top holds the flux, the
+// sides 0, the unseen bottom `seen` 0, padding equal to the island's edge); a
+// latitude-longitude sphere whose texels follow flux x max(0, N.y) with no
+// seam; the texture seen through the output camera against the mask.
+#define _XOPEN_SOURCE 700 // realpath
+#include <limits.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "ensure.h"
+#include "gather/texture.h"
+#include "io/exr.h"
+#include "model/image.h"
+#include "sphere_fixture.h"
+
+static char out[65536];
+
+static const char *data_file(const char *name)
+{
+    static char path[PATH_MAX + 64], dir[PATH_MAX];
+    if (realpath(ensure_tests_dir(), dir) == NULL) {
+        return name;
+    }
+    snprintf(path, sizeof path, "%s/data/%s", dir, name);
+    return path;
+}
+
+static int run_in(const char *dir, const char *args)
+{
+    char build[PATH_MAX];
+    if (realpath(ensure_build_dir(), build) == NULL) {
+        return -1;
+    }
+    int status = ensure_shell(out, sizeof out, "cd '%s' && '%s/weathering' %s 2>&1", dir, build,
+                              args);
+    if (status != 0) {
+        fprintf(stderr, "        %s", out);
+    }
+    return status;
+}
+
+// Reads the named channels of an EXR; false with a note on failure.
+static bool read_channels(const char *path, const char *const *names, int count, wx_image *image)
+{
+    wx_error err;
+    if (wx_exr_read(path, names, count, image, &err) != WX_OK) {
+        fprintf(stderr, "        %s\n", err.message);
+        return false;
+    }
+    return true;
+}
+
+// ---------------------------------------------------------------------------
+// The raster.
+
+// A square [0.25, 0.75]^2 of UV made of two triangles (a shared diagonal),
+// positions equal to (u, v, 0), optionally drawn twice.
+static void square_mesh(wx_mesh_data *m, float *positions, float *normals, float *uvs,
+                        uint32_t *indices, bool twice)
+{
+    static const float corners[4][2] = { { 0.25f, 0.25f }, { 0.75f, 0.25f }, { 0.75f, 0.75f },
+                                         { 0.25f, 0.75f } };
+    static const uint32_t tris[12] = { 0, 1, 2, 0, 2, 3, 0, 1, 2, 0, 2, 3 };
+    memset(m, 0, sizeof *m);
+    for (int k = 0; k < 4; ++k) {
+        positions[3 * k] = corners[k][0];
+        positions[3 * k + 1] = corners[k][1];
+        positions[3 * k + 2] = 0.0f;
+        normals[3 * k] = normals[3 * k + 1] = 0.0f;
+        normals[3 * k + 2] = 1.0f;
+        uvs[2 * k] = corners[k][0];
+        uvs[2 * k + 1] = corners[k][1];
+    }
+    memcpy(indices, tris, sizeof tris);
+    m->vertex_count = 4;
+    m->triangle_count = twice ? 4 : 2;
+    m->positions = positions;
+    m->normals = normals;
+    m->indices = indices;
+    m->uvs[0] = uvs;
+}
+
+// 16 x 16 texels: centres (i + 1/2)/16 inside [0.25, 0.75] are i = 4..11, so
+// 64 covered, the shared diagonal's centres once; drawn twice, all 64 overlap.
+// Padding 2 reaches exactly the texels within 2 texel centres of a covered one.
+TEST(uv_raster_counts_ties_overlaps_and_padding)
+{
+    float positions[12], normals[12], uvs[8];
+    uint32_t indices[12];
+    wx_mesh_data mesh;
+    wx_uv_raster r;
+    wx_error err;
+    square_mesh(&mesh, positions, normals, uvs, indices, false);
+    ENSURE(wx_uv_raster_build(&mesh, 0, 16, 16, 2, &r, &err) == WX_OK);
+    ENSURE(r.covered == 64 && r.overlapping == 0 && r.triangles_outside == 0);
+    int64_t padded = 0, nearest_ok = 0;
+    for (int j = 0; j < 16; ++j) {
+        for (int i = 0; i < 16; ++i) {
+            size_t t = (size_t)j * 16 + (size_t)i;
+            bool inside = i >= 4 && i <= 11 && j >= 4 && j <= 11;
+            ENSURE(inside == (r.triangle[t] >= 0));
+            // Brute force: the squared distance to the nearest covered centre.
+            int best = INT_MAX;
+            for (int b = 4; b <= 11; ++b) {
+                for (int a = 4; a <= 11; ++a) {
+                    int d = (a - i) * (a - i) + (b - j) * (b - j);
+                    best = d < best ? d : best;
+                }
+            }
+            if (!inside && best <= 4) {
+                padded++;
+                int s = r.source[t];
+                int si = s % 16, sj = s / 16;
+                nearest_ok += s >= 0 && r.triangle[s] >= 0 &&
+                              (si - i) * (si - i) + (sj - j) * (sj - j) == best;
+            } else if (!inside) {
+                ENSURE(r.source[t] == -1);
+            } else {
+                ENSURE(r.source[t] == (int32_t)t);
+            }
+        }
+    }
+    ENSURE(r.padded == padded && nearest_ok == padded);
+    // The surface point of a texel: the position interpolated at its centre.
+    double p[3];
+    float n[3];
+    size_t t = 5 * 16 + 9; // centre u = 9.5/16, v = 1 - 5.5/16
+    ENSURE(wx_uv_raster_point(&mesh, 0, &r, t, p, n));
+    ENSURE_NEAR(p[0], 9.5 / 16.0, 1e-6);
+    ENSURE_NEAR(p[1], 1.0 - 5.5 / 16.0, 1e-6);
+    ENSURE_NEAR(n[2], 1.0, 1e-6);
+    wx_uv_raster_free(&r);
+
+    square_mesh(&mesh, positions, normals, uvs, indices, true);
+    ENSURE(wx_uv_raster_build(&mesh, 0, 16, 16, 0, &r, &err) == WX_OK);
+    ENSURE(r.covered == 64 && r.overlapping == 64 && r.padded == 0);
+    bool first_wins = true;
+    for (size_t k = 0; k < 256; ++k) {
+        first_wins = first_wins && r.triangle[k] < 2; // the lower index of the pair
+    }
+    ENSURE(first_wins);
+    wx_uv_raster_free(&r);
+}
+
+// ---------------------------------------------------------------------------
+// The cube atlas.
+
+// Cameras above and on the four sides (none below), a flat box raining
+// straight down on 1.6 x 1.6 m, absorption 1, no output camera.
+static const char *cube_scene =
+    "<Weathering>\n"
+    "  <Solver><BoundingBox size=\"4\" centerY=\"1\"/>\n"
+    "    <Simulation timeStep=\"0.02\" steps=\"40\" seed=\"3\" iterations=\"%d\"/></Solver>\n"
+    "  <Emitters>\n"
+    "    <BoxEmitter minX=\"-0.8\" minY=\"2\" minZ=\"-0.8\" maxX=\"0.8\" maxY=\"2\" maxZ=\"0.8\"\n"
+    "                rate=\"%d\" end=\"0.5\" speed=\"10\"/>\n"
+    "  </Emitters>\n"
+    "  <Collider>\n"
+    "    <ProjectedMaps>\n"
+    "      <Ortho cameraName=\"top\"><View eye=\"0 5 0\" target=\"0 0 0\" up=\"0 0 -1\"\n"
+    "        width=\"1.6\" height=\"1.6\" resolution=\"256\"/></Ortho>\n"
+    "      <Ortho cameraName=\"px\"><View eye=\"5 0.5 0\" target=\"0 0.5 0\"\n"
+    "        width=\"1.6\" height=\"1.6\" resolution=\"256\"/></Ortho>\n"
+    "      <Ortho cameraName=\"nx\"><View eye=\"-5 0.5 0\" target=\"0 0.5 0\"\n"
+    "        width=\"1.6\" height=\"1.6\" resolution=\"256\"/></Ortho>\n"
+    "      <Ortho cameraName=\"pz\"><View eye=\"0 0.5 5\" target=\"0 0.5 0\"\n"
+    "        width=\"1.6\" height=\"1.6\" resolution=\"256\"/></Ortho>\n"
+    "      <Ortho cameraName=\"nz\"><View eye=\"0 0.5 -5\" target=\"0 0.5 0\"\n"
+    "        width=\"1.6\" height=\"1.6\" resolution=\"256\"/></Ortho>\n"
+    "    </ProjectedMaps>\n"
+    "  </Collider>\n"
+    "  <Geometry>\n"
+    "    <Mesh file=\"%s\">\n"
+    "      <Surface material=\"*\" absorption=\"1\"/>\n"
+    "      <TextureMap file=\"cube.exr\" width=\"768\" height=\"512\" padding=\"8\" every=\"%d\"/>\n"
+    "    </Mesh>\n"
+    "  </Geometry>\n"
+    "</Weathering>\n";
+
+// The islands of texture_cube.obj on 768 x 512 texels (tests/tools/gen_uv_meshes.py):
+// columns 16..239, 272..495, 528..751; rows 16..239 (top row of cells) and
+// 272..495: +Y, -Y, +X on the first row, -X, +Z, -Z on the second.
+typedef struct island {
+    const char *face;
+    int i0, j0; // first covered texel; 224 x 224 texels each
+} island;
+
+static const island cube_islands[6] = {
+    { "+Y", 16, 16 },   { "-Y", 272, 16 },  { "+X", 528, 16 },
+    { "-X", 16, 272 },  { "+Z", 272, 272 }, { "-Z", 528, 272 },
+};
+
+enum { ISLAND = 224, CUBE_W = 768, CUBE_H = 512 };
+
+TEST(cube_atlas_under_vertical_rain)
+{
+    const char *dir = ensure_tmpdir();
+    const int particles = 400000;
+    char text[8192];
+    snprintf(text, sizeof text, cube_scene, 1, 2 * particles, data_file("texture_cube.obj"), 0);
+    ensure_write_file(dir, "cube.xml", text);
+    ENSURE(run_in(dir, "run cube.xml --out cube -q") == 0);
+    char path[PATH_MAX];
+    snprintf(path, sizeof path, "%s/cube/cube.exr", dir);
+    static const char *const names[] = { "Y", "seen" };
+    wx_image img;
+    ENSURE(read_channels(path, names, 2, &img));
+    ENSURE(img.width == CUBE_W && img.height == CUBE_H);
+    const float *y = img.channels[0], *seen = img.channels[1];
+    // rate x end particles over 1.6 x 1.6 m: the flux through the top face.
+    const double flux = particles / (1.6 * 1.6);
+
+    // The top island holds the flux: its mean within 2%, its RMSE within 8%.
+    double sum = 0.0, se = 0.0;
+    int64_t n = 0;
+    for (int j = 16; j < 16 + ISLAND; ++j) {
+        for (int i = 16; i < 16 + ISLAND; ++i) {
+            double v = y[(size_t)j * CUBE_W + (size_t)i];
+            sum += v;
+            se += (v - flux) * (v - flux);
+            n += seen[(size_t)j * CUBE_W + (size_t)i] == 1.0f;
+        }
+    }
+    double mean = sum / (ISLAND * ISLAND), rmse = sqrt(se / (ISLAND * ISLAND)) / flux;
+    printf("        top island: mean %.1f of %.1f per m^2 (%.2f%%), RMSE %.2f%%\n", mean, flux,
+           100.0 * (mean / flux - 1.0), 100.0 * rmse);
+    ENSURE(n == ISLAND * ISLAND);
+    ENSURE_NEAR(mean / flux, 1.0, 0.02);
+    ENSURE(rmse <= 0.08);
+
+    // The sides: seen by their cameras, no rain reaches them. The bottom: no
+    // camera below, so not seen and 0.
+    for (int k = 1; k < 6; ++k) {
+        const island *is = &cube_islands[k];
+        double largest = 0.0;
+        int64_t seen_count = 0;
+        for (int j = is->j0; j < is->j0 + ISLAND; ++j) {
+            for (int i = is->i0; i < is->i0 + ISLAND; ++i) {
+                size_t t = (size_t)j * CUBE_W + (size_t)i;
+                largest = fmax(largest, fabs(y[t]));
+                seen_count += seen[t] == 1.0f;
+            }
+        }
+        printf("        %s island: largest value %g, %lld texels seen\n", is->face, largest,
+               (long long)seen_count);
+        ENSURE(largest <= 1e-6 * flux);
+        ENSURE(seen_count == (k == 1 ? 0 : ISLAND * ISLAND));
+    }
+
+    // Padding: the 8 rows above the top island take its top row's values,
+    // bit for bit, and the 9th is empty; the gaps between islands, 9 texels or
+    // more from any of them, hold 0 and seen 0.
+    int64_t equal = 0, checked = 0;
+    for (int i = 16; i < 16 + ISLAND; ++i) {
+        size_t edge = (size_t)16 * CUBE_W + (size_t)i;
+        for (int j = 8; j < 16; ++j) {
+            size_t t = (size_t)j * CUBE_W + (size_t)i;
+            equal += y[t] == y[edge] && seen[t] == 1.0f;
+            checked++;
+        }
+        ENSURE(y[(size_t)7 * CUBE_W + (size_t)i] == 0.0f && seen[(size_t)7 * CUBE_W + (size_t)i] == 0.0f);
+    }
+    ENSURE(equal == checked);
+    int64_t stray = 0;
+    for (int j = 0; j < CUBE_H; ++j) {
+        for (int i = 0; i < CUBE_W; ++i) {
+            bool gap = (j >= 248 && j <= 263) || (i >= 248 && i <= 263) || (i >= 504 && i <= 519);
+            size_t t = (size_t)j * CUBE_W + (size_t)i;
+            stray += gap && (y[t] != 0.0f || seen[t] != 0.0f);
+        }
+    }
+    ENSURE(stray == 0);
+    wx_image_free(&img);
+}
+
+// With iterations and every="1" the texture is an image sequence whose last
+// frame holds what the final file holds.
+TEST(cube_texture_frames)
+{
+    const char *dir = ensure_tmpdir();
+    char text[8192];
+    snprintf(text, sizeof text, cube_scene, 2, 100000, data_file("texture_cube.obj"), 1);
+    ensure_write_file(dir, "frames.xml", text);
+    ENSURE(run_in(dir, "run frames.xml --out frames -q") == 0);
+    char final_path[PATH_MAX], frame1[PATH_MAX], frame2[PATH_MAX], frame3[PATH_MAX];
+    snprintf(final_path, sizeof final_path, "%s/frames/cube.exr", dir);
+    snprintf(frame1, sizeof frame1, "%s/frames/cube.0001.exr", dir);
+    snprintf(frame2, sizeof frame2, "%s/frames/cube.0002.exr", dir);
+    snprintf(frame3, sizeof frame3, "%s/frames/cube.0003.exr", dir);
+    static const char *const names[] = { "Y", "seen" };
+    wx_image a, b, c;
+    ENSURE(read_channels(final_path, names, 2, &a));
+    ENSURE(read_channels(frame2, names, 2, &b));
+    ENSURE(read_channels(frame1, names, 2, &c));
+    size_t texels = (size_t)CUBE_W * CUBE_H;
+    ENSURE(memcmp(a.channels[0], b.channels[0], texels * sizeof(float)) == 0);
+    ENSURE(memcmp(a.channels[1], b.channels[1], texels * sizeof(float)) == 0);
+    // After one iteration of two, the top holds about half of the final dirt.
+    double first = 0.0, last = 0.0;
+    for (size_t t = 0; t < texels; ++t) {
+        first += c.channels[0][t];
+        last += a.channels[0][t];
+    }
+    ENSURE_NEAR(first / last, 0.5, 0.03);
+    ENSURE(ensure_read_file(frame3) == NULL);
+    wx_image_free(&a);
+    wx_image_free(&b);
+    wx_image_free(&c);
+}
+
+// ---------------------------------------------------------------------------
+// The latitude-longitude sphere.
+
+static const char *sphere_scene =
+    "<Weathering>\n"
+    "  <Solver><BoundingBox size=\"4\"/>\n"
+    "    <Simulation timeStep=\"0.02\" steps=\"60\" seed=\"1\"/></Solver>\n"
+    "  <Emitters>\n"
+    "    <BoxEmitter minX=\"-1.2\" minY=\"1.2\" minZ=\"-1.2\" maxX=\"1.2\" maxY=\"1.2\" maxZ=\"1.2\"\n"
+    "                rate=\"%d\" end=\"1\" speed=\"10\"/>\n"
+    "  </Emitters>\n"
+    "  <Collider>\n"
+    "    <ProjectedMaps>\n"
+    "      <Ortho cameraName=\"top\"><View eye=\"0 5 0\" target=\"0 0 0\" up=\"0 0 -1\"\n"
+    "        width=\"2.4\" height=\"2.4\" resolution=\"1024\"/></Ortho>\n"
+    "      <Ortho cameraName=\"px\"><View eye=\"5 0 0\" target=\"0 0 0\"\n"
+    "        width=\"2.4\" height=\"2.4\" resolution=\"512\"/></Ortho>\n"
+    "      <Ortho cameraName=\"nx\"><View eye=\"-5 0 0\" target=\"0 0 0\"\n"
+    "        width=\"2.4\" height=\"2.4\" resolution=\"512\"/></Ortho>\n"
+    "      <Ortho cameraName=\"pz\"><View eye=\"0 0 5\" target=\"0 0 0\"\n"
+    "        width=\"2.4\" height=\"2.4\" resolution=\"512\"/></Ortho>\n"
+    "      <Ortho cameraName=\"nz\"><View eye=\"0 0 -5\" target=\"0 0 0\"\n"
+    "        width=\"2.4\" height=\"2.4\" resolution=\"512\"/></Ortho>\n"
+    "      <Ortho cameraName=\"shot\" out=\"true\"><View eye=\"0 5 0\" target=\"0 0 0\"\n"
+    "        up=\"0 0 -1\" width=\"2.4\" height=\"2.4\" resolution=\"1024\"/>\n"
+    "        <OutputMap file=\"mask.exr\"/></Ortho>\n"
+    "    </ProjectedMaps>\n"
+    "  </Collider>\n"
+    "  <Geometry>\n"
+    "    <Mesh file=\"%s\">\n"
+    "      <Surface material=\"*\" absorption=\"1\"/>\n"
+    "      <TextureMap file=\"sphere.exr\" width=\"1024\" height=\"512\"/>\n"
+    "    </Mesh>\n"
+    "  </Geometry>\n"
+    "</Weathering>\n";
+
+static bool sphere_ran;
+static const double sphere_particles = 2e6;
+
+static const char *sphere_run(void)
+{
+    static char dir[PATH_MAX];
+    if (!sphere_ran) {
+        snprintf(dir, sizeof dir, "%s", ensure_tmpdir());
+        char text[8192];
+        snprintf(text, sizeof text, sphere_scene, (int)sphere_particles,
+                 data_file("uv_sphere.obj"));
+        ensure_write_file(dir, "sphere.xml", text);
+        sphere_ran = run_in(dir, "run sphere.xml --out sphere -q") == 0;
+    }
+    return sphere_ran ? dir : NULL;
+}
+
+// N.y of texel row j of the latitude-longitude layout (v = 1 at the north pole).
+static double row_ny(int j, int h)
+{
+    double v = 1.0 - (j + 0.5) / h;
+    return sin((v - 0.5) * SPHERE_PI);
+}
+
+// The texels follow (N/A) max(0, N.y) within the noise the mask has at the same
+// density (the same run's mask through a camera looking down), and the two
+// columns on either side of the seam agree as closely as interior neighbours.
+TEST(uv_sphere_follows_the_flux_without_a_seam)
+{
+    const char *dir = sphere_run();
+    ENSURE(dir != NULL);
+    if (dir == NULL) {
+        return;
+    }
+    char path[PATH_MAX];
+    snprintf(path, sizeof path, "%s/sphere/sphere.exr", dir);
+    static const char *const names[] = { "Y", "seen" };
+    wx_image img;
+    ENSURE(read_channels(path, names, 2, &img));
+    const int W = img.width, H = img.height;
+    const float *y = img.channels[0];
+    // Each texel weighs its area on the sphere (cos latitude = sqrt(1 - ny^2)).
+    double se = 0.0, sw = 0.0, ring_sum[7] = { 0 }, ring_want[7] = { 0 };
+    double seam = 0.0, inner = 0.0;
+    int64_t seam_n = 0, inner_n = 0;
+    for (int j = 0; j < H; ++j) {
+        double ny = row_ny(j, H);
+        if (ny <= 0.3) {
+            continue;
+        }
+        double want = sphere_box_density(ny, sphere_particles);
+        double area = sqrt(1.0 - ny * ny);
+        int ring = (int)((ny - 0.3) * 10.0);
+        ring = ring > 6 ? 6 : ring;
+        for (int i = 0; i < W; ++i) {
+            double v = y[(size_t)j * (size_t)W + (size_t)i];
+            se += area * (v - want) * (v - want) / (want * want);
+            sw += area;
+            ring_sum[ring] += area * v;
+            ring_want[ring] += area * want;
+            if (i + 1 < W) {
+                inner += fabs(v - y[(size_t)j * (size_t)W + (size_t)i + 1]);
+                inner_n++;
+            }
+        }
+        seam += fabs(y[(size_t)j * (size_t)W] - y[(size_t)j * (size_t)W + (size_t)W - 1]);
+        seam_n++;
+    }
+    double rmse = sqrt(se / sw), worst = 0.0;
+    for (int r = 0; r < 7; ++r) {
+        worst = fmax(worst, fabs(ring_sum[r] / ring_want[r] - 1.0));
+    }
+    double seam_step = seam / (double)seam_n, inner_step = inner / (double)inner_n;
+    wx_image_free(&img);
+
+    snprintf(path, sizeof path, "%s/sphere/mask.exr", dir);
+    int mw, mh;
+    float *mask = sphere_read_mask(path, &mw, &mh);
+    ENSURE(mask != NULL);
+    double mask_rmse = 0.0, mask_ring = 0.0;
+    if (mask != NULL) {
+        sphere_errors(mask, mw, mh, sphere_box_density, sphere_particles, &mask_rmse, &mask_ring);
+        free(mask);
+    }
+    printf("        texture: relative RMSE %.4f, worst ring %.4f; the mask: %.4f, %.4f\n", rmse,
+           worst, mask_rmse, mask_ring);
+    printf("        seam step %.1f, interior neighbours' step %.1f (ratio %.2f)\n", seam_step,
+           inner_step, seam_step / inner_step);
+    ENSURE(rmse <= fmax(1.5 * mask_rmse, mask_rmse + 0.02));
+    ENSURE(worst <= 0.03);
+    ENSURE(seam_step <= 1.5 * inner_step);
+}
+
+// The texture seen through the output camera (tests/tools/render_texture.c,
+// bilinear in the texture) against the mask of the same run: both are the same
+// function of the surface, so they agree within the noise.
+TEST(texture_through_the_output_camera_equals_the_mask)
+{
+    const char *dir = sphere_run();
+    ENSURE(dir != NULL);
+    if (dir == NULL) {
+        return;
+    }
+    char build[PATH_MAX];
+    ENSURE(realpath(ensure_build_dir(), build) != NULL);
+    int status = ensure_shell(out, sizeof out,
+                              "cd '%s' && '%s/tools/render_texture' '%s' sphere/sphere.exr "
+                              "--view '0 5 0 0 0 0 0 0 -1 2.4 2.4 1024' --exr sphere/through.exr "
+                              "2>&1",
+                              dir, build, data_file("uv_sphere.obj"));
+    if (status != 0) {
+        fprintf(stderr, "        %s", out);
+    }
+    ENSURE(status == 0);
+    char path[PATH_MAX];
+    snprintf(path, sizeof path, "%s/sphere/through.exr", dir);
+    static const char *const names[] = { "Y", "seen" };
+    wx_image img;
+    ENSURE(read_channels(path, names, 2, &img));
+    snprintf(path, sizeof path, "%s/sphere/mask.exr", dir);
+    int mw, mh;
+    float *mask = sphere_read_mask(path, &mw, &mh);
+    ENSURE(mask != NULL && mw == img.width && mh == img.height);
+    if (mask == NULL || mw != img.width || mh != img.height) {
+        free(mask);
+        wx_image_free(&img);
+        return;
+    }
+    // Over the pixels whose surface has n.y > 0.3 (within 0.95 of the centre's
+    // distance: n.y = sqrt(1 - r^2)).
+    double sa = 0.0, sb = 0.0, sd = 0.0, sm = 0.0;
+    int64_t n = 0;
+    for (int j = 0; j < mh; ++j) {
+        for (int i = 0; i < mw; ++i) {
+            double x = ((i + 0.5) / mw - 0.5) * 2.4, z = ((j + 0.5) / mh - 0.5) * 2.4;
+            double r2 = x * x + z * z;
+            if (r2 >= 1.0 || sqrt(1.0 - r2) <= 0.3) {
+                continue;
+            }
+            size_t t = (size_t)j * (size_t)mw + (size_t)i;
+            double a = img.channels[0][t], b = mask[t];
+            sa += a;
+            sb += b;
+            sd += (a - b) * (a - b);
+            sm += b * b;
+            n += img.channels[1][t] > 0.5f;
+        }
+    }
+    double ratio = sa / sb, rel = sqrt(sd / sm);
+    printf("        texture through the camera / mask: mean ratio %.4f, relative RMS "
+           "difference %.4f\n",
+           ratio, rel);
+    ENSURE(n > 500000);
+    ENSURE_NEAR(ratio, 1.0, 0.02);
+    ENSURE(rel <= 0.08);
+    free(mask);
+    wx_image_free(&img);
+}
+
+// A mesh without texture coordinates is refused before any work: exit 2, the
+// scene's line and the mesh file named, no output folder.
+TEST(mesh_without_uvs_is_refused)
+{
+    const char *dir = ensure_tmpdir();
+    char text[8192];
+    snprintf(text, sizeof text, cube_scene, 1, 1000, data_file("bake_box.obj"), 0);
+    ensure_write_file(dir, "nouv.xml", text);
+    ENSURE(run_in(dir, "run nouv.xml --out nouv -q") == 2);
+    ENSURE(strstr(out, "nouv.xml:") != NULL);
+    ENSURE(strstr(out, "bake_box.obj") != NULL);
+    ENSURE(strstr(out, "texture coordinates") != NULL);
+    char folder[PATH_MAX];
+    snprintf(folder, sizeof folder, "%s/nouv", dir);
+    ENSURE(ensure_shell(out, sizeof out, "test -e '%s'", folder) != 0);
+}
+
+int main(void)
+{
+    RUN(uv_raster_counts_ties_overlaps_and_padding);
+    RUN(cube_atlas_under_vertical_rain);
+    RUN(cube_texture_frames);
+    RUN(uv_sphere_follows_the_flux_without_a_seam);
+    RUN(texture_through_the_output_camera_equals_the_mask);
+    RUN(mesh_without_uvs_is_refused);
+    return ensure_summary();
+}
