@@ -356,7 +356,7 @@ static void print_texture(const wx_scene *scene, const wx_texture_map *t, const 
             input_texels += (int64_t)scene->cameras[c].camera.width * scene->cameras[c].camera.height;
         }
     }
-    printf("    memory: about %.0f MiB to write it\n",
+    printf("    writing it needs about %.0f MiB\n",
            (double)wx_texture_bytes(scene, t, input_texels) / (1024.0 * 1024.0));
 }
 

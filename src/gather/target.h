@@ -1,13 +1,14 @@
 // target.h: where a gather evaluates the mask: a set of texels, each standing
 // for one surface point with a world position and a normal (docs/architecture.md).
 //
-// Today a target is made by a camera: the output camera's depth and normal
-// maps, the point of texel (i, j) its centre at the depth the map holds, and
-// the second pass smooths over the camera's texel grid. A UV layout (a
-// TextureMap) is the next kind: the same first pass at positions rasterised in
-// the mesh's UV space, smoothed in world space. A new kind adds a case to
-// wx_target_kind and its construction; the passes read the target only through
-// this struct.
+// A target is made by a camera: the output camera's (or an input camera's)
+// depth and normal maps, the point of texel (i, j) its centre at the depth the
+// map holds, and the second pass smooths over the camera's texel grid. A UV
+// layout (a TextureMap, gather/texture.h) is not a target of its own: its
+// texels sample the masks computed on the input cameras' targets, so that its
+// smoothing runs along the surface in world space and ignores UV seams. A new
+// kind adds a case to wx_target_kind and its construction; the passes read the
+// target only through this struct.
 #ifndef WX_TARGET_H
 #define WX_TARGET_H
 

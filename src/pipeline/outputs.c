@@ -4,6 +4,8 @@
 #define _XOPEN_SOURCE 700 // realpath
 #include "pipeline/outputs.h"
 
+#include "pipeline/gather_phase.h"
+
 #include <errno.h>
 #include <limits.h>
 #include <stdarg.h>
@@ -52,6 +54,31 @@ static wx_result add_name(wx_output_names *list, int64_t *capacity, const char *
     return WX_OK;
 }
 
+// The previews of the channels of a file BASE.exr with <Substances> (BASE.png
+// without them is listed by the caller for the mask; a texture lists it here),
+// and its frames BASE.NNNN.exr for every k-th iteration.
+static wx_result add_sequence(const wx_scene *scene, const char *file, int every,
+                              wx_output_names *out, int64_t *capacity)
+{
+    char name[WX_OUTPUT_NAME_MAX];
+    wx_result r = WX_OK;
+    bool mask = scene->output_index >= 0 &&
+                strcmp(scene->cameras[scene->output_index].output_file, file) == 0;
+    if (!scene->substances_declared && !mask) {
+        wx_preview_name(file, name, sizeof name);
+        r = add_name(out, capacity, "%s", name);
+    }
+    for (int s = 0; s < scene->substance_count && scene->substances_declared && r == WX_OK; ++s) {
+        wx_channel_preview_name(file, scene->substances[s], name, sizeof name);
+        r = add_name(out, capacity, "%s", name);
+    }
+    for (int k = every; every > 0 && k <= scene->iterations && r == WX_OK; k += every) {
+        wx_frame_name(file, k, name, sizeof name);
+        r = add_name(out, capacity, "%s", name);
+    }
+    return r;
+}
+
 wx_result wx_output_names_list(const wx_scene *scene, unsigned phases, wx_output_names *out,
                                wx_error *err)
 {
@@ -76,6 +103,16 @@ wx_result wx_output_names_list(const wx_scene *scene, unsigned phases, wx_output
         r = add_name(out, &capacity, "%s", cam->output_file);
         if (r == WX_OK) {
             r = add_name(out, &capacity, "%s", png);
+        }
+        if (r == WX_OK) {
+            r = add_sequence(scene, cam->output_file, cam->every, out, &capacity);
+        }
+    }
+    for (int t = 0; t < scene->texture_count && r == WX_OK && (phases & WX_PHASE_GATHER); ++t) {
+        const wx_texture_map *tm = &scene->textures[t];
+        r = add_name(out, &capacity, "%s", tm->file);
+        if (r == WX_OK) {
+            r = add_sequence(scene, tm->file, tm->every, out, &capacity);
         }
     }
     if (r != WX_OK) {
