@@ -171,7 +171,7 @@ SAN_ENV := ASAN_OPTIONS=detect_leaks=1:strict_string_checks=1:check_initializati
 sanitize fuzz valgrind: DEB_PACKAGES += clang libclang-rt-dev valgrind
 sanitize: | deps
 	$(MAKE) --no-print-directory BUILD=$(SAN_BUILD) CFLAGS="$(SAN_CFLAGS)" \
-	    $(SAN_BUILD)/weathering $(SAN_BUILD)/weathering-viewer \
+	    $(SAN_BUILD)/weathering $(SAN_BUILD)/weathering-viewer $(SAN_BUILD)/tools/render_texture \
 	    $(TEST_SRC:tests/%.c=$(SAN_BUILD)/tests/%)
 	$(SAN_ENV) WX_BUILD=$(SAN_BUILD) WX_TESTS=tests tests/run.sh $(SAN_BUILD)/tests
 
