@@ -24,8 +24,9 @@
 
 #define SPHERE_PI 3.14159265358979323846
 
-// A UV sphere of radius 1 with smooth normals, as binary PLY.
-static inline bool sphere_write_mesh(const char *path, int stacks, int slices)
+// A UV sphere of radius `radius` with smooth normals, as binary PLY.
+static inline bool sphere_write_mesh_scaled(const char *path, int stacks, int slices,
+                                            double radius)
 {
     FILE *f = fopen(path, "wb");
     if (f == NULL) {
@@ -45,6 +46,9 @@ static inline bool sphere_write_mesh(const char *path, int stacks, int slices)
             v[3] = v[0];
             v[4] = v[1];
             v[5] = v[2];
+            for (int k = 0; k < 3; ++k) {
+                v[k] = (float)(v[k] * radius);
+            }
             fwrite(v, sizeof v, 1, f);
         }
     }
@@ -60,6 +64,12 @@ static inline bool sphere_write_mesh(const char *path, int stacks, int slices)
         }
     }
     return fclose(f) == 0;
+}
+
+// A UV sphere of radius 1 with smooth normals, as binary PLY.
+static inline bool sphere_write_mesh(const char *path, int stacks, int slices)
+{
+    return sphere_write_mesh_scaled(path, stacks, slices, 1.0);
 }
 
 // Writes dir/name: the sphere scene with the given <Emitters> content, bounding

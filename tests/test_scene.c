@@ -1,7 +1,7 @@
-// test_scene.c: the scene file (docs/design.md sections 3, 8, 9, 10, 11): defaults,
-// every attribute, camera matrices, substances, loads, exchanges, iterations and
-// ageing rules, texture maps, the bad scenes of tests/bad/, entity attacks, and the
-// schema.
+// test_scene.c: the scene file (docs/design.md sections 3, 8, 9, 10, 11, 12):
+// defaults, every attribute, camera matrices, substances, loads, exchanges,
+// iterations and ageing rules, texture maps, derived masks, the bad scenes of
+// tests/bad/, entity attacks, and the schema.
 #include <dirent.h>
 #include <errno.h>
 #include <stdlib.h>
@@ -1009,6 +1009,281 @@ TEST(texture_maps)
     wx_scene_free(&s);
 }
 
+// --- derived masks (docs/design.md section 12) ---
+
+static bool validates(const char *path);
+
+/// `text`, written as `name`, validates against the schema.
+static bool validates_text(const char *name, const char *text)
+{
+    return validates(ensure_write_file(ensure_tmpdir(), name, text));
+}
+
+static bool term_equals(const wx_term *got, const wx_term *want)
+{
+    return got->kind == want->kind && got->index == want->index &&
+           got->constant == want->constant && got->weight == want->weight &&
+           got->offset == want->offset && got->steepness == want->steepness &&
+           got->line == want->line;
+}
+
+/// Every field of a mask, its terms included.
+static bool mask_equals(const wx_mask_def *got, const wx_mask_def *want)
+{
+    bool ok = got->kind == want->kind && strcmp(got->name, want->name) == 0 &&
+              got->rays == want->rays && got->distance == want->distance &&
+              got->elevation == want->elevation && got->azimuth == want->azimuth &&
+              got->side_weight == want->side_weight &&
+              got->side_elevation == want->side_elevation &&
+              got->side_spread == want->side_spread && got->radius == want->radius &&
+              got->min == want->min && got->max == want->max && got->has_min == want->has_min &&
+              got->has_max == want->has_max && got->scale == want->scale &&
+              got->term_count == want->term_count && got->line == want->line;
+    for (int i = 0; ok && i < WX_MAX_TERMS; ++i) {
+        ok = term_equals(&got->terms[i], &want->terms[i]);
+    }
+    if (!ok) {
+        fprintf(stderr,
+                "mask '%s' at line %d: kind %d rays %d distance %g elevation %g azimuth %g side "
+                "%g %g %g radius %g min %g (%d) max %g (%d) scale %g terms %d\n",
+                got->name, got->line, (int)got->kind, got->rays, (double)got->distance,
+                (double)got->elevation, (double)got->azimuth, (double)got->side_weight,
+                (double)got->side_elevation, (double)got->side_spread, (double)got->radius,
+                (double)got->min, got->has_min, (double)got->max, got->has_max,
+                (double)got->scale, got->term_count);
+        for (int i = 0; i < got->term_count && i < WX_MAX_TERMS; ++i) {
+            const wx_term *t = &got->terms[i];
+            fprintf(stderr,
+                    "  term at line %d: kind %d index %d constant %g weight %g offset %g "
+                    "steepness %g\n",
+                    t->line, (int)t->kind, t->index, (double)t->constant, (double)t->weight,
+                    (double)t->offset, (double)t->steepness);
+        }
+    }
+    return ok;
+}
+
+// Every kind of mask with its defaults and with every attribute; <Masks>
+// before the <Substances> its terms name. Line numbers matter.
+static void masks_scene(char *text, size_t cap)
+{
+    snprintf(text, cap,
+             "<Weathering>\n"                                                           // 1
+             "  <Masks>\n"                                                              // 2
+             "    <Accessibility name=\"ao\"/>\n"                                       // 3
+             "    <Accessibility name=\"ao_far\" rays=\"4096\" distance=\"2.5\"/>\n"    // 4
+             "    <Exposure name=\"sun\"/>\n"                                           // 5
+             "    <Exposure name=\"low_sun\" elevation=\"-90\" azimuth=\"180\" "
+             "sideWeight=\"0.5\"\n"                                                     // 6
+             "              sideElevation=\"0.5\" sideSpread=\"60\"/>\n"                // 7
+             "    <Curvature name=\"curvature\"/>\n"                                    // 8
+             "    <Curvature name=\"Curv2\" radius=\"0.05\"/>\n"                        // 9
+             "    <Height name=\"height\"/>\n"                                          // 10
+             "    <Height name=\"above\" min=\"-1.5\"/>\n"                              // 11
+             "    <Height name=\"below\" max=\"10\"/>\n"                                // 12
+             "    <Height name=\"band\" min=\"0\" max=\"10\"/>\n"                       // 13
+             "    <Combine name=\"moss\">\n"                                            // 14
+             "      <Term mask=\"ao\" weight=\"1\" offset=\"0.5\" steepness=\"10\"/>\n" // 15
+             "      <Term mask=\"sun\" weight=\"-1\"/>\n"                               // 16
+             "      <Term substance=\"water\" weight=\"0.5\"/>\n"                       // 17
+             "      <Term constant=\"0.2\"/>\n"                                         // 18
+             "    </Combine>\n"                                                         // 19
+             "    <Combine name=\"dry\" scale=\"-2\">\n"                                // 20
+             "      <Term mask=\"moss\"/>\n"                                            // 21
+             "      <Term substance=\"dirt\" offset=\"-3\" steepness=\"0\"/>\n"         // 22
+             "      <Term constant=\"-1e3\" weight=\"0\"/>\n"                           // 23
+             "    </Combine>\n"                                                         // 24
+             "  </Masks>\n"                                                             // 25
+             "  <Substances><Substance name=\"water\"/><Substance name=\"dirt\"/>"
+             "</Substances>\n" VIEW_COLLIDER "</Weathering>\n");
+}
+
+TEST(masks_every_kind)
+{
+    char text[65536];
+    masks_scene(text, sizeof text);
+    wx_scene s;
+    wx_error err;
+    ENSURE(load_text("masks.xml", text, &s, &err, true) == WX_OK);
+    enum { WATER, DIRT };
+    ENSURE(s.substances_declared && s.substance_count == 2 && s.dirt_substance == DIRT);
+    ENSURE(s.mask_count == 12);
+    const wx_mask_def want[12] = {
+        { .kind = WX_MASK_ACCESSIBILITY, .name = "ao", .rays = 64, .distance = 1.0f, .line = 3 },
+        { .kind = WX_MASK_ACCESSIBILITY, .name = "ao_far", .rays = 4096, .distance = 2.5f,
+          .line = 4 },
+        { .kind = WX_MASK_EXPOSURE, .name = "sun", .elevation = 45.0f, .azimuth = 0.0f,
+          .side_weight = 0.0f, .side_elevation = 1.0f, .side_spread = 0.0f, .line = 5 },
+        { .kind = WX_MASK_EXPOSURE, .name = "low_sun", .elevation = -90.0f, .azimuth = 180.0f,
+          .side_weight = 0.5f, .side_elevation = 0.5f, .side_spread = 60.0f, .line = 7 },
+        { .kind = WX_MASK_CURVATURE, .name = "curvature", .radius = 0.0f, .line = 8 },
+        { .kind = WX_MASK_CURVATURE, .name = "Curv2", .radius = 0.05f, .line = 9 },
+        { .kind = WX_MASK_HEIGHT, .name = "height", .line = 10 },
+        { .kind = WX_MASK_HEIGHT, .name = "above", .min = -1.5f, .has_min = true, .line = 11 },
+        { .kind = WX_MASK_HEIGHT, .name = "below", .max = 10.0f, .has_max = true, .line = 12 },
+        { .kind = WX_MASK_HEIGHT, .name = "band", .min = 0.0f, .max = 10.0f, .has_min = true,
+          .has_max = true, .line = 13 },
+        { .kind = WX_MASK_COMBINE, .name = "moss", .scale = 1.0f, .term_count = 4, .line = 14,
+          .terms = {
+              { .kind = WX_TERM_MASK, .index = 0, .weight = 1.0f, .offset = 0.5f,
+                .steepness = 10.0f, .line = 15 },
+              { .kind = WX_TERM_MASK, .index = 2, .weight = -1.0f, .line = 16 },
+              { .kind = WX_TERM_SUBSTANCE, .index = WATER, .weight = 0.5f, .line = 17 },
+              { .kind = WX_TERM_CONSTANT, .index = -1, .constant = 0.2f, .weight = 1.0f,
+                .line = 18 },
+          } },
+        { .kind = WX_MASK_COMBINE, .name = "dry", .scale = -2.0f, .term_count = 3, .line = 20,
+          .terms = {
+              { .kind = WX_TERM_MASK, .index = 10, .weight = 1.0f, .line = 21 },
+              { .kind = WX_TERM_SUBSTANCE, .index = DIRT, .weight = 1.0f, .offset = -3.0f,
+                .line = 22 },
+              { .kind = WX_TERM_CONSTANT, .index = -1, .constant = -1000.0f, .weight = 0.0f,
+                .line = 23 },
+          } },
+    };
+    for (int i = 0; i < 12; ++i) {
+        ENSURE(mask_equals(&s.masks[i], &want[i]));
+    }
+    // Masks add no ageing: the substances do (design.md section 10 gives them channels).
+    ENSURE(s.rule_count == 0);
+    wx_scene_free(&s);
+    ENSURE(s.mask_count == 0);
+    if (ensure_shell(NULL, 0, "command -v xmllint >/dev/null") == 0) {
+        ENSURE(validates_text("masks_schema.xml", text));
+    }
+}
+
+// Without <Substances> the one substance "dirt" is a term's substance too;
+// no <Masks>, or an empty one, gives no mask.
+TEST(masks_without_substances)
+{
+    char text[65536];
+    snprintf(text, sizeof text,
+             "<Weathering>\n"
+             "  <Masks>\n"
+             "    <Accessibility name=\"a2345678901234567890123456789012\"/>\n"
+             "    <Combine name=\"grime\" scale=\"0.5\">\n"
+             "      <Term substance=\"dirt\" weight=\"2\" steepness=\"4\"/>\n"
+             "      <Term mask=\"a2345678901234567890123456789012\" weight=\"-1\"/>\n"
+             "    </Combine>\n"
+             "  </Masks>\n" VIEW_COLLIDER "</Weathering>\n");
+    wx_scene s;
+    wx_error err;
+    ENSURE(load_text("masks_dirt.xml", text, &s, &err, true) == WX_OK);
+    ENSURE(!s.substances_declared && s.substance_count == 1 && s.dirt_substance == 0);
+    ENSURE(s.mask_count == 2);
+    ENSURE(strlen(s.masks[0].name) == WX_SUBSTANCE_NAME_MAX);
+    const wx_mask_def grime = {
+        .kind = WX_MASK_COMBINE, .name = "grime", .scale = 0.5f, .term_count = 2, .line = 4,
+        .terms = {
+            { .kind = WX_TERM_SUBSTANCE, .index = 0, .weight = 2.0f, .steepness = 4.0f,
+              .line = 5 },
+            { .kind = WX_TERM_MASK, .index = 0, .weight = -1.0f, .line = 6 },
+        },
+    };
+    ENSURE(mask_equals(&s.masks[1], &grime));
+    ENSURE(!wx_scene_has_ageing(&s));
+    wx_scene_free(&s);
+    if (ensure_shell(NULL, 0, "command -v xmllint >/dev/null") == 0) {
+        ENSURE(validates_text("masks_dirt_schema.xml", text));
+    }
+
+    // An empty <Masks> is no mask (version 1's output); so is no <Masks>.
+    snprintf(text, sizeof text, "<Weathering>\n  <Masks/>\n" VIEW_COLLIDER "</Weathering>\n");
+    ENSURE(load_text("masks_empty.xml", text, &s, &err, true) == WX_OK);
+    ENSURE(s.mask_count == 0);
+    wx_scene_free(&s);
+    ENSURE(wx_scene_load(data_path("full.xml"), &s, &err) == WX_OK);
+    ENSURE(s.mask_count == 0);
+    wx_scene_free(&s);
+
+    // A term naming a substance the scene does not have, and a name too long.
+    snprintf(text, sizeof text,
+             "<Weathering>\n"
+             "  <Masks><Combine name=\"c\">\n"
+             "    <Term substance=\"water\"/>\n"
+             "  </Combine></Masks>\n" VIEW_COLLIDER "</Weathering>\n");
+    ENSURE(load_text("masks_water.xml", text, &s, &err, false) == WX_BAD_INPUT);
+    ENSURE_CAUSE(err, BAD_SCENE);
+    ENSURE(ensure_contains(err.message, "masks_water.xml:3: <Term> substance=\"water\" names an "
+                                        "undeclared substance (without <Substances> the scene "
+                                        "has the one substance 'dirt')"));
+    wx_scene_free(&s);
+    snprintf(text, sizeof text,
+             "<Weathering>\n"
+             "  <Masks><Height name=\"a23456789012345678901234567890123\"/></Masks>\n"
+             VIEW_COLLIDER "</Weathering>\n");
+    ENSURE(load_text("masks_long.xml", text, &s, &err, false) == WX_BAD_INPUT);
+    ENSURE_CAUSE(err, BAD_VALUE);
+    ENSURE(ensure_contains(err.message, "masks_long.xml:2: <Height> name is too long (at most 32 "
+                                        "characters)"));
+    wx_scene_free(&s);
+}
+
+// The limits: 8 substances and 24 masks, a Combine of 16 terms.
+TEST(masks_limits_accepted)
+{
+    char text[65536];
+    int n = snprintf(text, sizeof text, "<Weathering>\n  <Substances>");
+    for (int k = 0; k < WX_MAX_SUBSTANCES; ++k) {
+        n += snprintf(text + n, sizeof text - (size_t)n, "<Substance name=\"s%d\"/>", k);
+    }
+    n += snprintf(text + n, sizeof text - (size_t)n, "</Substances>\n  <Masks>\n");
+    for (int m = 0; m < WX_MAX_MASKS - 1; ++m) {
+        n += snprintf(text + n, sizeof text - (size_t)n, "    <Curvature name=\"m%d\"/>\n", m);
+    }
+    n += snprintf(text + n, sizeof text - (size_t)n, "    <Combine name=\"all\">\n");
+    for (int t = 0; t < WX_MAX_TERMS; ++t) {
+        n += snprintf(text + n, sizeof text - (size_t)n, "      <Term mask=\"m%d\"/>\n", t);
+    }
+    snprintf(text + n, sizeof text - (size_t)n, "    </Combine>\n  </Masks>\n" VIEW_COLLIDER
+                                                "</Weathering>\n");
+    wx_scene s;
+    wx_error err;
+    ENSURE(load_text("masks_limits.xml", text, &s, &err, true) == WX_OK);
+    ENSURE(s.substance_count == WX_MAX_SUBSTANCES && s.mask_count == WX_MAX_MASKS);
+    ENSURE(WX_MAX_SUBSTANCES + WX_MAX_MASKS <= WX_IMAGE_MAX_CHANNELS - 1);
+    const wx_mask_def *all = &s.masks[WX_MAX_MASKS - 1];
+    ENSURE(all->term_count == WX_MAX_TERMS);
+    for (int t = 0; t < WX_MAX_TERMS; ++t) {
+        ENSURE(all->terms[t].kind == WX_TERM_MASK && all->terms[t].index == t);
+    }
+    wx_scene_free(&s);
+    if (ensure_shell(NULL, 0, "command -v xmllint >/dev/null") == 0) {
+        ENSURE(validates_text("masks_limits_schema.xml", text));
+    }
+}
+
+// A mask is a channel of every output: its preview BASE_NAME.png must not be
+// another output's (here the mask's mask_b_dirt.png, the TextureMap's mask_b_dirt.png).
+TEST(masks_previews_are_outputs)
+{
+    char text[65536];
+    snprintf(text, sizeof text,
+             "<Weathering>\n"
+             "  <Masks><Curvature name=\"b_dirt\"/></Masks>\n"
+             "  <Geometry><Mesh file=\"%s\">\n"
+             "    <TextureMap file=\"mask_b.exr\"/>\n"
+             "  </Mesh></Geometry>\n" VIEW_COLLIDER "</Weathering>\n",
+             abs_data_path("box.obj"));
+    wx_scene s;
+    wx_error err;
+    ENSURE(load_text("masks_preview.xml", text, &s, &err, false) == WX_BAD_INPUT);
+    ENSURE_CAUSE(err, BAD_SCENE);
+    ENSURE(ensure_contains(err.message, "masks_preview.xml:4: <TextureMap> file=\"mask_b.exr\" "
+                                        "writes the preview 'mask_b_dirt.png'"));
+    wx_scene_free(&s);
+    // Without the mask the scene has the one channel Y: mask.png and mask_b.png.
+    snprintf(text, sizeof text,
+             "<Weathering>\n"
+             "  <Geometry><Mesh file=\"%s\">\n"
+             "    <TextureMap file=\"mask_b.exr\"/>\n"
+             "  </Mesh></Geometry>\n" VIEW_COLLIDER "</Weathering>\n",
+             abs_data_path("box.obj"));
+    ENSURE(load_text("masks_no_preview.xml", text, &s, &err, true) == WX_OK);
+    wx_scene_free(&s);
+}
+
 static double seconds_now(void)
 {
     struct timespec ts;
@@ -1266,6 +1541,14 @@ TEST(schema_rejects_bad_values)
         "texture_map_not_exr", "texture_map_uv_too_large", "texture_map_padding_negative",
         "texture_map_zero_resolution", "texture_map_width_too_large", "texture_map_without_file",
         "texture_map_same_file_twice", "texture_map_outside_mesh",
+        // docs/design.md section 12 (issue 18).
+        "term_unknown_mask", "accessibility_rays_zero", "accessibility_rays_too_many",
+        "accessibility_distance_zero", "exposure_elevation_above_90",
+        "exposure_side_weight_negative", "curvature_radius_negative", "term_steepness_negative",
+        "mask_name_clashes_with_substance", "mask_name_clashes_with_mask",
+        "mask_name_reserved_seen", "mask_name_reserved_y", "mask_name_with_a_dot",
+        "mask_without_name", "combine_without_terms", "combine_too_many_terms", "masks_too_many",
+        "masks_twice", "mask_unknown_element",
     };
     int failures = 0;
     for (size_t i = 0; i < sizeof invalid / sizeof invalid[0]; ++i) {
@@ -1296,6 +1579,10 @@ int main(void)
     RUN(substance_limits_accepted);
     RUN(substance_errors_at_their_line);
     RUN(texture_maps);
+    RUN(masks_every_kind);
+    RUN(masks_without_substances);
+    RUN(masks_limits_accepted);
+    RUN(masks_previews_are_outputs);
     RUN(bad_scenes);
     RUN(entity_bomb_refused_quickly);
     RUN(external_entity_refused);

@@ -458,21 +458,24 @@ wx_result wx_texture_sample(const wx_texture_def *def, float *const *out, float 
     for (int j = 0; j < H; ++j) {
         seen_count += seen_rows[j];
     }
-    // Padding: every value of the nearest covered texel, `seen` included.
-    for (size_t t = 0; t < texels; ++t) {
-        int32_t s = r->source[t];
-        if (s < 0 || (size_t)s == t) {
-            continue;
-        }
-        for (int c = 0; c < def->channels; ++c) {
-            out[c][t] = out[c][s];
-        }
-        seen[t] = seen[s];
-    }
     if (seen_texels != NULL) {
         *seen_texels = seen_count;
     }
     free(views);
     free(seen_rows);
     return WX_OK;
+}
+
+void wx_texture_pad(const wx_uv_raster *raster, float *const *planes, int count)
+{
+    const size_t texels = (size_t)raster->width * (size_t)raster->height;
+    for (size_t t = 0; t < texels; ++t) {
+        int32_t s = raster->source[t];
+        if (s < 0 || (size_t)s == t) {
+            continue;
+        }
+        for (int c = 0; c < count; ++c) {
+            planes[c][t] = planes[c][s];
+        }
+    }
 }

@@ -75,9 +75,13 @@ typedef struct wx_texture_def {
 /// size): at a covered texel whose point some input camera sees, the mean of
 /// the seeing cameras' values weighted by |N . view| (a camera that sees the
 /// surface head-on resolves it best), seen 1; at a covered texel no camera
-/// sees, 0 and seen 0; at a padding texel its source's values; elsewhere 0.
+/// sees, 0 and seen 0; elsewhere 0 (wx_texture_pad fills the padding).
 /// `seen_texels` (may be NULL) gets the covered texels that are seen.
 wx_result wx_texture_sample(const wx_texture_def *def, float *const *out, float *seen,
                             int64_t *seen_texels, wx_error *err);
+
+/// Padding: every texel within the raster's padding of an island takes all the
+/// values of its nearest covered texel, in each of the `count` planes.
+void wx_texture_pad(const wx_uv_raster *raster, float *const *planes, int count);
 
 #endif

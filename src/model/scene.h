@@ -170,6 +170,63 @@ typedef struct wx_texture_map {
     int line;
 } wx_texture_map;
 
+/// The kinds of derived mask (docs/design.md section 12, docs/masks.md).
+typedef enum wx_mask_kind {
+    WX_MASK_ACCESSIBILITY, ///< cosine-weighted share of open directions within `distance`
+    WX_MASK_EXPOSURE,      ///< direct light of a sun and two side suns, with real shadows
+    WX_MASK_CURVATURE,     ///< mean curvature, 1/world unit (convex > 0)
+    WX_MASK_HEIGHT,        ///< clamp((y - min) / (max - min), 0, 1)
+    WX_MASK_COMBINE,       ///< clamp(scale * sum of terms, 0, 1)
+} wx_mask_kind;
+
+typedef enum wx_term_kind {
+    WX_TERM_MASK,      ///< a derived mask defined before the Combine
+    WX_TERM_SUBSTANCE, ///< a substance, per square metre
+    WX_TERM_CONSTANT,
+} wx_term_kind;
+
+/// One <Term> of a <Combine>: weight * S(x), S Riihiaho's sigmoid
+/// (x - o) / (2 sqrt(1/s + (x - o)^2)) + 1/2 for steepness s > 0, else x.
+typedef struct wx_term {
+    wx_term_kind kind;
+    int index;       ///< MASK: index into wx_scene.masks (< the Combine's); SUBSTANCE: substance
+    float constant;  ///< CONSTANT: the value x
+    float weight;    ///< default 1
+    float offset;    ///< o, default 0
+    float steepness; ///< s >= 0, default 0 (S(x) = x)
+    int line;
+} wx_term;
+
+/// Most <Term>s a <Combine> takes.
+#define WX_MAX_TERMS 16
+/// Most derived masks a scene takes (with the substances, at most
+/// WX_IMAGE_MAX_CHANNELS - 1 channels in all: `seen` needs one).
+#define WX_MAX_MASKS 24
+
+/// One derived mask of <Masks> (docs/design.md section 12).
+typedef struct wx_mask_def {
+    wx_mask_kind kind;
+    char name[WX_SUBSTANCE_NAME_MAX + 1]; ///< shares the substances' namespace; not Y, seen
+    /// Accessibility: rays per point (1..4096, default 64), distance > 0 (world
+    /// units, default 1).
+    int rays;
+    float distance;
+    /// Exposure (degrees): elevation in [-90, 90] (default 45), azimuth from +X
+    /// towards +Z (default 0), side_weight (default 0), side_elevation (a
+    /// factor of elevation, default 1), side_spread (default 0).
+    float elevation, azimuth, side_weight, side_elevation, side_spread;
+    /// Curvature: radius in world units, 0 = 4 texels of the target.
+    float radius;
+    /// Height: the range of y; has_min/has_max false take the geometry's bounds.
+    float min, max;
+    bool has_min, has_max;
+    /// Combine.
+    float scale; ///< default 1
+    wx_term terms[WX_MAX_TERMS];
+    int term_count;
+    int line;
+} wx_mask_def;
+
 typedef struct wx_mesh {
     char *path; ///< resolved against the scene's folder (owned)
     wx_surface *surfaces;
@@ -205,6 +262,15 @@ typedef struct wx_scene {
     /// Every <TextureMap>, in document order (owned).
     wx_texture_map *textures;
     int texture_count;
+
+    /// <Masks>: the derived masks in document order (a Combine's terms name
+    /// only masks before it).
+    wx_mask_def masks[WX_MAX_MASKS];
+    int mask_count;
+    /// The geometry's bounds once imported (a run fills them for Height's
+    /// default range); has_bounds false until then.
+    double bounds_min[3], bounds_max[3];
+    bool has_bounds;
 
     /// Substances (docs/design.md section 9): without <Substances> the one
     /// substance "dirt" (substances_declared false).

@@ -12,12 +12,13 @@
 #include "io/png_preview.h"
 #include "pipeline/load.h"
 #include "core/progress.h"
+#include "pipeline/masks_phase.h"
 #include "pipeline/outputs.h"
 #include "pipeline/texture_phase.h"
 
 static wx_result write_mask(const wx_scene *scene, const wx_run_def *opts, const wx_maps *in_maps,
-                            const wx_maps *given_out, int frame, wx_phase_detail *detail,
-                            wx_error *err);
+                            const wx_maps *given_out, const wx_mask_context *masks, int frame,
+                            wx_phase_detail *detail, wx_error *err);
 
 wx_result wx_gather_scene(const wx_scene *scene, const wx_run_def *opts, wx_error *err)
 {
@@ -95,29 +96,36 @@ wx_result wx_gather_frame(const wx_scene *scene, const wx_run_def *opts, const w
                        "gather needs one",
                        scene->path);
     }
-    wx_result r = WX_OK;
-    if (has_output) {
+    // The derived masks' collider, shared by the mask and every texture.
+    wx_mask_context masks;
+    wx_result r = wx_mask_context_init(scene, in_maps, &masks, err);
+    if (r == WX_OK && has_output) {
         int every = scene->cameras[scene->output_index].every;
         if (frame == 0 || (every > 0 && frame % every == 0)) {
-            r = write_mask(scene, opts, in_maps, given_out, frame, detail, err);
+            r = write_mask(scene, opts, in_maps, given_out, &masks, frame, detail, err);
         }
     }
     if (r == WX_OK) {
-        r = wx_textures_write(scene, opts, textures, in_maps, frame, detail, err);
+        r = wx_textures_write(scene, opts, textures, in_maps, &masks, frame, detail, err);
     }
+    wx_mask_context_free(&masks);
     return r;
 }
 
 int wx_mask_channels(const wx_scene *scene, char names[][WX_NAME_MAX])
 {
-    if (!scene->substances_declared) {
+    if (!scene->substances_declared && scene->mask_count == 0) {
         snprintf(names[0], WX_NAME_MAX, "Y");
         return 1;
     }
+    int n = 0;
     for (int s = 0; s < scene->substance_count; ++s) {
-        snprintf(names[s], WX_NAME_MAX, "%s.Y", scene->substances[s]);
+        snprintf(names[n++], WX_NAME_MAX, "%s.Y", scene->substances[s]);
     }
-    return scene->substance_count;
+    for (int m = 0; m < scene->mask_count; ++m) {
+        snprintf(names[n++], WX_NAME_MAX, "%s.Y", scene->masks[m].name);
+    }
+    return n;
 }
 
 void wx_frame_name(const char *mask_name, int frame, char *out, size_t cap)
@@ -140,8 +148,8 @@ void wx_channel_preview_name(const char *mask_name, const char *channel, char *o
 
 // The mask of frame `frame` (0: the final file and its previews).
 static wx_result write_mask(const wx_scene *scene, const wx_run_def *opts, const wx_maps *in_maps,
-                            const wx_maps *given_out, int frame, wx_phase_detail *detail,
-                            wx_error *err)
+                            const wx_maps *given_out, const wx_mask_context *masks, int frame,
+                            wx_phase_detail *detail, wx_error *err)
 {
     double t0 = wx_now_s();
     const wx_scene_camera *out = &scene->cameras[scene->output_index];
@@ -204,7 +212,8 @@ static wx_result write_mask(const wx_scene *scene, const wx_run_def *opts, const
     }
     // One gather per substance: its amount and baseline planes (model/maps.h),
     // the hits all substances share.
-    for (int s = 0; s < channels && result == WX_OK; ++s) {
+    const int substances = scene->substance_count;
+    for (int s = 0; s < substances && result == WX_OK; ++s) {
         for (int v = 0; v < k; ++v) {
             size_t plane = (size_t)s * (size_t)in_maps[v].width * (size_t)in_maps[v].height;
             views[v].dirt = in_maps[v].dirt != NULL ? in_maps[v].dirt + plane : NULL;
@@ -234,6 +243,12 @@ static wx_result write_mask(const wx_scene *scene, const wx_run_def *opts, const
                     100.0 * (double)st.capped_texels / (double)st.surface_texels, st.target_hits,
                     (double)out->max_radius, 100.0 * (double)out->noise);
         }
+    }
+    // The derived masks after the substances (a Combine reads them).
+    if (result == WX_OK && scene->mask_count > 0) {
+        result = wx_masks_at_camera(scene, opts, masks, &out->camera, om,
+                                    (const float *const *)image->channels,
+                                    image->channels + substances, err);
     }
     double t2 = wx_now_s();
     detail->compute = t2 - t1;

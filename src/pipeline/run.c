@@ -2,6 +2,7 @@
 // bake, simulate and gather, each input file read once.
 #include "pipeline/run.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -58,8 +59,28 @@ wx_result wx_run_phases(wx_scene *scene, const wx_run_def *opts, unsigned phases
     // TextureMaps read their meshes' UV layouts: imported with the bake's, or
     // for them alone when nothing is baked.
     bool textures_needed = scene->texture_count > 0 && (phases & (WX_PHASE_SIMULATE | WX_PHASE_GATHER));
-    if (r == WX_OK && (bake || textures_needed)) {
+    // Height's default range is the geometry's bounds (docs/design.md section 12).
+    bool bounds_needed = false;
+    for (int m = 0; m < scene->mask_count; ++m) {
+        const wx_mask_def *md = &scene->masks[m];
+        bounds_needed |= md->kind == WX_MASK_HEIGHT && !(md->has_min && md->has_max);
+    }
+    bounds_needed = bounds_needed && scene->mesh_count > 0 && (phases & WX_PHASE_GATHER);
+    if (r == WX_OK && (bake || textures_needed || bounds_needed)) {
         r = wx_geometry_load(scene, opts->quiet, &geometry, err);
+    }
+    for (int m = 0; r == WX_OK && m < geometry.count; ++m) {
+        const wx_mesh_data *d = &geometry.meshes[m].data;
+        if (d->triangle_count == 0) {
+            continue;
+        }
+        for (int k = 0; k < 3; ++k) {
+            scene->bounds_min[k] = scene->has_bounds ? fmin(scene->bounds_min[k], d->bounds_min[k])
+                                                     : d->bounds_min[k];
+            scene->bounds_max[k] = scene->has_bounds ? fmax(scene->bounds_max[k], d->bounds_max[k])
+                                                     : d->bounds_max[k];
+        }
+        scene->has_bounds = true;
     }
     if (r == WX_OK && (phases & WX_PHASE_GATHER)) {
         r = wx_gather_check(scene, err);

@@ -197,12 +197,67 @@ static void free_planes(camera_planes *cache, int count, int planes)
     free(cache);
 }
 
+// The derived masks at a texture's covered texels that are seen (channels
+// after the substances'): the surface points of the raster, the substances'
+// sampled values for the Combines, the texel size from the mesh's area.
+static wx_result texture_masks(const wx_scene *scene, const wx_run_def *opts,
+                               const wx_mask_context *masks, const wx_texture_target *t,
+                               wx_image *image, wx_error *err)
+{
+    const wx_uv_raster *ras = &t->raster;
+    const size_t texels = (size_t)ras->width * (size_t)ras->height;
+    const float *seen = image->channels[image->channel_count - 1];
+    double *position = malloc(3 * texels * sizeof *position);
+    float *normal = calloc(3 * texels, sizeof *normal);
+    unsigned char *valid = calloc(texels, 1);
+    if (position == NULL || normal == NULL || valid == NULL) {
+        free(position);
+        free(normal);
+        free(valid);
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "texture: out of memory (masks)");
+    }
+    for (size_t i = 0; i < texels; ++i) {
+        position[3 * i] = position[3 * i + 1] = position[3 * i + 2] = 0.0;
+        valid[i] = seen[i] > 0.5f &&
+                   wx_uv_raster_point(&t->mesh, t->def->uv, ras, i, &position[3 * i], &normal[3 * i]);
+    }
+    // A texel's world size: the mesh's area over the covered texels.
+    double area = 0.0;
+    for (int64_t k = 0; k < t->mesh.triangle_count; ++k) {
+        const uint32_t *idx = &t->mesh.indices[3 * k];
+        const float *a = &t->mesh.positions[3 * (size_t)idx[0]];
+        const float *b = &t->mesh.positions[3 * (size_t)idx[1]];
+        const float *c = &t->mesh.positions[3 * (size_t)idx[2]];
+        double e1[3] = { b[0] - a[0], b[1] - a[1], b[2] - a[2] };
+        double e2[3] = { c[0] - a[0], c[1] - a[1], c[2] - a[2] };
+        double x = e1[1] * e2[2] - e1[2] * e2[1], y = e1[2] * e2[0] - e1[0] * e2[2];
+        double z = e1[0] * e2[1] - e1[1] * e2[0];
+        area += 0.5 * sqrt(x * x + y * y + z * z);
+    }
+    wx_mask_points points = { .width = ras->width,
+                              .height = ras->height,
+                              .position = position,
+                              .normal = normal,
+                              .valid = valid,
+                              .texel = ras->covered > 0 ? (float)sqrt(area / (double)ras->covered)
+                                                        : 1.0f };
+    const int S = scene->substance_count;
+    wx_result r = wx_masks_at_points(scene, opts, masks, &points,
+                                     (const float *const *)image->channels, image->channels + S,
+                                     err);
+    free(position);
+    free(normal);
+    free(valid);
+    return r;
+}
+
 // One texture: sampled into `image` (its channels allocated) and written with
 // its previews (frame 0).
 static wx_result write_texture(const wx_scene *scene, const wx_run_def *opts,
                                const wx_texture_target *t, const wx_gather_view *views,
-                               float *const *planes, int frame, char names[][WX_NAME_MAX],
-                               int channels, wx_phase_detail *detail, wx_error *err)
+                               float *const *planes, const wx_mask_context *masks, int frame,
+                               char names[][WX_NAME_MAX], int channels, wx_phase_detail *detail,
+                               wx_error *err)
 {
     const wx_texture_map *def = t->def;
     const char *channel_names[WX_IMAGE_MAX_CHANNELS];
@@ -227,9 +282,17 @@ static wx_result write_texture(const wx_scene *scene, const wx_run_def *opts,
                               .inputs = views,
                               .input_count = scene->input_count,
                               .smoothed = (const float *const *)planes,
-                              .channels = channels - 1,
+                              .channels = scene->substance_count,
                               .threads = opts->threads };
         r = wx_texture_sample(&td, image->channels, image->channels[channels - 1], NULL, err);
+    }
+    // The derived masks at the texels whose point is seen, then the padding of
+    // every channel.
+    if (r == WX_OK && scene->mask_count > 0) {
+        r = texture_masks(scene, opts, masks, t, image, err);
+    }
+    if (r == WX_OK) {
+        wx_texture_pad(&t->raster, image->channels, channels);
     }
     double t1 = wx_now_s();
     if (r == WX_OK) {
@@ -276,15 +339,16 @@ static wx_result write_texture(const wx_scene *scene, const wx_run_def *opts,
 }
 
 wx_result wx_textures_write(const wx_scene *scene, const wx_run_def *opts,
-                            const wx_textures *textures, const wx_maps *in_maps, int frame,
-                            wx_phase_detail *detail, wx_error *err)
+                            const wx_textures *textures, const wx_maps *in_maps,
+                            const wx_mask_context *masks, int frame, wx_phase_detail *detail,
+                            wx_error *err)
 {
     if (textures == NULL || textures->count == 0) {
         return WX_OK;
     }
     char names[WX_IMAGE_MAX_CHANNELS][WX_NAME_MAX];
     const int channels = wx_texture_channels(scene, names);
-    const int substances = channels - 1;
+    const int substances = scene->substance_count;
     const int planes_per_key = scene->input_count * substances;
     wx_gather_view *views = calloc((size_t)scene->input_count + 1, sizeof *views);
     camera_planes *cache = calloc((size_t)textures->count, sizeof *cache);
@@ -325,8 +389,8 @@ wx_result wx_textures_write(const wx_scene *scene, const wx_run_def *opts,
             }
         }
         if (r == WX_OK) {
-            r = write_texture(scene, opts, t, views, cache[slot].planes, frame, names, channels,
-                              detail, err);
+            r = write_texture(scene, opts, t, views, cache[slot].planes, masks, frame, names,
+                              channels, detail, err);
         }
         if (r != WX_OK) {
             wx_error_prefix(err, "texture %s", t->def->file);

@@ -1,0 +1,136 @@
+// masks_phase.c: the derived masks at the targets of a frame (masks_phase.h).
+#include "pipeline/masks_phase.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+wx_result wx_mask_context_init(const wx_scene *scene, const wx_maps *in_maps,
+                               wx_mask_context *ctx, wx_error *err)
+{
+    memset(ctx, 0, sizeof *ctx);
+    if (scene->mask_count == 0) {
+        return WX_OK;
+    }
+    const int n = scene->input_count;
+    wx_camera *cams = calloc((size_t)n + 1, sizeof *cams);
+    wx_maps *maps = calloc((size_t)n + 1, sizeof *maps);
+    size_t largest = 0;
+    for (int k = 0; k < n; ++k) {
+        size_t texels = (size_t)in_maps[k].width * (size_t)in_maps[k].height;
+        largest = texels > largest ? texels : largest;
+    }
+    ctx->zero_impact = calloc(2 * largest + 1, sizeof *ctx->zero_impact);
+    wx_result r = WX_OK;
+    if (cams == NULL || maps == NULL || ctx->zero_impact == NULL) {
+        r = wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "masks: out of memory");
+    }
+    double ylo = INFINITY, yhi = -INFINITY;
+    int k = 0;
+    for (int c = 0; c < scene->camera_count && r == WX_OK; ++c) {
+        if (scene->cameras[c].is_output) {
+            continue;
+        }
+        cams[k] = scene->cameras[c].camera;
+        // The maps as the collider reads them: depth and normal borrowed.
+        maps[k].width = in_maps[k].width;
+        maps[k].height = in_maps[k].height;
+        maps[k].depth = in_maps[k].depth;
+        maps[k].normal = in_maps[k].normal;
+        maps[k].impact = ctx->zero_impact;
+        for (int j = 0; !scene->has_bounds && j < maps[k].height; ++j) {
+            for (int i = 0; i < maps[k].width; ++i) {
+                float d = maps[k].depth[(size_t)j * (size_t)maps[k].width + (size_t)i];
+                if (wx_depth_is_empty(d)) {
+                    continue;
+                }
+                float uvd[3], p[3];
+                wx_map_texel_center(maps[k].width, maps[k].height, i, j, &uvd[0], &uvd[1]);
+                uvd[2] = d;
+                wx_camera_map_to_world(&cams[k], uvd, p);
+                ylo = fmin(ylo, p[1]);
+                yhi = fmax(yhi, p[1]);
+            }
+        }
+        k++;
+    }
+    if (r == WX_OK) {
+        r = wx_collider_init(&ctx->collider, cams, maps, n, false, err);
+    }
+    free(cams);
+    free(maps);
+    if (r != WX_OK) {
+        wx_mask_context_free(ctx);
+        return r;
+    }
+    ctx->height_min = (float)(scene->has_bounds ? scene->bounds_min[1] : ylo);
+    ctx->height_max = (float)(scene->has_bounds ? scene->bounds_max[1] : yhi);
+    ctx->ready = true;
+    return WX_OK;
+}
+
+void wx_mask_context_free(wx_mask_context *ctx)
+{
+    if (ctx->ready || ctx->collider.cameras != NULL) {
+        wx_collider_free(&ctx->collider);
+    }
+    free(ctx->zero_impact);
+    memset(ctx, 0, sizeof *ctx);
+}
+
+wx_result wx_masks_at_points(const wx_scene *scene, const wx_run_def *opts,
+                             const wx_mask_context *ctx, const wx_mask_points *points,
+                             const float *const *substances, float *const *out, wx_error *err)
+{
+    wx_masks_def def = { .scene = scene,
+                         .collider = ctx->ready ? &ctx->collider : NULL,
+                         .points = *points,
+                         .substances = substances,
+                         .height_min = ctx->height_min,
+                         .height_max = ctx->height_max,
+                         .seed = opts->seed,
+                         .threads = opts->threads };
+    return wx_masks_compute(&def, out, err);
+}
+
+wx_result wx_masks_at_camera(const wx_scene *scene, const wx_run_def *opts,
+                             const wx_mask_context *ctx, const wx_camera *camera,
+                             const wx_maps *maps, const float *const *substances,
+                             float *const *out, wx_error *err)
+{
+    const int W = maps->width, H = maps->height;
+    const size_t texels = (size_t)W * (size_t)H;
+    double *position = malloc(3 * texels * sizeof *position);
+    unsigned char *valid = malloc(texels);
+    if (position == NULL || valid == NULL) {
+        free(position);
+        free(valid);
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "masks: out of memory (%zu texels)", texels);
+    }
+    for (int j = 0; j < H; ++j) {
+        for (int i = 0; i < W; ++i) {
+            size_t t = (size_t)j * (size_t)W + (size_t)i;
+            float d = maps->depth[t];
+            const float *n = &maps->normal[3 * t];
+            valid[t] = !wx_depth_is_empty(d) && (n[0] != 0.0f || n[1] != 0.0f || n[2] != 0.0f);
+            float uvd[3] = { 0.0f, 0.0f, valid[t] ? d : 0.0f }, p[3];
+            wx_map_texel_center(W, H, i, j, &uvd[0], &uvd[1]);
+            wx_camera_map_to_world(camera, uvd, p);
+            for (int k = 0; k < 3; ++k) {
+                position[3 * t + k] = p[k];
+            }
+        }
+    }
+    float frame_w, frame_h;
+    wx_camera_frame_size(camera, &frame_w, &frame_h);
+    wx_mask_points points = { .width = W,
+                              .height = H,
+                              .position = position,
+                              .normal = maps->normal,
+                              .valid = valid,
+                              .texel = frame_w / (float)W };
+    wx_result r = wx_masks_at_points(scene, opts, ctx, &points, substances, out, err);
+    free(position);
+    free(valid);
+    return r;
+}

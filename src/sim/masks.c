@@ -1,0 +1,340 @@
+// masks.c: the derived masks (masks.h).
+#include "sim/masks.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/parallel.h"
+
+#define PI 3.14159265358979323846
+
+// Curvature looks at most this many texels of the grid away from a point.
+#define CURVATURE_MAX_REACH 32
+
+double wx_sigmoid(double x, double offset, double steepness)
+{
+    if (!(steepness > 0.0)) {
+        return x;
+    }
+    double d = x - offset;
+    return d / (2.0 * sqrt(1.0 / steepness + d * d)) + 0.5;
+}
+
+void wx_sun_direction(double elevation, double azimuth, double out[3])
+{
+    double e = elevation * PI / 180.0, a = azimuth * PI / 180.0;
+    out[0] = cos(e) * cos(a);
+    out[1] = sin(e);
+    out[2] = cos(e) * sin(a);
+}
+
+int wx_mask_rays(const wx_mask_def *mask)
+{
+    switch (mask->kind) {
+    case WX_MASK_ACCESSIBILITY:
+        return mask->rays;
+    case WX_MASK_EXPOSURE:
+        return mask->side_weight != 0.0f ? 3 : 1;
+    default:
+        return 0;
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Rays.
+
+typedef struct job {
+    const wx_masks_def *def;
+    float *const *out;
+    float offset;   // start this far along the normal
+    double first;   // length of a ray's first segment
+    int mask;       // the mask being computed
+    double suns[3][3];
+    double sun_weights[3];
+    int sun_count;
+} job;
+
+static uint64_t splitmix(uint64_t x)
+{
+    x += 0x9e3779b97f4a7c15ull;
+    x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
+    x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
+    return x ^ (x >> 31);
+}
+
+static double unit_of(uint64_t x)
+{
+    return (double)(x >> 11) * (1.0 / 9007199254740992.0);
+}
+
+static double radical_inverse(uint32_t i)
+{
+    i = (i << 16) | (i >> 16);
+    i = ((i & 0x00ff00ffu) << 8) | ((i & 0xff00ff00u) >> 8);
+    i = ((i & 0x0f0f0f0fu) << 4) | ((i & 0xf0f0f0f0u) >> 4);
+    i = ((i & 0x33333333u) << 2) | ((i & 0xccccccccu) >> 2);
+    i = ((i & 0x55555555u) << 1) | ((i & 0xaaaaaaaau) >> 1);
+    return (double)i * (1.0 / 4294967296.0);
+}
+
+// An orthonormal frame (t, b) around unit n (Duff et al. 2017).
+static void frame_of(const float n[3], double t[3], double b[3])
+{
+    double sign = n[2] >= 0.0f ? 1.0 : -1.0;
+    double a = -1.0 / (sign + n[2]);
+    double c = n[0] * n[1] * a;
+    t[0] = 1.0 + sign * n[0] * n[0] * a;
+    t[1] = sign * c;
+    t[2] = -sign * n[0];
+    b[0] = c;
+    b[1] = sign + n[1] * n[1] * a;
+    b[2] = -n[1];
+}
+
+// True when the ray from p along unit dir travels `length` without entering a
+// surface the collider records: segments of doubling length, each cleared by
+// the coarse pyramid when it can be, swept otherwise.
+static bool ray_free(const wx_collider *collider, const double p[3], const double dir[3],
+                     double length, double first)
+{
+    if (collider == NULL) {
+        return true;
+    }
+    double t0 = 0.0, step = first;
+    while (t0 < length) {
+        double t1 = fmin(length, t0 + step);
+        float a[3], b[3];
+        for (int k = 0; k < 3; ++k) {
+            a[k] = (float)(p[k] + dir[k] * t0);
+            b[k] = (float)(p[k] + dir[k] * t1);
+        }
+        if (!wx_collider_coarse_clear(collider, a, b)) {
+            wx_hit hit;
+            if (wx_collider_sweep(collider, a, b, &hit)) {
+                return false;
+            }
+        }
+        t0 = t1;
+        step *= 2.0;
+    }
+    return true;
+}
+
+// Where a ray from surface point p along unit dir starts: on the ray itself
+// (so that a shadow's edge does not move), `offset` above the surface, or at
+// most 2 offsets along the ray for rays at grazing angles; 1.5 times further
+// along where that is still inside what the maps record.
+// Returns the distance skipped, or -1 when every start lies inside (the ray is
+// closed: the point lies within what the maps record as solid).
+static double ray_start(const job *jb, const double p[3], const float n[3], const double dir[3],
+                        double out[3])
+{
+    double c = n[0] * dir[0] + n[1] * dir[1] + n[2] * dir[2];
+    double skip = jb->offset / fmax(c, 0.5);
+    static const double factors[2] = { 1.0, 1.5 };
+    for (int tries = 0; tries < 2; ++tries) {
+        float f[3];
+        for (int k = 0; k < 3; ++k) {
+            out[k] = p[k] + dir[k] * skip * factors[tries];
+            f[k] = (float)out[k];
+        }
+        if (jb->def->collider == NULL || !wx_collider_point_collides(jb->def->collider, f)) {
+            return skip * factors[tries];
+        }
+    }
+    return -1.0;
+}
+
+// Distance from p along dir to the exit of the solver's bounding box (0 when p
+// lies outside it).
+static double box_exit(const wx_scene *scene, const double p[3], const double dir[3])
+{
+    double h = 0.5 * scene->bbox_size, t = INFINITY;
+    for (int k = 0; k < 3; ++k) {
+        double lo = scene->bbox_center[k] - h, hi = scene->bbox_center[k] + h;
+        if (!(p[k] >= lo && p[k] <= hi)) {
+            return 0.0;
+        }
+        if (dir[k] > 0.0) {
+            t = fmin(t, (hi - p[k]) / dir[k]);
+        } else if (dir[k] < 0.0) {
+            t = fmin(t, (lo - p[k]) / dir[k]);
+        }
+    }
+    return isfinite(t) ? t : 0.0;
+}
+
+static float accessibility(const job *jb, const wx_mask_def *m, size_t t, const double p[3],
+                           const float n[3])
+{
+    double start[3], tx[3], bx[3];
+    frame_of(n, tx, bx);
+    uint64_t h = splitmix(jb->def->seed ^ splitmix((uint64_t)jb->mask * 0x632be59bd9b4e019ull ^
+                                                   (uint64_t)t));
+    double r1 = unit_of(h), r2 = unit_of(splitmix(h));
+    int open = 0;
+    for (int i = 0; i < m->rays; ++i) {
+        // A stratified point of the unit square, rotated per point, mapped to
+        // cosine-weighted directions (Malley's method).
+        double u = fmod((i + 0.5) / m->rays + r1, 1.0), v = fmod(radical_inverse((uint32_t)i) + r2, 1.0);
+        double r = sqrt(u), phi = 2.0 * PI * v, z = sqrt(fmax(0.0, 1.0 - u));
+        double dir[3];
+        for (int k = 0; k < 3; ++k) {
+            dir[k] = r * cos(phi) * tx[k] + r * sin(phi) * bx[k] + z * n[k];
+        }
+        double skipped = ray_start(jb, p, n, dir, start);
+        open += skipped >= 0.0 &&
+                (skipped >= m->distance ||
+                 ray_free(jb->def->collider, start, dir, m->distance - skipped, jb->first));
+    }
+    return (float)open / (float)m->rays;
+}
+
+static float exposure(const job *jb, const double p[3], const float n[3])
+{
+    double start[3], sum = 0.0;
+    for (int s = 0; s < jb->sun_count; ++s) {
+        const double *sun = jb->suns[s];
+        double c = n[0] * sun[0] + n[1] * sun[1] + n[2] * sun[2];
+        if (!(c > 0.0) || jb->sun_weights[s] == 0.0) {
+            continue;
+        }
+        if (ray_start(jb, p, n, sun, start) < 0.0) {
+            continue; // inside what the maps record: no light
+        }
+        double length = box_exit(jb->def->scene, start, sun);
+        if (ray_free(jb->def->collider, start, sun, length, jb->first)) {
+            sum += jb->sun_weights[s] * c;
+        }
+    }
+    return (float)fmin(1.0, fmax(0.0, sum));
+}
+
+// Mean curvature: the least-squares normal curvature over the neighbours
+// within the radius, sum (n_q - n_p) . (q - p) / sum |q - p|^2 (a sphere of
+// radius R gives 1/R exactly, a plane 0, a cylinder 1/(2R)).
+static float curvature(const job *jb, const wx_mask_def *m, int i, int j)
+{
+    const wx_mask_points *g = &jb->def->points;
+    double radius = m->radius > 0.0f ? m->radius : 4.0 * g->texel;
+    int reach = (int)ceil(radius / g->texel);
+    reach = reach < 1 ? 1 : (reach > CURVATURE_MAX_REACH ? CURVATURE_MAX_REACH : reach);
+    size_t t = (size_t)j * (size_t)g->width + (size_t)i;
+    const double *p = &g->position[3 * t];
+    const float *n = &g->normal[3 * t];
+    double num = 0.0, den = 0.0, r2max = radius * radius;
+    for (int y = j - reach; y <= j + reach; ++y) {
+        for (int x = i - reach; x <= i + reach; ++x) {
+            if (x < 0 || y < 0 || x >= g->width || y >= g->height || (x == i && y == j)) {
+                continue;
+            }
+            size_t q = (size_t)y * (size_t)g->width + (size_t)x;
+            if (!g->valid[q]) {
+                continue;
+            }
+            const double *pq = &g->position[3 * q];
+            const float *nq = &g->normal[3 * q];
+            double d[3] = { pq[0] - p[0], pq[1] - p[1], pq[2] - p[2] };
+            double r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+            if (!(r2 <= r2max) || !(r2 > 0.0) ||
+                !(n[0] * nq[0] + n[1] * nq[1] + n[2] * nq[2] > 0.0f)) {
+                continue; // too far, the same point, or the other side of a thin part
+            }
+            num += (nq[0] - n[0]) * d[0] + (nq[1] - n[1]) * d[1] + (nq[2] - n[2]) * d[2];
+            den += r2;
+        }
+    }
+    return den > 0.0 ? (float)(num / den) : 0.0f;
+}
+
+static float combine(const job *jb, const wx_mask_def *m, size_t t)
+{
+    double sum = 0.0;
+    for (int k = 0; k < m->term_count; ++k) {
+        const wx_term *term = &m->terms[k];
+        double x = term->kind == WX_TERM_CONSTANT ? term->constant
+                   : term->kind == WX_TERM_MASK   ? jb->out[term->index][t]
+                                                  : jb->def->substances[term->index][t];
+        sum += term->weight * wx_sigmoid(x, term->offset, term->steepness);
+    }
+    return (float)fmin(1.0, fmax(0.0, m->scale * sum));
+}
+
+static void mask_rows(int64_t begin, int64_t end, int worker, void *context)
+{
+    (void)worker;
+    const job *jb = context;
+    const wx_masks_def *def = jb->def;
+    const wx_mask_def *m = &def->scene->masks[jb->mask];
+    const wx_mask_points *g = &def->points;
+    float *out = jb->out[jb->mask];
+    double lo = m->has_min ? m->min : def->height_min, hi = m->has_max ? m->max : def->height_max;
+    for (int64_t j = begin; j < end; ++j) {
+        for (int i = 0; i < g->width; ++i) {
+            size_t t = (size_t)j * (size_t)g->width + (size_t)i;
+            if (!g->valid[t]) {
+                out[t] = 0.0f;
+                continue;
+            }
+            const double *p = &g->position[3 * t];
+            const float *n = &g->normal[3 * t];
+            switch (m->kind) {
+            case WX_MASK_ACCESSIBILITY:
+                out[t] = accessibility(jb, m, t, p, n);
+                break;
+            case WX_MASK_EXPOSURE:
+                out[t] = exposure(jb, p, n);
+                break;
+            case WX_MASK_CURVATURE:
+                out[t] = curvature(jb, m, i, (int)j);
+                break;
+            case WX_MASK_HEIGHT:
+                out[t] = hi > lo ? (float)fmin(1.0, fmax(0.0, (p[1] - lo) / (hi - lo))) : 0.0f;
+                break;
+            case WX_MASK_COMBINE:
+                out[t] = combine(jb, m, t);
+                break;
+            }
+        }
+    }
+}
+
+wx_result wx_masks_compute(const wx_masks_def *def, float *const *out, wx_error *err)
+{
+    (void)err;
+    const wx_scene *scene = def->scene;
+    job jb;
+    memset(&jb, 0, sizeof jb);
+    jb.def = def;
+    jb.out = out;
+    // Rays start two of the collider's texels off the surface; their first
+    // segment is four texels long.
+    float texel = def->points.texel;
+    for (int c = 0; def->collider != NULL && c < def->collider->camera_count; ++c) {
+        texel = fmaxf(texel, def->collider->cameras[c].texel_ws);
+    }
+    jb.offset = 2.0f * texel;
+    jb.first = 4.0 * texel;
+    for (int m = 0; m < scene->mask_count; ++m) {
+        const wx_mask_def *md = &scene->masks[m];
+        jb.mask = m;
+        if (md->kind == WX_MASK_EXPOSURE) {
+            // The main sun, and the two side suns at azimuth +- spread.
+            wx_sun_direction(md->elevation, md->azimuth, jb.suns[0]);
+            jb.sun_weights[0] = 1.0;
+            jb.sun_count = 1;
+            if (md->side_weight != 0.0f) {
+                double e = (double)md->side_elevation * md->elevation;
+                wx_sun_direction(e, (double)md->azimuth + md->side_spread, jb.suns[1]);
+                wx_sun_direction(e, (double)md->azimuth - md->side_spread, jb.suns[2]);
+                jb.sun_weights[1] = jb.sun_weights[2] = md->side_weight;
+                jb.sun_count = 3;
+            }
+        }
+        // Rays cost far more than the rest: rows in small work items.
+        wx_parallel_for(def->threads, def->points.height, wx_mask_rays(md) > 0 ? 1 : 16,
+                        mask_rows, &jb);
+    }
+    return WX_OK;
+}

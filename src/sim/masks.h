@@ -1,0 +1,65 @@
+// masks.h: the derived masks of docs/design.md section 12 (docs/masks.md):
+// accessibility, sun exposure with real shadows, curvature, height and
+// Riihiaho's sigmoid combinations, evaluated at the surface points of a target
+// (the output camera's texels, a TextureMap's texels).
+//
+// Accessibility and exposure march rays through the projected-maps collider
+// (collider.h), the very geometry the particles hit: a ray from a point
+// starts just off the surface (on the ray, two texels above the surface, so
+// that a surface never shadows itself and a shadow's edge stays put), and is cut into segments of doubling length, each
+// cleared by the collider's coarse pyramid when it can be and swept otherwise.
+// Directions are stratified per point (a Hammersley set rotated by a hash of
+// the seed, the mask and the point), so the result is the same for any thread
+// count and 32-64 rays give a smooth mask without a second pass.
+#ifndef WX_MASKS_H
+#define WX_MASKS_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "core/error.h"
+#include "model/scene.h"
+#include "sim/collider.h"
+
+/// Where the masks are evaluated: a width x height grid of surface points
+/// (texel (i, j) at j*width + i), views into memory the caller owns.
+typedef struct wx_mask_points {
+    int width, height;
+    const double *position;      ///< 3 per point, world
+    const float *normal;         ///< 3 per point, unit, facing out of the surface
+    const unsigned char *valid;  ///< 1 where a point is evaluated; the others get 0
+    /// The grid's texel size in world units: what Curvature's default radius
+    /// (4 texels) and its neighbourhood in the grid are measured in.
+    float texel;
+} wx_mask_points;
+
+/// Everything the masks need.
+typedef struct wx_masks_def {
+    const wx_scene *scene;        ///< the masks (in order), the bounding box
+    const wx_collider *collider;  ///< the input cameras' maps; NULL: no occluder anywhere
+    wx_mask_points points;
+    /// The substances' values at the points (per square metre), one plane per
+    /// substance of the scene: what a Combine's substance terms read.
+    const float *const *substances;
+    float height_min, height_max; ///< Height's range where a mask does not give it
+    uint64_t seed;
+    int threads;
+} wx_masks_def;
+
+/// Fills out[m] (width*height floats) for every mask m of the scene, in order
+/// (a Combine reads the masks before it). WX_FAIL when out of memory.
+wx_result wx_masks_compute(const wx_masks_def *def, float *const *out, wx_error *err);
+
+/// Riihiaho's sigmoid (his eq. 3.7): (x - o) / (2 sqrt(1/s + (x - o)^2)) + 1/2
+/// for steepness s > 0; x itself for s = 0.
+double wx_sigmoid(double x, double offset, double steepness);
+
+/// The unit direction of a sun at elevation e and azimuth a (degrees; azimuth
+/// from +X towards +Z): (cos e cos a, sin e, cos e sin a).
+void wx_sun_direction(double elevation, double azimuth, double out[3]);
+
+/// Rays a mask marches per point (0 for the masks that march none): for the
+/// cost estimate of `info`.
+int wx_mask_rays(const wx_mask_def *mask);
+
+#endif
