@@ -92,28 +92,79 @@ static void frame_of(const float n[3], double t[3], double b[3])
     b[2] = -n[1];
 }
 
+// The part of a ray that some camera sees: beyond the last camera's frame
+// nothing can stop it (docs/design.md section 4: a point no camera sees does
+// not collide). The distance from p along dir where the last frame is left.
+static double frames_exit(const wx_collider *collider, const double p[3], const double dir[3],
+                          double length)
+{
+    double last = 0.0;
+    for (int c = 0; c < collider->camera_count; ++c) {
+        const wx_collider_camera *cam = &collider->cameras[c];
+        double lo = 0.0, hi = length;
+        const double *rows[2] = { cam->mx, cam->my };
+        const double size[2] = { cam->width, cam->height };
+        for (int a = 0; a < 2 && lo <= hi; ++a) {
+            const double *m = rows[a];
+            double x0 = m[0] * p[0] + m[1] * p[1] + m[2] * p[2] + m[3];
+            double dx = m[0] * dir[0] + m[1] * dir[1] + m[2] * dir[2];
+            if (fabs(dx) < 1e-12) {
+                if (!(x0 >= 0.0 && x0 <= size[a])) {
+                    hi = -1.0;
+                }
+                continue;
+            }
+            double t0 = (0.0 - x0) / dx, t1 = (size[a] - x0) / dx;
+            lo = fmax(lo, fmin(t0, t1));
+            hi = fmin(hi, fmax(t0, t1));
+        }
+        if (lo <= hi) {
+            last = fmax(last, hi);
+        }
+    }
+    return last;
+}
+
+// Whether segment a -> b of a ray is free: cleared by the coarse pyramid, or
+// cut in two halves (the finer levels bound it tighter) down to `finest`, then
+// swept.
+static bool segment_free(const wx_collider *collider, const double a[3], const double b[3],
+                         double length, double finest)
+{
+    float fa[3] = { (float)a[0], (float)a[1], (float)a[2] };
+    float fb[3] = { (float)b[0], (float)b[1], (float)b[2] };
+    if (wx_collider_coarse_clear(collider, fa, fb)) {
+        return true;
+    }
+    if (length <= finest) {
+        wx_hit hit;
+        return !wx_collider_sweep(collider, fa, fb, &hit);
+    }
+    double m[3] = { 0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1]), 0.5 * (a[2] + b[2]) };
+    return segment_free(collider, a, m, 0.5 * length, finest) &&
+           segment_free(collider, m, b, 0.5 * length, finest);
+}
+
 // True when the ray from p along unit dir travels `length` without entering a
-// surface the collider records: segments of doubling length, each cleared by
-// the coarse pyramid when it can be, swept otherwise.
+// surface the collider records: cut at the last camera frame it crosses, then
+// in segments of doubling length (segment_free).
 static bool ray_free(const wx_collider *collider, const double p[3], const double dir[3],
                      double length, double first)
 {
     if (collider == NULL) {
         return true;
     }
+    length = frames_exit(collider, p, dir, length);
     double t0 = 0.0, step = first;
     while (t0 < length) {
         double t1 = fmin(length, t0 + step);
-        float a[3], b[3];
+        double a[3], b[3];
         for (int k = 0; k < 3; ++k) {
-            a[k] = (float)(p[k] + dir[k] * t0);
-            b[k] = (float)(p[k] + dir[k] * t1);
+            a[k] = p[k] + dir[k] * t0;
+            b[k] = p[k] + dir[k] * t1;
         }
-        if (!wx_collider_coarse_clear(collider, a, b)) {
-            wx_hit hit;
-            if (wx_collider_sweep(collider, a, b, &hit)) {
-                return false;
-            }
+        if (!segment_free(collider, a, b, t1 - t0, first)) {
+            return false;
         }
         t0 = t1;
         step *= 2.0;
