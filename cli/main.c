@@ -29,6 +29,7 @@
 #include "pipeline/run.h"
 #include "pipeline/texture_phase.h"
 #include "sim/emitter.h"
+#include "sim/masks.h"
 #include "core/limits.h"
 #include "model/camera.h"
 
@@ -314,6 +315,80 @@ static void print_camera(const wx_scene *scene, const wx_scene_camera *sc)
     }
 }
 
+// The derived masks (docs/masks.md), and what their rays cost: one per point
+// of the mask and of every texture, estimated at the texels they cover at most,
+// at the rate bench_masks measures (about 1.3 million rays a second a thread).
+static void print_masks(const wx_scene *scene, int threads)
+{
+    static const char *const kinds[] = { "accessibility", "exposure", "curvature", "height",
+                                         "combine" };
+    if (scene->mask_count == 0) {
+        return;
+    }
+    double points = 0.0;
+    if (scene->output_index >= 0) {
+        const wx_scene_camera *out = &scene->cameras[scene->output_index];
+        points += (double)out->output_width * out->output_height;
+    }
+    for (int t = 0; t < scene->texture_count; ++t) {
+        points += (double)scene->textures[t].width * scene->textures[t].height;
+    }
+    printf("masks (%d), channels NAME.Y:\n", scene->mask_count);
+    double rays = 0.0;
+    for (int m = 0; m < scene->mask_count; ++m) {
+        const wx_mask_def *md = &scene->masks[m];
+        printf("  %-12s %s", md->name, kinds[md->kind]);
+        switch (md->kind) {
+        case WX_MASK_ACCESSIBILITY:
+            printf(", %d rays within %g", md->rays, (double)md->distance);
+            break;
+        case WX_MASK_EXPOSURE:
+            printf(", sun at elevation %g azimuth %g", (double)md->elevation, (double)md->azimuth);
+            if (md->side_weight != 0.0f) {
+                printf(", side suns of weight %g at elevation %g azimuth %g +- %g",
+                       (double)md->side_weight, (double)(md->side_elevation * md->elevation),
+                       (double)md->azimuth, (double)md->side_spread);
+            }
+            break;
+        case WX_MASK_CURVATURE:
+            if (md->radius > 0.0f) {
+                printf(", over %g", (double)md->radius);
+            } else {
+                printf(", over 4 target texels");
+            }
+            break;
+        case WX_MASK_HEIGHT:
+            if (md->has_min && md->has_max) {
+                printf(", y from %g to %g", (double)md->min, (double)md->max);
+            } else {
+                printf(", y over the geometry's bounds%s", md->has_min || md->has_max ? " (one end given)" : "");
+            }
+            break;
+        case WX_MASK_COMBINE:
+            printf(", scale %g:", (double)md->scale);
+            for (int k = 0; k < md->term_count; ++k) {
+                const wx_term *t = &md->terms[k];
+                printf(" %s%g x S(", k > 0 ? "+ " : "", (double)t->weight);
+                if (t->kind == WX_TERM_CONSTANT) {
+                    printf("%g", (double)t->constant);
+                } else {
+                    printf("%s", t->kind == WX_TERM_MASK ? scene->masks[t->index].name
+                                                          : scene->substances[t->index]);
+                }
+                printf(t->steepness > 0.0f ? "; offset %g, steepness %g)" : ")",
+                       (double)t->offset, (double)t->steepness);
+            }
+            break;
+        }
+        printf("\n");
+        rays += points * wx_mask_rays(md);
+    }
+    if (rays > 0.0) {
+        printf("  rays: at most %.0f million over %.0f target texels, about %.0f s on %d thread%s\n",
+               rays / 1e6, points, rays / (1.3e6 * threads), threads, threads == 1 ? "" : "s");
+    }
+}
+
 // A TextureMap: its mesh, size, UV channel and smoothing; its coverage,
 // overlaps and padding estimated on a raster of at most 1024 texels a side;
 // the triangles outside the tile (exact); its memory.
@@ -496,6 +571,7 @@ static int command_info(const cli_args *args)
         print_rules(&scene, scene.rules, scene.rule_count);
         printf("\n");
     }
+    print_masks(&scene, opts.threads);
     printf("meshes (%d):\n", scene.mesh_count);
     for (int m = 0; m < scene.mesh_count; ++m) {
         const wx_mesh *mesh = &scene.meshes[m];

@@ -80,6 +80,17 @@ void wx_memory_estimate(const wx_scene *scene, unsigned phases, wx_memory_need *
     }
     // The mask: the gather's planes per output texel, one plane per substance.
     double gather_out = WX_GATHER_BYTES_PER_OUTPUT_TEXEL + WX_PLANE_BYTES_PER_TEXEL * (S - 1);
+    // Derived masks (docs/masks.md): a plane each, and while they are computed
+    // the points (a double position and a flag per texel); the collider's copy
+    // of every input camera's depth with its pyramid, and zero impact planes.
+    double collider = 0.0;
+    if (scene->mask_count > 0) {
+        gather_out += WX_PLANE_BYTES_PER_TEXEL * scene->mask_count + 25.0;
+        collider = 0.0; // filled once the input texels are known, below
+    }
+    if (scene->mask_count > 0) {
+        collider = WX_MASK_COLLIDER_BYTES_PER_TEXEL * input_texels + 8.0 * largest_input;
+    }
     bool textures = scene->texture_count > 0 && (phases & (WX_PHASE_SIMULATE | WX_PHASE_GATHER));
     bool texture_frames = false;
     for (int t = 0; textures && t < scene->texture_count; ++t) {
@@ -139,7 +150,7 @@ void wx_memory_estimate(const wx_scene *scene, unsigned phases, wx_memory_need *
         need->gather_bytes =
             (WX_GATHER_BYTES_PER_INPUT_TEXEL + WX_PLANE_BYTES_PER_TEXEL * simulated_extra) *
                 input_texels +
-            gather_out * (out != NULL ? output_texels : 0.0) + need->texture_raster_bytes +
+            gather_out * (out != NULL ? output_texels : 0.0) + collider + need->texture_raster_bytes +
             need->texture_write_bytes;
     }
     // The renderer leaves part of its memory behind for the phases after it.

@@ -36,6 +36,10 @@ typedef struct wx_memory_need {
     int mesh_line;             ///< scene line of the largest mesh file
 } wx_memory_need;
 
+/// Bytes per input texel of the derived masks' collider: its depth copy and
+/// the coarse pyramid's levels.
+#define WX_MASK_COLLIDER_BYTES_PER_TEXEL 6.0
+
 /// The program's own memory before any scene data (code, libraries, heaps).
 #define WX_MEMORY_BASELINE (64.0 * 1024.0 * 1024.0)
 /// The GL context and llvmpipe's own buffers in the bake.

@@ -410,7 +410,9 @@ int64_t wx_texture_bytes(const wx_scene *scene, const wx_texture_map *t, int64_t
     // channels and the preview's alpha; the compressed chunks written (at most
     // the image again); every channel but seen on every input camera, and the
     // gather's planes for one of them (the adaptive pass's 14 floats a texel).
-    return texels * (4 + 4 + 1) + texels * 4 * (channels + 1) + texels * 4 * channels +
+    // The derived masks' points: a double position, a normal and a flag.
+    const int64_t points = scene->mask_count > 0 ? texels * (24 + 12 + 1) : 0;
+    return points + texels * (4 + 4 + 1) + texels * 4 * (channels + 1) + texels * 4 * channels +
            camera_texels * 4 * (channels - 1) + camera_texels / (scene->input_count > 0 ?
                                                                  scene->input_count : 1) * 4 * 14;
 }
