@@ -212,7 +212,8 @@ static wx_result write_mask(const wx_scene *scene, const wx_run_def *opts, const
     }
     // One gather per substance: its amount and baseline planes (model/maps.h),
     // the hits all substances share.
-    const int substances = scene->substance_count;
+    // A scene made in memory may leave substance_count 0: the one substance.
+    const int substances = scene->substance_count > 0 ? scene->substance_count : 1;
     for (int s = 0; s < substances && result == WX_OK; ++s) {
         for (int v = 0; v < k; ++v) {
             size_t plane = (size_t)s * (size_t)in_maps[v].width * (size_t)in_maps[v].height;

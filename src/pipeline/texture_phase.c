@@ -241,7 +241,7 @@ static wx_result texture_masks(const wx_scene *scene, const wx_run_def *opts,
                               .valid = valid,
                               .texel = ras->covered > 0 ? (float)sqrt(area / (double)ras->covered)
                                                         : 1.0f };
-    const int S = scene->substance_count;
+    const int S = image->channel_count - 1 - scene->mask_count;
     wx_result r = wx_masks_at_points(scene, opts, masks, &points,
                                      (const float *const *)image->channels, image->channels + S,
                                      err);
@@ -282,7 +282,7 @@ static wx_result write_texture(const wx_scene *scene, const wx_run_def *opts,
                               .inputs = views,
                               .input_count = scene->input_count,
                               .smoothed = (const float *const *)planes,
-                              .channels = scene->substance_count,
+                              .channels = channels - 1 - scene->mask_count,
                               .threads = opts->threads };
         r = wx_texture_sample(&td, image->channels, image->channels[channels - 1], NULL, err);
     }
@@ -348,7 +348,7 @@ wx_result wx_textures_write(const wx_scene *scene, const wx_run_def *opts,
     }
     char names[WX_IMAGE_MAX_CHANNELS][WX_NAME_MAX];
     const int channels = wx_texture_channels(scene, names);
-    const int substances = scene->substance_count;
+    const int substances = scene->substance_count > 0 ? scene->substance_count : 1;
     const int planes_per_key = scene->input_count * substances;
     wx_gather_view *views = calloc((size_t)scene->input_count + 1, sizeof *views);
     camera_planes *cache = calloc((size_t)textures->count, sizeof *cache);
