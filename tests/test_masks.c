@@ -393,6 +393,23 @@ TEST(masks_in_a_texture)
     free(seen);
 }
 
+// Rays are stratified per point from a hash of the seed, the mask and the
+// point: the same bytes for 1 and 2 threads.
+TEST(same_bytes_for_any_thread_count)
+{
+    const char *dir = ensure_tmpdir();
+    static const double wall[2][6] = { { -1, -0.1, -3, 7, 0, 3 }, { -0.25, 0, -3, 0, 1, 3 } };
+    write_boxes(dir, "t.obj", wall, 2);
+    write_scene(dir, "t.xml", "t.obj", 3.0, 8.0, 128,
+                "<Accessibility name=\"ao\" rays=\"16\" distance=\"1\"/>"
+                "<Exposure name=\"sun\" elevation=\"30\" azimuth=\"170\" sideWeight=\"0.3\" "
+                "sideSpread=\"40\"/><Curvature name=\"k\"/>",
+                "", NULL);
+    ENSURE(run_in(dir, "run t.xml --out one -q --threads 1") == 0);
+    ENSURE(run_in(dir, "run t.xml --out two -q --threads 2") == 0);
+    ENSURE(ensure_shell(out, sizeof out, "cd '%s' && cmp one/mask.exr two/mask.exr", dir) == 0);
+}
+
 int main(void)
 {
     RUN(sigmoid_and_sun_direction);
@@ -401,5 +418,6 @@ int main(void)
     RUN(inside_a_closed_box);
     RUN(sphere_curvature_and_height);
     RUN(masks_in_a_texture);
+    RUN(same_bytes_for_any_thread_count);
     return ensure_summary();
 }
