@@ -1,9 +1,13 @@
 // main.c: the `weathering` command line (docs/design.md section 6).
 //
 //   weathering COMMAND SCENE.xml [--out DIR] [--seed N] [--threads N] [--stats FILE.json] [-q]
+//   weathering init MESH [--preset P] [-o SCENE.xml] [--resolution PX] [--units U] [--force]
+//   weathering run MESH --preset P [options]      (docs/presets.md)
+//   weathering split FILE.exr [--out DIR]
 //
 // Exit status: 0 success, 2 bad usage or bad input (one message naming the file,
 // and the line for XML), 1 any other failure.
+#define _XOPEN_SOURCE 700 // realpath
 #include <errno.h>
 #include <inttypes.h>
 #include <math.h>
@@ -12,13 +16,18 @@
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
+#include <limits.h>
+#include <strings.h>
+#include <sys/stat.h>
 
 #include "core/atomic_file.h"
 #include "core/progress.h"
 #include "core/usage.h"
+#include "io/exr.h"
 #include "io/scene_xml.h"
 #include "io/stats_json.h"
 #include "model/geometry.h"
+#include "model/image.h"
 #include "model/scene.h"
 #include "pipeline/bake_phase.h"
 #include "pipeline/gather_phase.h"
@@ -26,6 +35,7 @@
 #include "pipeline/memory.h"
 #include "pipeline/outputs.h"
 #include "pipeline/pipeline.h"
+#include "pipeline/preset.h"
 #include "pipeline/run.h"
 #include "pipeline/texture_phase.h"
 #include "sim/emitter.h"
@@ -44,6 +54,12 @@ typedef struct cli_args {
     bool seed_set;
     int threads; // 0: all cores
     bool quiet;
+    // init, and run on a mesh (docs/presets.md).
+    const char *preset;   // NULL: rain
+    const char *init_out; // -o SCENE.xml
+    int resolution;       // 0: 1024
+    const char *units;    // NULL: m
+    bool force;
 } cli_args;
 
 typedef int (*command_fn)(const cli_args *args);
@@ -59,6 +75,8 @@ static int command_bake(const cli_args *args);
 static int command_simulate(const cli_args *args);
 static int command_gather(const cli_args *args);
 static int command_run(const cli_args *args);
+static int command_init(const cli_args *args);
+static int command_split(const cli_args *args);
 
 static const command commands[] = {
     { "run", command_run, "bake what needs baking, simulate, gather: the whole job" },
@@ -66,6 +84,8 @@ static const command commands[] = {
     { "simulate", command_simulate, "fly the particles; write <camera>_dirt.exr" },
     { "gather", command_gather, "turn the dirt maps into the mask and the TextureMaps" },
     { "info", command_info, "validate a scene and print what it holds" },
+    { "init", command_init, "write a commented scene for a mesh from a preset (MESH, not SCENE)" },
+    { "split", command_split, "write each channel of an EXR as a file of its own (FILE.exr)" },
 };
 enum { COMMAND_COUNT = sizeof commands / sizeof commands[0] };
 
@@ -73,6 +93,9 @@ static void print_usage(FILE *out)
 {
     fprintf(out,
             "usage: weathering COMMAND SCENE.xml [options]\n"
+            "       weathering init MESH [--preset P] [-o SCENE.xml] [--resolution PX] [--units U] [--force]\n"
+            "       weathering run MESH --preset P [options]\n"
+            "       weathering split FILE.exr [--out DIR]\n"
             "\n"
             "Particle-driven weathering masks: dirt-carrying particles collide against\n"
             "depth maps of a model and leave a dirt mask for compositing.\n"
@@ -89,6 +112,11 @@ static void print_usage(FILE *out)
             "  --threads N        worker threads (default: all cores)\n"
             "  --stats FILE.json  write run statistics as JSON\n"
             "  -q, --quiet        no progress bars or notes on stderr\n"
+            "  --preset P         init, run MESH: rain (default), dust, soot or moss\n"
+            "  -o SCENE.xml       init: the scene to write (default: MESH's name .xml here)\n"
+            "  --resolution PX    init, run MESH: texels across the largest frame (1024)\n"
+            "  --units U          init, run MESH: the mesh's unit: m (default), cm, mm, in, ft\n"
+            "  --force            init: replace an existing scene file\n"
             "  -h, --help         this help\n"
             "  --version          print the version\n"
             "\n"
@@ -169,6 +197,33 @@ static int parse_args(int argc, char **argv, cli_args *args)
                 return usage_error("--threads takes a whole number from 1 to 1024, not '%s'", v);
             }
             args->threads = (int)n;
+        } else if (is_option(arg, "--preset")) {
+            args->preset = option_value(argc, argv, &i, "--preset", &missing);
+            if (!missing && wx_preset_find(args->preset) < 0) {
+                return usage_error("unknown preset '%s' (presets: rain, dust, soot, moss)",
+                                   args->preset);
+            }
+        } else if (strcmp(arg, "-o") == 0 || is_option(arg, "--output")) {
+            args->init_out = option_value(argc, argv, &i, arg[1] == 'o' ? "-o" : "--output",
+                                          &missing);
+            if (!missing && (args->init_out[0] == '\0' || strlen(args->init_out) >= WX_PATH_MAX)) {
+                return usage_error("%s needs a file name", "-o");
+            }
+        } else if (is_option(arg, "--resolution")) {
+            const char *v = option_value(argc, argv, &i, "--resolution", &missing);
+            uint64_t n = 0;
+            if (!missing && !wx_parse_whole(v, 16, 16384, &n)) {
+                return usage_error("--resolution takes a whole number from 16 to 16384, not '%s'",
+                                   v);
+            }
+            args->resolution = (int)n;
+        } else if (is_option(arg, "--units")) {
+            args->units = option_value(argc, argv, &i, "--units", &missing);
+            if (!missing && !(wx_unit_metres(args->units) > 0.0)) {
+                return usage_error("--units takes m, cm, mm, in or ft, not '%s'", args->units);
+            }
+        } else if (strcmp(arg, "--force") == 0) {
+            args->force = true;
         } else if (arg[0] == '-' && arg[1] != '\0') {
             return usage_error("unknown option '%s'", arg);
         } else if (args->command == NULL) {
@@ -742,9 +797,217 @@ static int command_gather(const cli_args *args)
     return run_phases(args, WX_PHASE_GATHER);
 }
 
+// --- init, run MESH, split (docs/presets.md) -------------------------------------
+
+// A scene file is an .xml; anything else given to `run` is a mesh.
+static bool is_scene_file(const char *path)
+{
+    size_t n = strlen(path);
+    return n >= 4 && strcasecmp(path + n - 4, ".xml") == 0;
+}
+
+static void mesh_base(const char *path, char *out, size_t cap)
+{
+    const char *slash = strrchr(path, '/');
+    snprintf(out, cap, "%s", slash != NULL ? slash + 1 : path);
+    char *dot = strrchr(out, '.');
+    if (dot != NULL && dot != out) {
+        *dot = '\0';
+    }
+}
+
+// The scene text for the mesh of `args`, its path written as `mesh_ref`.
+static int generate(const cli_args *args, const char *mesh_ref, char **text)
+{
+    wx_init_def def = { .mesh_path = args->scene_path,
+                        .mesh_ref = mesh_ref,
+                        .preset = args->preset,
+                        .resolution = args->resolution,
+                        .unit_m = args->units != NULL ? wx_unit_metres(args->units) : 1.0 };
+    wx_error err;
+    wx_result r = wx_scene_generate(&def, text, &err);
+    if (r != WX_OK) {
+        fprintf(stderr, "weathering: %s\n", err.message);
+    }
+    return r;
+}
+
+// Creates `path` and its parents (mkdir -p).
+static bool make_folder(const char *path)
+{
+    char buf[WX_PATH_MAX];
+    snprintf(buf, sizeof buf, "%s", path);
+    for (char *p = buf + 1; *p != '\0'; ++p) {
+        if (*p == '/') {
+            *p = '\0';
+            if (mkdir(buf, 0777) != 0 && errno != EEXIST) {
+                return false;
+            }
+            *p = '/';
+        }
+    }
+    return mkdir(buf, 0777) == 0 || errno == EEXIST;
+}
+
+static int command_init(const cli_args *args)
+{
+    char scene_path[WX_PATH_MAX], base[256];
+    mesh_base(args->scene_path, base, sizeof base);
+    if (args->init_out != NULL) {
+        snprintf(scene_path, sizeof scene_path, "%s", args->init_out);
+    } else {
+        snprintf(scene_path, sizeof scene_path, "%s.xml", base);
+    }
+    if (!is_scene_file(scene_path)) {
+        return usage_error("-o %s: the scene's name must end in .xml", scene_path);
+    }
+    struct stat st;
+    if (!args->force && stat(scene_path, &st) == 0) {
+        fprintf(stderr, "weathering: %s exists; give --force to replace it\n", scene_path);
+        return WX_BAD_INPUT;
+    }
+    // The mesh as the scene names it: as given when the scene is written in the
+    // current folder and the path is relative, else absolute.
+    char mesh_ref[WX_PATH_MAX];
+    if (strchr(scene_path, '/') == NULL && args->scene_path[0] != '/') {
+        snprintf(mesh_ref, sizeof mesh_ref, "%s", args->scene_path);
+    } else if (realpath(args->scene_path, mesh_ref) == NULL) {
+        fprintf(stderr, "weathering: %s: mesh file not found\n", args->scene_path);
+        return WX_BAD_INPUT;
+    }
+    char *text = NULL;
+    int status = generate(args, mesh_ref, &text);
+    if (status != WX_OK) {
+        return status;
+    }
+    wx_error err;
+    wx_result r = wx_write_file_atomic(scene_path, text, strlen(text), &err);
+    free(text);
+    if (r != WX_OK) {
+        fprintf(stderr, "weathering: %s\n", err.message);
+        return r;
+    }
+    // What the scene says, checked as a run would read it.
+    wx_scene scene;
+    r = wx_scene_load(scene_path, &scene, &err);
+    if (r != WX_OK) {
+        fprintf(stderr, "weathering: the generated scene does not load (a bug): %s\n",
+                err.message);
+        return WX_FAIL;
+    }
+    if (!args->quiet) {
+        fprintf(stderr,
+                "weathering: wrote %s (preset %s: %d cameras, %d emitter%s%s); run it with "
+                "`weathering run %s`\n",
+                scene_path, args->preset != NULL ? args->preset : "rain", scene.camera_count,
+                scene.emitter_count, scene.emitter_count == 1 ? "" : "s",
+                scene.texture_count > 0 ? ", a TextureMap" : "", scene_path);
+    }
+    wx_scene_free(&scene);
+    return WX_OK;
+}
+
 static int command_run(const cli_args *args)
 {
-    return run_phases(args, WX_PHASE_BAKE | WX_PHASE_SIMULATE | WX_PHASE_GATHER);
+    const unsigned all = WX_PHASE_BAKE | WX_PHASE_SIMULATE | WX_PHASE_GATHER;
+    if (is_scene_file(args->scene_path)) {
+        return run_phases(args, all);
+    }
+    // A mesh: its scene generated into the output folder as scene.xml, then run.
+    char out_dir[WX_PATH_MAX], base[256], mesh_ref[WX_PATH_MAX], scene_path[WX_PATH_MAX + 16];
+    mesh_base(args->scene_path, base, sizeof base);
+    if (args->out_dir != NULL) {
+        snprintf(out_dir, sizeof out_dir, "%s", args->out_dir);
+    } else {
+        snprintf(out_dir, sizeof out_dir, "out/%s", base);
+    }
+    if (realpath(args->scene_path, mesh_ref) == NULL) {
+        fprintf(stderr, "weathering: %s: mesh file not found\n", args->scene_path);
+        return WX_BAD_INPUT;
+    }
+    char *text = NULL;
+    int status = generate(args, mesh_ref, &text);
+    if (status != WX_OK) {
+        return status;
+    }
+    snprintf(scene_path, sizeof scene_path, "%s/scene.xml", out_dir);
+    wx_error err;
+    wx_result r = make_folder(out_dir)
+                      ? wx_write_file_atomic(scene_path, text, strlen(text), &err)
+                      : wx_fail(&err, WX_CAUSE_UNREADABLE, "%s: cannot create the folder",
+                                out_dir);
+    free(text);
+    if (r != WX_OK) {
+        fprintf(stderr, "weathering: %s\n", err.message);
+        return r;
+    }
+    cli_args scene_args = *args;
+    scene_args.scene_path = scene_path;
+    scene_args.out_dir = out_dir;
+    return run_phases(&scene_args, all);
+}
+
+// Every channel of an EXR as a single-channel file BASE_NAME.exr (channel Y
+// inside; NAME.Y gives BASE_NAME), for programs that read one layer at a time
+// (Blender 3.4's shader nodes). Prints the written paths.
+static int command_split(const cli_args *args)
+{
+    wx_image *in = calloc(1, sizeof *in), *one = calloc(1, sizeof *one);
+    wx_error err;
+    wx_result r = in != NULL && one != NULL ? wx_exr_read_header(args->scene_path, in, &err)
+                                            : wx_fail(&err, WX_CAUSE_OUT_OF_MEMORY, "out of memory");
+    int count = r == WX_OK ? in->channel_count : 0;
+    char names[WX_IMAGE_MAX_CHANNELS][WX_NAME_MAX];
+    const char *wanted[WX_IMAGE_MAX_CHANNELS];
+    for (int c = 0; c < count; ++c) {
+        snprintf(names[c], WX_NAME_MAX, "%s", in->channel_names[c]);
+        wanted[c] = names[c];
+    }
+    if (in != NULL) {
+        wx_image_free(in);
+    }
+    if (r == WX_OK) {
+        r = wx_exr_read(args->scene_path, wanted, count, in, &err);
+    }
+    char dir[WX_PATH_MAX], base[256];
+    const char *slash = strrchr(args->scene_path, '/');
+    if (args->out_dir != NULL) {
+        snprintf(dir, sizeof dir, "%s", args->out_dir);
+    } else if (slash != NULL) {
+        snprintf(dir, sizeof dir, "%.*s", (int)(slash - args->scene_path), args->scene_path);
+    } else {
+        snprintf(dir, sizeof dir, ".");
+    }
+    mesh_base(args->scene_path, base, sizeof base);
+    static const char *const y[1] = { "Y" };
+    for (int c = 0; c < count && r == WX_OK; ++c) {
+        char name[WX_NAME_MAX], path[WX_PATH_MAX + 512];
+        snprintf(name, sizeof name, "%s", names[c]);
+        size_t n = strlen(name);
+        if (n > 2 && strcmp(name + n - 2, ".Y") == 0) {
+            name[n - 2] = '\0';
+        }
+        snprintf(path, sizeof path, "%s/%s_%s.exr", dir, base, name);
+        r = wx_image_alloc(one, in->width, in->height, 1, y, &err);
+        if (r == WX_OK) {
+            memcpy(one->channels[0], in->channels[c],
+                   (size_t)in->width * (size_t)in->height * sizeof(float));
+            r = wx_exr_write(path, one, &err);
+            wx_image_free(one);
+        }
+        if (r == WX_OK) {
+            printf("%s\n", path);
+        }
+    }
+    if (r != WX_OK) {
+        fprintf(stderr, "weathering: %s\n", err.message);
+    }
+    if (in != NULL) {
+        wx_image_free(in);
+    }
+    free(in);
+    free(one);
+    return r;
 }
 
 // --- interrupts -------------------------------------------------------------------
@@ -792,7 +1055,16 @@ int main(int argc, char **argv)
     for (int i = 0; i < COMMAND_COUNT; ++i) {
         if (strcmp(args.command, commands[i].name) == 0) {
             if (args.scene_path == NULL) {
-                return usage_error("%s needs a scene file", args.command);
+                return usage_error("%s needs a file", args.command);
+            }
+            bool mesh_options = args.preset != NULL || args.init_out != NULL ||
+                                args.resolution > 0 || args.units != NULL || args.force;
+            bool takes_them = strcmp(args.command, "init") == 0 ||
+                              (strcmp(args.command, "run") == 0 && !is_scene_file(args.scene_path));
+            if (mesh_options && !takes_them) {
+                return usage_error("--preset, -o, --resolution, --units and --force are for "
+                                   "`init MESH` and `run MESH` (%s was given a scene)",
+                                   args.command);
             }
             return commands[i].run(&args);
         }

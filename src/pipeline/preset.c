@@ -1,0 +1,380 @@
+// preset.c: scenes generated for a mesh (preset.h, docs/presets.md).
+#include "pipeline/preset.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "io/mesh_import.h"
+#include "model/mesh.h"
+
+const char *const wx_preset_names[] = { "rain", "dust", "soot", "moss" };
+const int wx_preset_count = 4;
+
+enum { PRESET_RAIN, PRESET_DUST, PRESET_SOOT, PRESET_MOSS };
+
+/// What a preset sets: the physics of its particles (relative to the mesh's
+/// size s and the fall's duration) and its surfaces.
+typedef struct preset {
+    const char *what;     // one line for the scene's header
+    double speed;         // launch speed, in mesh sizes per second
+    double gravity;       // share of gravity (drag on dust and soot)
+    double spread;        // degrees of the emitter's cone
+    double wind;          // wind force, in shares of gravity
+    double wind_dir[3];
+    double turbulence;    // turbulence strength, in shares of gravity
+    double particles;     // particles over the run (all iterations)
+    int iterations;
+    bool bottom;          // a camera below (particles reach undersides)
+    double absorption, bounce, deposit, erosion;
+    double resilience, friction;
+} preset;
+
+static const preset presets[] = {
+    [PRESET_RAIN] = { "rain slanting in a steady wind: streaks below what sticks out, washed "
+                      "tops, clean sheltered walls",
+                      2.0, 1.0, 8.0, 0.3, { -1.0, 0.0, -0.4 }, 0.0, 400000, 1, false,
+                      0.05, 0.15, 0.3, 0.4, 0.2, 0.9 },
+    [PRESET_DUST] = { "dust settling from still air: tops and ledges gather it, undersides stay "
+                      "clean",
+                      0.3, 0.2, 20.0, 0.0, { 0.0, 0.0, 0.0 }, 0.1, 300000, 1, false,
+                      0.3, 0.05, 0.8, 0.02, 0.1, 0.6 },
+    [PRESET_SOOT] = { "soot drifting on a turbulent breeze: a sticky film on the windward side, "
+                      "thinner on tops, some on undersides",
+                      0.4, 0.1, 30.0, 0.15, { 1.0, 0.0, 0.3 }, 0.25, 300000, 1, true,
+                      0.5, 0.05, 0.9, 0.01, 0.05, 0.8 },
+    [PRESET_MOSS] = { "five rainy spells: the rain's water lingers, moss grows from it where it "
+                      "stays wet, and a 'mossy' mask adds shelter and shade",
+                      2.0, 1.0, 8.0, 0.3, { -1.0, 0.0, -0.4 }, 0.0, 400000, 5, false,
+                      0.3, 0.1, 0.5, 0.1, 0.2, 0.9 },
+};
+
+int wx_preset_find(const char *name)
+{
+    for (int p = 0; p < wx_preset_count; ++p) {
+        if (strcmp(name, wx_preset_names[p]) == 0) {
+            return p;
+        }
+    }
+    return -1;
+}
+
+double wx_unit_metres(const char *name)
+{
+    static const struct {
+        const char *name;
+        double metres;
+    } units[] = { { "m", 1.0 }, { "cm", 0.01 }, { "mm", 0.001 }, { "in", 0.0254 },
+                  { "ft", 0.3048 } };
+    for (size_t k = 0; k < sizeof units / sizeof units[0]; ++k) {
+        if (strcmp(name, units[k].name) == 0) {
+            return units[k].metres;
+        }
+    }
+    return 0.0;
+}
+
+// ---------------------------------------------------------------------------
+// The text.
+
+typedef struct text {
+    char *s;
+    size_t len, cap;
+    bool failed;
+} text;
+
+static void put(text *t, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+
+static void put(text *t, const char *fmt, ...)
+{
+    for (int tries = 0; tries < 2 && !t->failed; ++tries) {
+        va_list ap;
+        va_start(ap, fmt);
+        int n = vsnprintf(t->s != NULL ? t->s + t->len : NULL, t->s != NULL ? t->cap - t->len : 0,
+                          fmt, ap);
+        va_end(ap);
+        if (n < 0) {
+            t->failed = true;
+            return;
+        }
+        if (t->s != NULL && t->len + (size_t)n < t->cap) {
+            t->len += (size_t)n;
+            return;
+        }
+        size_t cap = (t->cap + (size_t)n + 1) * 2;
+        char *s = realloc(t->s, cap);
+        if (s == NULL) {
+            t->failed = true;
+            return;
+        }
+        t->s = s;
+        t->cap = cap;
+    }
+}
+
+// A camera looking along -axis at the box centre c, from `distance` away, with
+// a frame of `w` x `h` at `texel` world units a texel.
+static void camera(text *t, const char *name, const double c[3], const double axis[3],
+                   const double up[3], double distance, double w, double h, double texel,
+                   bool out, int out_px)
+{
+    int pw = out ? out_px : (int)fmin(16384.0, fmax(16.0, ceil(w / texel)));
+    int ph = out ? out_px : (int)fmin(16384.0, fmax(16.0, ceil(h / texel)));
+    put(t,
+        "      <Ortho cameraName=\"%s\"%s>\n"
+        "        <View eye=\"%.6g %.6g %.6g\" target=\"%.6g %.6g %.6g\" up=\"%.6g %.6g %.6g\" "
+        "width=\"%.6g\" height=\"%.6g\" resolution=\"%d %d\"/>\n",
+        name, out ? " out=\"true\"" : "", c[0] + axis[0] * distance, c[1] + axis[1] * distance,
+        c[2] + axis[2] * distance, c[0], c[1], c[2], up[0], up[1], up[2], w, h, pw, ph);
+    if (out) {
+        put(t, "        <OutputMap file=\"mask.exr\"/>\n");
+    }
+    put(t, "      </Ortho>\n");
+}
+
+static const char *base_name(const char *path, char *out, size_t cap)
+{
+    const char *slash = strrchr(path, '/');
+    const char *name = slash != NULL ? slash + 1 : path;
+    snprintf(out, cap, "%s", name);
+    char *dot = strrchr(out, '.');
+    if (dot != NULL && dot != out) {
+        *dot = '\0';
+    }
+    // A plain name for the texture's file: letters, digits, '_', '-', '.'.
+    for (char *p = out; *p != '\0'; ++p) {
+        bool ok = (*p >= 'a' && *p <= 'z') || (*p >= 'A' && *p <= 'Z') || (*p >= '0' && *p <= '9') ||
+                  *p == '_' || *p == '-' || *p == '.';
+        *p = ok ? *p : '_';
+    }
+    return out;
+}
+
+static void escape_attr(const char *in, char *out, size_t cap)
+{
+    size_t n = 0;
+    for (; *in != '\0' && n + 7 < cap; ++in) {
+        const char *rep = *in == '&' ? "&amp;" : *in == '"' ? "&quot;" : *in == '<' ? "&lt;"
+                                               : *in == '>' ? "&gt;" : NULL;
+        if (rep != NULL) {
+            n += (size_t)snprintf(out + n, cap - n, "%s", rep);
+        } else {
+            out[n++] = *in;
+        }
+    }
+    out[n] = '\0';
+}
+
+wx_result wx_scene_generate(const wx_init_def *def, char **out_text, wx_error *err)
+{
+    *out_text = NULL;
+    int pi = wx_preset_find(def->preset != NULL ? def->preset : "rain");
+    if (pi < 0) {
+        return wx_fail(err, WX_CAUSE_USAGE, "unknown preset '%s' (presets: rain, dust, soot, moss)",
+                       def->preset);
+    }
+    const preset *p = &presets[pi];
+    // The mesh: its bounds, and whether it has UVs (channel 0) for a TextureMap.
+    wx_mesh_data mesh;
+    bool uvs = true;
+    wx_result r = wx_mesh_import_uvs(def->mesh_path, 1u, &mesh, err);
+    if (r != WX_OK && err->cause == WX_CAUSE_NO_UVS) {
+        uvs = false;
+        r = wx_mesh_import(def->mesh_path, &mesh, err);
+    }
+    if (r != WX_OK) {
+        return r;
+    }
+    int64_t triangles = mesh.triangle_count;
+    double lo[3], hi[3];
+    memcpy(lo, mesh.bounds_min, sizeof lo);
+    memcpy(hi, mesh.bounds_max, sizeof hi);
+    wx_mesh_data_free(&mesh);
+    if (triangles == 0) {
+        return wx_fail(err, WX_CAUSE_BAD_MESH, "%s: the mesh has no triangles", def->mesh_path);
+    }
+    double ext[3], c[3], size = 0.0;
+    for (int k = 0; k < 3; ++k) {
+        ext[k] = hi[k] - lo[k];
+        c[k] = 0.5 * (lo[k] + hi[k]);
+        size = fmax(size, ext[k]);
+    }
+    if (!(size > 0.0) || !isfinite(size)) {
+        return wx_fail(err, WX_CAUSE_BAD_MESH, "%s: the mesh has no extent", def->mesh_path);
+    }
+    const int R = def->resolution > 0 ? def->resolution : 1024;
+    const double unit = def->unit_m > 0.0 ? def->unit_m : 1.0;
+    const double margin = 0.1 * size;
+    const double texel = (size + 2.0 * margin) / R;
+
+    // The fall: from H above the top at the preset's speed under its gravity.
+    const double g = 9.8 / unit * p->gravity, H = 0.75 * size, v = p->speed * size;
+    const double fall = (-v + sqrt(v * v + 2.0 * g * H)) / g;
+    const double dt = fall / 50.0, emit = 2.0 * fall;
+    const int steps = (int)ceil((emit + 2.0 * fall) / dt);
+    // The wind's drift over the fall widens the emitter upwind.
+    double wind_len = sqrt(p->wind_dir[0] * p->wind_dir[0] + p->wind_dir[1] * p->wind_dir[1] +
+                           p->wind_dir[2] * p->wind_dir[2]);
+    double wind = p->wind * 9.8 / unit, drift[3] = { 0.0, 0.0, 0.0 };
+    for (int k = 0; k < 3 && wind_len > 0.0; ++k) {
+        drift[k] = 0.5 * wind * fall * fall * p->wind_dir[k] / wind_len;
+    }
+    double e_lo[3] = { lo[0] - margin, hi[1] + H, lo[2] - margin };
+    double e_hi[3] = { hi[0] + margin, hi[1] + H, hi[2] + margin };
+    for (int k = 0; k < 3; k += 2) {
+        // The drops drift by drift[k]: start them that far upwind.
+        e_lo[k] -= fmax(0.0, drift[k]);
+        e_hi[k] -= fmin(0.0, drift[k]);
+    }
+    double box = 2.0 * fmax(size, fmax(e_hi[0] - e_lo[0], e_hi[2] - e_lo[2])) + 2.0 * H;
+    double rate = p->particles / p->iterations / emit;
+
+    char mesh_attr[4096 + 64], base[256], preset_line[512];
+    escape_attr(def->mesh_ref, mesh_attr, sizeof mesh_attr);
+    base_name(def->mesh_path, base, sizeof base);
+    snprintf(preset_line, sizeof preset_line, "%s", p->what);
+
+    char iterations[48] = "";
+    if (p->iterations > 1) {
+        snprintf(iterations, sizeof iterations, " iterations=\"%d\"", p->iterations);
+    }
+    text t = { 0 };
+    put(&t, "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
+    put(&t,
+        "<!-- Generated by weathering init for %s, preset %s (docs/presets.md): %s.\n"
+        "     The mesh's bounding box is %.6g x %.6g x %.6g (largest extent s = %.6g) around\n"
+        "     (%.6g, %.6g, %.6g); every size below is a multiple of s, so a model in\n"
+        "     centimetres weathers as one in metres; gravity is 9.8 m/s^2 in the mesh's unit\n"
+        "     (%.6g m). Edit freely: `weathering info` on this file checks it. -->\n",
+        base, wx_preset_names[pi], preset_line, ext[0], ext[1], ext[2], size, c[0], c[1],
+        c[2], unit);
+    put(&t, "<Weathering>\n");
+    if (pi == PRESET_MOSS) {
+        put(&t,
+            "  <!-- The rain carries water; moss grows from the water that stays. -->\n"
+            "  <Substances>\n    <Substance name=\"water\"/>\n    <Substance name=\"moss\"/>\n"
+            "  </Substances>\n");
+    }
+    put(&t,
+        "  <Solver>\n"
+        "    <!-- A cube around the mesh and the emitter: particles leaving it are gone. -->\n"
+        "    <BoundingBox size=\"%.6g\" centerX=\"%.6g\" centerY=\"%.6g\" centerZ=\"%.6g\"/>\n"
+        "    <!-- A fall of 0.75 s from the emitter to the top takes %.3g s: 50 steps a fall;\n"
+        "         particles are emitted over two falls and fly two more. -->\n"
+        "    <Simulation timeStep=\"%.6g\" steps=\"%d\" seed=\"1\"%s/>\n"
+        "  </Solver>\n",
+        box, c[0], c[1] + 0.5 * H, c[2], fall, dt, steps, iterations);
+    put(&t, "  <ForceFields>\n");
+    put(&t, "    <!-- Gravity%s, in the mesh's unit per second squared. -->\n"
+            "    <Gravity acceleration=\"%.6g\"/>\n",
+        p->gravity < 1.0 ? " slowed by the air's drag on fine particles" : "", g);
+    if (p->wind > 0.0) {
+        put(&t,
+            "    <!-- A steady wind: over a fall it carries a particle (%.3g, %.3g) across;\n"
+            "         the emitter starts that far upwind. -->\n"
+            "    <Wind strength=\"%.6g\" dirX=\"%.6g\" dirY=\"%.6g\" dirZ=\"%.6g\"/>\n",
+            drift[0], drift[2], wind, p->wind_dir[0], p->wind_dir[1], p->wind_dir[2]);
+    }
+    if (p->turbulence > 0.0) {
+        put(&t,
+            "    <!-- Eddies about a fifth of the mesh across. -->\n"
+            "    <Turbulence strength=\"%.6g\" frequency=\"%.6g\" octaves=\"3\"/>\n",
+            p->turbulence * 9.8 / unit, 5.0 / size);
+    }
+    put(&t, "  </ForceFields>\n");
+    put(&t,
+        "  <Emitters>\n"
+        "    <!-- A rectangle over the footprint (plus a margin of s/10), %.3g s above the top,\n"
+        "         %.0f particles over the run. -->\n"
+        "    <BoxEmitter name=\"%s\" minX=\"%.6g\" minY=\"%.6g\" minZ=\"%.6g\" maxX=\"%.6g\" "
+        "maxY=\"%.6g\" maxZ=\"%.6g\"\n"
+        "                dirX=\"0\" dirY=\"-1\" dirZ=\"0\" spread=\"%.6g\" rate=\"%.6g\" start=\"0\" "
+        "end=\"%.6g\"\n"
+        "                speed=\"%.6g\" maxCollisions=\"60\"%s>\n",
+        0.75, p->particles, wx_preset_names[pi], e_lo[0], e_lo[1], e_lo[2], e_hi[0], e_hi[1],
+        e_hi[2], p->spread, rate, emit, v, pi == PRESET_MOSS ? "" : " dirt=\"1\"");
+    if (pi == PRESET_MOSS) {
+        put(&t, "      <Load substance=\"water\" amount=\"1\"/>\n");
+    }
+    put(&t, "    </BoxEmitter>\n  </Emitters>\n");
+    put(&t,
+        "  <Collider resilience=\"%.6g\" friction=\"%.6g\" adherence=\"1\" deposit=\"1\" "
+        "erosion=\"1\">\n"
+        "    <ProjectedMaps>\n"
+        "      <!-- The mesh from four sides and above%s, frames s/10 wider than it, %.4g a\n"
+        "           texel (a resolution of %d across the largest). -->\n",
+        p->resilience, p->friction, p->bottom ? " and below" : "", texel, R);
+    double d = 2.0 * (size + 2.0 * margin);
+    static const double Y[3] = { 0, 1, 0 }, NZ[3] = { 0, 0, -1 }, PZ[3] = { 0, 0, 1 };
+    const double fx = ext[0] + 2 * margin, fy = ext[1] + 2 * margin, fz = ext[2] + 2 * margin;
+    camera(&t, "front", c, (const double[3]){ 0, 0, 1 }, Y, d, fx, fy, texel, false, 0);
+    camera(&t, "back", c, (const double[3]){ 0, 0, -1 }, Y, d, fx, fy, texel, false, 0);
+    camera(&t, "left", c, (const double[3]){ -1, 0, 0 }, Y, d, fz, fy, texel, false, 0);
+    camera(&t, "right", c, (const double[3]){ 1, 0, 0 }, Y, d, fz, fy, texel, false, 0);
+    camera(&t, "top", c, Y, NZ, d, fx, fz, texel, false, 0);
+    if (p->bottom) {
+        camera(&t, "bottom", c, (const double[3]){ 0, -1, 0 }, PZ, d, fx, fz, texel, false, 0);
+    }
+    // A three-quarter view from the front right, above; its frame holds the
+    // whole box whichever way it turns.
+    double q[3] = { 1.0, 0.8, 1.2 }, ql = sqrt(1.0 + 0.64 + 1.44);
+    for (int k = 0; k < 3; ++k) {
+        q[k] /= ql;
+    }
+    double diag = sqrt(ext[0] * ext[0] + ext[1] * ext[1] + ext[2] * ext[2]) + 2.0 * margin;
+    put(&t, "      <!-- The output camera: a three-quarter view from the front right. -->\n");
+    camera(&t, "shot", c, q, Y, d, diag, diag, texel, true, R);
+    put(&t, "    </ProjectedMaps>\n  </Collider>\n");
+    if (pi == PRESET_MOSS) {
+        put(&t,
+            "  <!-- Between spells half the water evaporates and a tenth of what is left\n"
+            "       becomes moss. -->\n"
+            "  <Ageing>\n    <Transfer from=\"water\" to=\"moss\" rate=\"0.1\"/>\n"
+            "    <Decay substance=\"water\" rate=\"0.5\"/>\n  </Ageing>\n");
+    }
+    put(&t,
+        "  <Geometry>\n"
+        "    <Mesh file=\"%s\">\n"
+        "      <!-- Every material alike: edit or add <Surface material=\"NAME\"> per material. -->\n"
+        "      <Surface material=\"*\" absorption=\"%.6g\" bounce=\"%.6g\"",
+        mesh_attr, p->absorption, p->bounce);
+    if (pi == PRESET_MOSS) {
+        put(&t, ">\n        <Exchange substance=\"water\" deposit=\"%.6g\" erosion=\"%.6g\"/>\n"
+                "      </Surface>\n",
+            p->deposit, p->erosion);
+    } else {
+        put(&t, " deposit=\"%.6g\" erosion=\"%.6g\"/>\n", p->deposit, p->erosion);
+    }
+    if (uvs) {
+        put(&t,
+            "      <!-- The mesh has UVs: the weathering in its own layout too (docs/texture.md). -->\n"
+            "      <TextureMap file=\"%s_texture.exr\" resolution=\"%d\"/>\n",
+            base, R);
+    }
+    put(&t, "    </Mesh>\n  </Geometry>\n");
+    if (pi == PRESET_MOSS) {
+        put(&t,
+            "  <!-- Where moss would look right: wet, sheltered, shaded (docs/masks.md). -->\n"
+            "  <Masks>\n"
+            "    <Accessibility name=\"shelter\" rays=\"32\" distance=\"%.6g\"/>\n"
+            "    <Exposure name=\"sun\" elevation=\"50\" azimuth=\"200\" sideWeight=\"0.4\" "
+            "sideElevation=\"0.7\" sideSpread=\"60\"/>\n"
+            "    <Combine name=\"mossy\">\n"
+            "      <Term substance=\"water\" weight=\"0.7\" offset=\"%.6g\" steepness=\"%.6g\"/>\n"
+            "      <Term mask=\"shelter\" weight=\"-0.6\" offset=\"0.75\" steepness=\"40\"/>\n"
+            "      <Term mask=\"sun\" weight=\"-0.5\"/>\n"
+            "      <Term constant=\"0.7\"/>\n"
+            "    </Combine>\n"
+            "  </Masks>\n",
+            0.15 * size, 0.1 * rate * emit / (size * size), 1.0 / pow(0.1 * rate * emit / (size * size), 2.0));
+    }
+    put(&t, "</Weathering>\n");
+    if (t.failed) {
+        free(t.s);
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (scene text)");
+    }
+    *out_text = t.s;
+    return WX_OK;
+}
