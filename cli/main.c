@@ -370,6 +370,45 @@ static void print_camera(const wx_scene *scene, const wx_scene_camera *sc)
     }
 }
 
+// Whether the cameras frame the mesh: its vertices outside every input
+// camera's frame (nothing is known there) and outside the output camera's.
+static void print_frames(const wx_scene *scene, const wx_mesh_data *mesh)
+{
+    int64_t unseen = 0, out_of_shot = 0;
+    for (int64_t v = 0; v < mesh->vertex_count && mesh->positions != NULL; ++v) {
+        float p[3];
+        for (int k = 0; k < 3; ++k) {
+            p[k] = (float)(mesh->origin[k] + mesh->positions[3 * v + k]);
+        }
+        bool seen = false;
+        for (int c = 0; c < scene->camera_count; ++c) {
+            float uvd[3];
+            wx_camera_world_to_map(&scene->cameras[c].camera, p, uvd);
+            bool inside = uvd[0] >= 0.0f && uvd[0] <= 1.0f && uvd[1] >= 0.0f && uvd[1] <= 1.0f;
+            if (scene->cameras[c].is_output) {
+                out_of_shot += !inside;
+            } else {
+                seen = seen || inside;
+            }
+        }
+        unseen += !seen;
+    }
+    if (unseen == 0) {
+        printf("    every vertex lies inside an input camera's frame");
+    } else {
+        printf("    %lld of %lld vertices lie outside every input camera's frame (nothing is "
+               "known there)",
+               (long long)unseen, (long long)mesh->vertex_count);
+    }
+    if (scene->output_index >= 0) {
+        printf(out_of_shot == 0 ? "; all inside the output camera's\n"
+                                : "; %lld outside the output camera's\n",
+               (long long)out_of_shot);
+    } else {
+        printf("\n");
+    }
+}
+
 // The derived masks (docs/masks.md), and what their rays cost: one per point
 // of the mask and of every texture, estimated at the texels they cover at most,
 // at the rate bench_masks measures (about 1.3 million rays a second a thread).
@@ -666,6 +705,7 @@ static int command_info(const cli_args *args)
                    (long long)g->data.triangle_count, (long long)g->data.vertex_count,
                    g->data.bounds_min[0], g->data.bounds_min[1], g->data.bounds_min[2],
                    g->data.bounds_max[0], g->data.bounds_max[1], g->data.bounds_max[2]);
+            print_frames(&scene, &g->data);
             for (int k = 0; k < g->data.material_count; ++k) {
                 wx_printable(g->data.material_names[k], shown, sizeof shown);
                 printf("    material '%s' -> <Surface material=\"%s\">\n", shown,
