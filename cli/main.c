@@ -777,6 +777,55 @@ static int report(wx_result r, const wx_error *err)
 
 // Runs the phases in `phases` in order, in one process; a phase that is not run
 // reads what an earlier command left in the output folder.
+// One output's line of the summary: its size and channels.
+static void print_output(const wx_run_def *opts, const char *name)
+{
+    char path[WX_PATH_MAX + 512];
+    snprintf(path, sizeof path, "%s/%s", opts->out_dir, name);
+    struct stat st;
+    if (stat(path, &st) != 0) {
+        return;
+    }
+    wx_image *image = calloc(1, sizeof *image);
+    wx_error err;
+    fprintf(stderr, "  %-28s %8.1f MB", name, (double)st.st_size / 1e6);
+    if (image != NULL && wx_exr_read_header(path, image, &err) == WX_OK) {
+        fprintf(stderr, "  %d x %d, channels", image->width, image->height);
+        for (int c = 0; c < image->channel_count; ++c) {
+            fprintf(stderr, "%s %s", c > 0 ? "," : "", image->channel_names[c]);
+        }
+        wx_image_free(image);
+    }
+    free(image);
+    fprintf(stderr, "\n");
+}
+
+// After a run: what the particles left (each substance on the surfaces at the
+// start and at the end, and what they brought) and the main files written.
+static void print_summary(const wx_scene *scene, const wx_run_def *opts, const wx_run_report *run,
+                          unsigned phases)
+{
+    const wx_sim_stats *st = &run->stats;
+    if ((phases & WX_PHASE_SIMULATE) && st->particles_emitted > 0) {
+        double hit = 100.0 * (1.0 - (double)st->escaped_without_hit / (double)st->particles_emitted);
+        fprintf(stderr, "  %.1f%% of the particles hit the model\n", hit);
+        for (int k = 0; k < st->substance_count; ++k) {
+            const wx_substance_ledger *l = &st->substance[k];
+            fprintf(stderr, "  %-10s on the surfaces %.6g at the start, %.6g at the end (brought %.6g)\n",
+                    st->substance_names[k], l->initial_surface, l->final_surface, l->emitted);
+        }
+    }
+    if (!(phases & WX_PHASE_GATHER)) {
+        return;
+    }
+    if (scene->output_index >= 0) {
+        print_output(opts, scene->cameras[scene->output_index].output_file);
+    }
+    for (int t = 0; t < scene->texture_count; ++t) {
+        print_output(opts, scene->textures[t].file);
+    }
+}
+
 static int run_phases(const cli_args *args, unsigned phases)
 {
     double start = wx_now_s();
@@ -817,6 +866,7 @@ static int run_phases(const cli_args *args, unsigned phases)
         }
         fprintf(stderr, "weathering: %s done in %.2f s%s; outputs in %s\n", args->command,
                 run.times.total, flown, opts.out_dir);
+        print_summary(&scene, &opts, &run, phases);
     }
     wx_scene_free(&scene);
     return report(r, &err);

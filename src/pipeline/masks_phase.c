@@ -89,7 +89,8 @@ wx_result wx_masks_at_points(const wx_scene *scene, const wx_run_def *opts,
                          .height_min = ctx->height_min,
                          .height_max = ctx->height_max,
                          .seed = opts->seed,
-                         .threads = opts->threads };
+                         .threads = opts->threads,
+                         .quiet = opts->quiet };
     return wx_masks_compute(&def, out, err);
 }
 

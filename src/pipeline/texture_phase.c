@@ -144,6 +144,9 @@ static wx_result compute_planes(const wx_scene *scene, const wx_run_def *opts,
     const int k_count = scene->input_count;
     wx_result r = WX_OK;
     int k = 0;
+    // The mask on every input camera's texels, a channel at a time.
+    wx_progress progress;
+    wx_progress_begin(&progress, "texture", (int64_t)k_count * channels, opts->quiet);
     for (int cam = 0; cam < scene->camera_count && r == WX_OK; ++cam) {
         const wx_scene_camera *sc = &scene->cameras[cam];
         if (sc->is_output) {
@@ -180,9 +183,11 @@ static wx_result compute_planes(const wx_scene *scene, const wx_run_def *opts,
             def.threads = opts->threads;
             def.quiet = true;
             r = wx_gather_compute(&def, *plane, NULL, err);
+            wx_progress_update(&progress, (int64_t)k * channels + c + 1);
         }
         k++;
     }
+    wx_progress_end(&progress);
     return r;
 }
 

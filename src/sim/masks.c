@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "core/parallel.h"
+#include "core/progress.h"
 
 #define PI 3.14159265358979323846
 
@@ -53,6 +54,7 @@ typedef struct job {
     double suns[3][3];
     double sun_weights[3];
     int sun_count;
+    wx_progress *progress; // drawn by worker 0: rows of all the masks
 } job;
 
 static uint64_t splitmix(uint64_t x)
@@ -314,7 +316,6 @@ static float combine(const job *jb, const wx_mask_def *m, size_t t)
 
 static void mask_rows(int64_t begin, int64_t end, int worker, void *context)
 {
-    (void)worker;
     const job *jb = context;
     const wx_masks_def *def = jb->def;
     const wx_mask_def *m = &def->scene->masks[jb->mask];
@@ -348,6 +349,9 @@ static void mask_rows(int64_t begin, int64_t end, int worker, void *context)
                 break;
             }
         }
+        if (worker == 0) {
+            wx_progress_update(jb->progress, (int64_t)jb->mask * g->height + j + 1);
+        }
     }
 }
 
@@ -367,6 +371,10 @@ wx_result wx_masks_compute(const wx_masks_def *def, float *const *out, wx_error 
     }
     jb.offset = 2.0f * texel;
     jb.first = 4.0 * texel;
+    wx_progress progress;
+    wx_progress_begin(&progress, "masks", (int64_t)scene->mask_count * def->points.height,
+                      def->quiet);
+    jb.progress = &progress;
     for (int m = 0; m < scene->mask_count; ++m) {
         const wx_mask_def *md = &scene->masks[m];
         jb.mask = m;
@@ -387,5 +395,6 @@ wx_result wx_masks_compute(const wx_masks_def *def, float *const *out, wx_error 
         wx_parallel_for(def->threads, def->points.height, wx_mask_rays(md) > 0 ? 1 : 16,
                         mask_rows, &jb);
     }
+    wx_progress_end(&progress);
     return WX_OK;
 }

@@ -44,6 +44,7 @@ typedef struct wx_masks_def {
     float height_min, height_max; ///< Height's range where a mask does not give it
     uint64_t seed;
     int threads;
+    bool quiet; ///< no progress bar
 } wx_masks_def;
 
 /// Fills out[m] (width*height floats) for every mask m of the scene, in order
