@@ -12,7 +12,12 @@
 // rust): S walks through them and wraps, particles are coloured by their load
 // of the shown one (scaled by its emitter load), depth samples by its amount
 // on their texel, and a screenshot shows particles in the shown substance's
-// colour.
+// colour. With <Masks> (the thesis scene with Height, Curvature,
+// Accessibility and Combine masks): M's cycle, each mask's value at every
+// sample (Height by its formula; at the samples of the input cameras, the
+// values wx_masks_at_camera gives on their maps; at a stride of 3 too), the
+// ramps' colours and Curvature's scale, and a screenshot with --mask showing
+// the bright end of the ramp above its dark end; a bad --mask exits 2.
 #include <fcntl.h>
 #include <png.h>
 #include <stdint.h>
@@ -62,46 +67,84 @@ static int screenshot(const char *png, int frames)
     return screenshot_of(NULL, png, frames, "");
 }
 
-// The thesis scene with three substances: its emitter carries 2 of water and
-// 0.25 of dirt, none of rust (the thesis' maps are substance dirt's). Written
-// once into the temporary folder, with the maps' absolute paths.
-static const char *substance_scene(void)
+// The thesis scene written into the temporary folder as `file`, with the
+// maps' absolute paths, `before_solver` inserted before its <Solver> and,
+// with `water`, its emitter carrying 2 of water and 0.25 of dirt (instead of
+// 1 of dirt). NULL when thesis_box.xml changed so that the edits miss.
+static const char *thesis_variant(const char *file, const char *before_solver, bool water)
 {
-    static const char *path;
-    if (path != NULL) {
-        return path;
-    }
     char *text = ensure_read_file("xml_scenes/thesis_box.xml");
     char maps[4200], *cwd = getcwd(NULL, 0);
     snprintf(maps, sizeof maps, "%s/maps/", cwd);
     free(cwd);
     static char scene[65536];
     size_t n = 0;
+    bool solver = false, emitter = !water;
     for (const char *p = text; *p != '\0' && n + 4300 < sizeof scene;) {
         if (strncmp(p, "../maps/", 8) == 0) {
             n += (size_t)snprintf(scene + n, sizeof scene - n, "%s", maps);
             p += 8;
         } else if (strncmp(p, "<Solver>", 8) == 0) {
-            n += (size_t)snprintf(scene + n, sizeof scene - n,
-                                  "<Substances><Substance name=\"water\"/>"
-                                  "<Substance name=\"dirt\"/><Substance name=\"rust\"/>"
-                                  "</Substances>\n  <Solver>");
+            n += (size_t)snprintf(scene + n, sizeof scene - n, "%s\n  <Solver>", before_solver);
             p += 8;
-        } else if (strncmp(p, "dirt=\"1\" maxCollisions=\"50\"/>", 29) == 0) {
+            solver = true;
+        } else if (water && strncmp(p, "dirt=\"1\" maxCollisions=\"50\"/>", 29) == 0) {
             n += (size_t)snprintf(scene + n, sizeof scene - n,
                                   "dirt=\"0.25\" maxCollisions=\"50\">"
                                   "<Load substance=\"water\" amount=\"2\"/></PointEmitter>");
             p += 29;
+            emitter = true;
         } else {
             scene[n++] = *p++;
         }
     }
     scene[n] = '\0';
     free(text);
-    if (strstr(scene, "<Load substance") == NULL || strstr(scene, "../maps/") != NULL) {
+    if (!solver || !emitter || strstr(scene, "../maps/") != NULL) {
         return NULL; // thesis_box.xml changed: the test must follow
     }
-    path = ensure_write_file(ensure_tmpdir(), "substances.xml", scene);
+    return ensure_write_file(ensure_tmpdir(), file, scene);
+}
+
+// The thesis scene with three substances: its emitter carries 2 of water and
+// 0.25 of dirt, none of rust (the thesis' maps are substance dirt's). Written
+// once into the temporary folder, with the maps' absolute paths.
+static const char *substance_scene(void)
+{
+    static const char *path;
+    if (path == NULL) {
+        path = thesis_variant("substances.xml",
+                              "<Substances><Substance name=\"water\"/>"
+                              "<Substance name=\"dirt\"/><Substance name=\"rust\"/>"
+                              "</Substances>",
+                              true);
+    }
+    return path;
+}
+
+// The thesis scene (a 2 m cube, y 0 to 2, on a slab, y -0.2 to 0) with
+// derived masks: `step` is 0 below y = 1 and 1 above y = 1.0001 (the cube's
+// top and upper half bright, its lower half and the slab dark), `height` y / 2;
+// `both` combines height and ao.
+static const char *mask_scene(void)
+{
+    static const char *path;
+    if (path == NULL) {
+        path = thesis_variant("masks.xml",
+                              "<Masks>\n"
+                              "    <Height name=\"step\" min=\"1\" max=\"1.0001\"/>\n"
+                              "    <Height name=\"height\" min=\"0\" max=\"2\"/>\n"
+                              "    <Curvature name=\"curv\"/>\n"
+                              "    <Accessibility name=\"ao\" rays=\"4\" distance=\"1\"/>\n"
+                              "    <Combine name=\"both\">\n"
+                              "      <Term mask=\"height\" weight=\"0.5\"/>\n"
+                              "      <Term mask=\"ao\" weight=\"0.5\" offset=\"0.5\""
+                              " steepness=\"10\"/>\n"
+                              "      <Term constant=\"0.1\"/>\n"
+                              "    </Combine>\n"
+                              "  </Masks>",
+                              false);
+    }
     return path;
 }
 
@@ -226,6 +269,59 @@ TEST(screenshot_shows_the_chosen_substance)
     ENSURE(dirt_blue == 0);
 }
 
+// Mean row (from the top) of the pixels exactly of colour rgb, and how many.
+static long rows_of(const image *img, const uint8_t rgb[3], double *mean_row)
+{
+    long n = 0;
+    double sum = 0.0;
+    for (long p = 0; p < (long)img->width * img->height; ++p) {
+        const uint8_t *px = &img->rgb[3 * p];
+        if (px[0] == rgb[0] && px[1] == rgb[1] && px[2] == rgb[2]) {
+            n++;
+            sum += (double)(p / img->width);
+        }
+    }
+    *mean_row = n > 0 ? sum / (double)n : 0.0;
+    return n;
+}
+
+// --mask step: the depth samples above y = 1 (the cube's top and the upper
+// half of its front) in the ramp's bright end, those below (the slab, the
+// lower half) in its dark end, higher up the picture on average; particles
+// keep their colour. Without --mask the same scene shows neither colour.
+TEST(screenshot_shows_the_chosen_mask)
+{
+    ENSURE(have_xvfb());
+    const char *scene = mask_scene();
+    ENSURE(scene != NULL);
+    int status = screenshot_of(scene, "step.png", 30, "--mask step");
+    if (status != 0) {
+        fprintf(stderr, "%s", out);
+    }
+    ENSURE(status == 0);
+    ENSURE(ensure_contains(out, "mask step 1/5 (height)"));
+    ENSURE(screenshot_of(scene, "no_mask.png", 30, "") == 0);
+    image step, plain;
+    ENSURE(read_png("step.png", &step));
+    if (!read_png("no_mask.png", &plain)) {
+        free(step.rgb);
+        ENSURE(false);
+    }
+    const uint8_t *dark = VW_MASK_RAMP[0], *bright = VW_MASK_RAMP[VW_MASK_RAMP_COUNT - 1];
+    double dark_row, bright_row, unused;
+    long dark_px = rows_of(&step, dark, &dark_row);
+    long bright_px = rows_of(&step, bright, &bright_row);
+    long dirty = count_color(&step, VW_PARTICLE_DIRTY_COLOR, 1);
+    long plain_dark = rows_of(&plain, dark, &unused);
+    long plain_bright = rows_of(&plain, bright, &unused);
+    free(step.rgb);
+    free(plain.rgb);
+    ENSURE(dark_px >= 2000 && bright_px >= 500);
+    ENSURE(bright_row + 20.0 < dark_row);
+    ENSURE(dirty >= 20);
+    ENSURE(plain_dark == 0 && plain_bright == 0);
+}
+
 // Bad input is found before any window opens: no display needed.
 static int viewer_without_display(const char *args)
 {
@@ -257,6 +353,19 @@ TEST(bad_usage_exits_2)
     ENSURE(viewer_without_display("xml_scenes/thesis_box.xml --substance") == 2);
     ENSURE(viewer_without_display("xml_scenes/thesis_box.xml --substance rust") == 2);
     ENSURE(ensure_contains(out, "no such substance (it has dirt)"));
+    // --mask names a mask of <Masks>; the message lists them.
+    ENSURE(viewer_without_display("--help") == 0);
+    ENSURE(ensure_contains(out, "--mask NAME"));
+    ENSURE(viewer_without_display("xml_scenes/thesis_box.xml --mask") == 2);
+    ENSURE(viewer_without_display("xml_scenes/thesis_box.xml --mask ao") == 2);
+    ENSURE(ensure_contains(out, "--mask ao: xml_scenes/thesis_box.xml has no such mask (it has "
+                                "no <Masks>)"));
+    const char *scene = mask_scene();
+    ENSURE(scene != NULL);
+    char args[4400];
+    snprintf(args, sizeof args, "%s --mask moss", scene);
+    ENSURE(viewer_without_display(args) == 2);
+    ENSURE(ensure_contains(out, "no such mask (it has step, height, curv, ao, both)"));
 }
 
 // A <View> camera without maps: the viewer runs `weathering bake` in a child
@@ -681,6 +790,247 @@ TEST(substances_cycle_and_colour_by_the_shown_one)
     vw_world_free(&w);
 }
 
+// Height's value at a sample, as sim/masks.c works it out.
+static float height_at(const vw_world *w, int m, int point)
+{
+    const wx_mask_def *md = &w->scene.masks[m];
+    double lo = md->min, hi = md->max, y = w->points[point].position[1];
+    return (float)fmin(1.0, fmax(0.0, (y - lo) / (hi - lo)));
+}
+
+static bool same_rgb(const float c[3], const uint8_t rgb[3])
+{
+    for (int k = 0; k < 3; ++k) {
+        if (c[k] != (float)rgb[k] / 255.0f) {
+            return false;
+        }
+    }
+    return true;
+}
+
+// M's cycle, and each mask's value at every depth sample: Height by its
+// formula at the sample's own point, every mask at an input camera's samples
+// the very values wx_masks_at_camera gives on that camera's maps (the samples
+// are every texel here), a Combine of masks already shown reading them back
+// exactly; the colours of the ramps.
+TEST(masks_cycle_and_colour_the_depth_samples)
+{
+    const char *scene = mask_scene();
+    ENSURE(scene != NULL);
+    vw_settings settings = thesis_settings();
+    settings.scene_path = scene;
+    static vw_world w;
+    wx_error err;
+    ENSURE(vw_world_parse(&w, &settings, &err) == WX_OK);
+    ENSURE(vw_world_finish(&w, &settings, &err) == WX_OK);
+    ENSURE(w.sample_stride == 1);
+    ENSURE(vw_world_mask_count(&w) == 5);
+    ENSURE(w.mask == -1 && isnan(vw_world_mask_value(&w, 0)));
+    ENSURE(vw_world_find_mask(&w, "ao") == 3 && vw_world_find_mask(&w, "water") == -1);
+    ENSURE(strcmp(vw_world_mask_kind_name(&w, 2), "curvature") == 0);
+    // M: off -> step -> height -> curv -> ao -> both -> off, each computed
+    // when first shown.
+    static const char *const order[5] = { "step", "height", "curv", "ao", "both" };
+    for (int k = 0; k < 5; ++k) {
+        int m = vw_world_next_mask(&w);
+        ENSURE(m == k && strcmp(w.scene.masks[m].name, order[k]) == 0);
+        ENSURE(!vw_world_mask_ready(&w, m));
+        ENSURE(vw_world_show_mask(&w, m, &err) == WX_OK);
+        ENSURE(w.mask == m && vw_world_mask_ready(&w, m));
+    }
+    ENSURE(vw_world_next_mask(&w) == -1);
+    ENSURE(vw_world_show_mask(&w, -1, &err) == WX_OK && w.mask == -1);
+    ENSURE(vw_world_next_mask(&w) == 0 && vw_world_mask_ready(&w, 0));
+
+    // Height at every sample, of every camera (the output camera's too).
+    int wrong = 0, bright = 0, dark = 0;
+    for (int i = 0; i < w.point_count; ++i) {
+        for (int m = 0; m < 2; ++m) {
+            wrong += w.mask_values[m][i] != height_at(&w, m, i);
+        }
+        bright += w.mask_values[0][i] == 1.0f;
+        dark += w.mask_values[0][i] == 0.0f;
+    }
+    ENSURE(wrong == 0);
+    // The cube's top (64 x 64 texels from above) and the upper half of its
+    // front (64 x 32, by the front and the output camera) are bright.
+    ENSURE(bright == 64 * 64 + 2 * 64 * 32 && dark > 20000 && bright + dark > w.point_count - 100);
+
+    // The input cameras' samples against the library at their maps' texels.
+    float *zero = calloc(256 * 256, sizeof *zero);
+    float *planes[5];
+    for (int m = 0; m < 5; ++m) {
+        planes[m] = malloc(256 * 256 * sizeof *planes[m]);
+        ENSURE(planes[m] != NULL);
+    }
+    const float *substances[1] = { zero };
+    ENSURE(zero != NULL && w.mask_context != NULL);
+    for (int c = 0; c < 2; ++c) {
+        ENSURE(w.maps[w.camera_maps[c]].width == 256);
+        ENSURE(wx_masks_at_camera(&w.scene, &w.opts, w.mask_context, &w.scene.cameras[c].camera,
+                                  &w.maps[w.camera_maps[c]], substances, planes, &err) == WX_OK);
+        vw_range r = w.camera_points[c];
+        for (int i = r.first; i < r.first + r.count; ++i) {
+            for (int m = 0; m < 5; ++m) {
+                wrong += w.mask_values[m][i] != planes[m][w.samples[i].texel];
+            }
+        }
+    }
+    for (int m = 0; m < 5; ++m) {
+        free(planes[m]);
+    }
+    free(zero);
+    ENSURE(wrong == 0);
+    // Accessibility: open on top of the cube, less so where the cube meets the slab.
+    double top = 0.0, foot = 0.0;
+    int tops = 0, feet = 0;
+    for (int i = 0; i < w.point_count; ++i) {
+        const float *p = w.points[i].position;
+        if (p[1] > 1.99f && fabsf(p[0]) < 0.5f && fabsf(p[2]) < 0.5f) {
+            top += w.mask_values[3][i];
+            tops++;
+        } else if (fabsf(p[1]) < 0.01f && fabsf(p[0]) < 0.9f && p[2] > 1.0f && p[2] < 1.05f) {
+            foot += w.mask_values[3][i];
+            feet++;
+        }
+    }
+    ENSURE(tops > 100 && feet > 10);
+    ENSURE(top / tops > 0.95 && foot / feet < 0.8 * top / tops);
+
+    // Curvature: the box's faces are flat (at an edge the other face's
+    // points are left out), so 0 everywhere and the ramp's scale 1. On other
+    // values it spans their 99th percentile of |value| (no value: left out).
+    int curved = 0;
+    for (int i = 0; i < w.point_count; ++i) {
+        curved += w.mask_values[2][i] != 0.0f;
+    }
+    ENSURE(curved == 0 && w.mask_scale[2] == 1.0f);
+    ENSURE(w.mask_scale[0] == 1.0f && w.mask_scale[3] == 1.0f);
+    float *fake = malloc((size_t)w.point_count * sizeof *fake);
+    ENSURE(fake != NULL);
+    // The first 20000 samples: 10000 zeros and +-1, ..., +-5000; the others
+    // no value. Sorted by |value|: 10000 zeros, then 1, 1, 2, 2, ..., so the
+    // 99th percentile, at (20000 - 1) * 0.99 = 19799.01, is 4900.
+    ENSURE(w.point_count > 20000);
+    for (int i = 0; i < w.point_count; ++i) {
+        int k = i / 4, pair = i % 4;
+        fake[i] = i >= 20000 ? NAN : pair >= 2 ? 0.0f : (float)(k + 1) * (pair ? -1.0f : 1.0f);
+    }
+    ENSURE(mask_scale(&w, 2, fake) == 4900.0f);
+    for (int i = 0; i < w.point_count; ++i) {
+        fake[i] = i == 5 ? -0.25f : i % 3 ? 0.0f : NAN; // one curved sample among flat ones
+    }
+    ENSURE(mask_scale(&w, 2, fake) == 0.25f);
+    ENSURE(mask_scale(&w, 0, fake) == 1.0f); // not Curvature
+    free(fake);
+
+    // Colours: step's samples at the ends of the ramp, unshaded; Curvature's
+    // grey where flat, blue and red at -scale and +scale and beyond.
+    ENSURE(vw_world_show_mask(&w, 0, &err) == WX_OK);
+    size_t n = (size_t)w.point_count;
+    uint32_t *picked = malloc(n * sizeof *picked);
+    vw_vertex *colored = malloc(n * sizeof *colored);
+    ENSURE(picked != NULL && colored != NULL);
+    for (size_t k = 0; k < n; ++k) {
+        picked[k] = (uint32_t)k;
+    }
+    vw_world_mask_colors(&w, picked, n, colored);
+    int bad = 0;
+    for (size_t k = 0; k < n; ++k) {
+        float v = w.mask_values[0][k];
+        bad += memcmp(colored[k].position, w.points[k].position, sizeof colored[k].position) != 0;
+        if (v == 0.0f) {
+            bad += !same_rgb(colored[k].color, VW_MASK_RAMP[0]);
+        } else if (v == 1.0f) {
+            bad += !same_rgb(colored[k].color, VW_MASK_RAMP[VW_MASK_RAMP_COUNT - 1]);
+        }
+    }
+    free(picked);
+    free(colored);
+    ENSURE(bad == 0);
+    float rgb[3];
+    vw_world_mask_color(&w, 0.5f, rgb);
+    ENSURE(same_rgb(rgb, VW_MASK_RAMP[2]));
+    vw_world_mask_color(&w, 7.0f, rgb); // clamped
+    ENSURE(same_rgb(rgb, VW_MASK_RAMP[VW_MASK_RAMP_COUNT - 1]));
+    ENSURE(vw_world_show_mask(&w, 2, &err) == WX_OK);
+    float scale = w.mask_scale[2];
+    vw_world_mask_color(&w, 0.0f, rgb);
+    ENSURE(same_rgb(rgb, VW_CURVATURE_RAMP[1]));
+    vw_world_mask_color(&w, -scale, rgb);
+    ENSURE(same_rgb(rgb, VW_CURVATURE_RAMP[0]));
+    vw_world_mask_color(&w, 3.0f * scale, rgb);
+    ENSURE(same_rgb(rgb, VW_CURVATURE_RAMP[2]));
+
+    // A reload keeps the mask by name, computed again; else shows none.
+    ENSURE(vw_world_keep_mask(&w, "nothing", &err) == WX_OK && w.mask == -1);
+    vw_world_free(&w);
+
+    // Shown first, a Combine computes what it reads too, and those only.
+    ENSURE(vw_world_parse(&w, &settings, &err) == WX_OK);
+    ENSURE(vw_world_finish(&w, &settings, &err) == WX_OK);
+    ENSURE(vw_world_keep_mask(&w, "both", &err) == WX_OK && w.mask == 4);
+    ENSURE(vw_world_mask_ready(&w, 1) && vw_world_mask_ready(&w, 3));
+    ENSURE(!vw_world_mask_ready(&w, 0) && !vw_world_mask_ready(&w, 2));
+    wrong = 0;
+    for (int i = 0; i < w.point_count; ++i) {
+        wrong += w.mask_values[1][i] != height_at(&w, 1, i);
+    }
+    ENSURE(wrong == 0);
+    vw_world_free(&w);
+
+    // Without <Masks>: nothing to cycle.
+    settings = thesis_settings();
+    ENSURE(vw_world_parse(&w, &settings, &err) == WX_OK);
+    ENSURE(vw_world_finish(&w, &settings, &err) == WX_OK);
+    ENSURE(vw_world_mask_count(&w) == 0 && vw_world_next_mask(&w) == -1);
+    ENSURE(w.mask_context == NULL);
+    vw_world_free(&w);
+}
+
+// Fewer samples than texels (a stride of 3): each mask is evaluated on the
+// grid of the sampled texels, and each sample gets its own texel's value.
+TEST(masks_at_sparse_samples)
+{
+    const char *scene = mask_scene();
+    ENSURE(scene != NULL);
+    vw_settings settings = thesis_settings();
+    settings.scene_path = scene;
+    static vw_world w;
+    wx_error err;
+    ENSURE(vw_world_parse(&w, &settings, &err) == WX_OK);
+    ENSURE(vw_world_finish(&w, &settings, &err) == WX_OK);
+    free(w.lines);
+    free(w.points);
+    free(w.samples);
+    free(w.camera_lines);
+    free(w.camera_points);
+    ENSURE(build_geometry_within(&w, 40000, &err) == WX_OK);
+    ENSURE(w.sample_stride == 3);
+    ENSURE(vw_world_show_mask(&w, 1, &err) == WX_OK);
+    ENSURE(vw_world_show_mask(&w, 2, &err) == WX_OK);
+    int wrong = 0, nan = 0, flat = 0, top = 0;
+    for (int i = 0; i < w.point_count; ++i) {
+        wrong += w.mask_values[1][i] != height_at(&w, 1, i);
+        nan += isnan(w.mask_values[2][i]);
+        // Flat in the middle of the cube's top, seen from above.
+        const float *p = w.points[i].position;
+        if (w.samples[i].input == 1 && p[1] > 1.99f && fabsf(p[0]) < 0.8f && fabsf(p[2]) < 0.8f) {
+            top++;
+            flat += fabsf(w.mask_values[2][i]) < 1e-3f;
+        }
+    }
+    ENSURE(wrong == 0 && nan == 0);
+    ENSURE(top > 100 && flat == top);
+    // Where the samples are: texels 1, 4, 7, ... of every row and column.
+    for (int i = 0; i < w.point_count; ++i) {
+        int texel = w.samples[i].texel;
+        wrong += texel % 256 % 3 != 1 || texel / 256 % 3 != 1;
+    }
+    ENSURE(wrong == 0);
+    vw_world_free(&w);
+}
+
 int main(void)
 {
     RUN(thesis_scene_geometry);
@@ -689,11 +1039,14 @@ int main(void)
     RUN(initial_view_frames_the_box);
     RUN(one_substance_is_dirt);
     RUN(substances_cycle_and_colour_by_the_shown_one);
+    RUN(masks_cycle_and_colour_the_depth_samples);
+    RUN(masks_at_sparse_samples);
     RUN(bad_usage_exits_2);
     RUN(bad_scene_exits_2_and_names_the_file);
     RUN(failed_bake_exits_2);
     RUN(screenshot_shows_cameras_and_particles);
     RUN(screenshot_is_reproducible);
     RUN(screenshot_shows_the_chosen_substance);
+    RUN(screenshot_shows_the_chosen_mask);
     return ensure_summary();
 }

@@ -222,10 +222,11 @@ static void upload(GLuint vbo, const void *data, size_t size)
     glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)size, data, GL_STREAM_DRAW);
 }
 
-static bool depth_samples_current(const vw_draw *draw, const vw_show *show, const float mvp[16],
-                                  int width, int height)
+static bool depth_samples_current(const vw_draw *draw, const vw_world *world, const vw_show *show,
+                                  const float mvp[16], int width, int height)
 {
     if (!draw->depth_valid || width != draw->depth_width || height != draw->depth_height ||
+        draw->depth_mask != world->mask ||
         memcmp(mvp, draw->depth_mvp, sizeof draw->depth_mvp) != 0) {
         return false;
     }
@@ -238,13 +239,15 @@ static bool depth_samples_current(const vw_draw *draw, const vw_show *show, cons
 }
 
 // The depth samples of the shown cameras, nearest per pixel: picked again only
-// when the view or the shown cameras change; coloured again every frame when
-// they show deposits, which change with every step.
+// when the view, the shown cameras or the shown mask change; coloured again
+// every frame when they show deposits, which change with every step (a mask
+// shown instead stays as it is).
 static wx_result update_depth_samples(vw_draw *draw, const vw_world *world, const vw_show *show,
                                       const float mvp[16], int width, int height, wx_error *err)
 {
-    bool deposits = vw_world_shows_deposits(world);
-    if (depth_samples_current(draw, show, mvp, width, height)) {
+    bool mask = world->mask >= 0;
+    bool deposits = !mask && vw_world_shows_deposits(world);
+    if (depth_samples_current(draw, world, show, mvp, width, height)) {
         if (deposits) {
             vw_world_deposit_colors(world, draw->depth_picked, (size_t)draw->depth_count,
                                     draw->staging, draw->vertices);
@@ -273,7 +276,9 @@ static wx_result update_depth_samples(vw_draw *draw, const vw_world *world, cons
         draw->depth_picked[k] = i;
         draw->vertices[k] = world->points[i];
     }
-    if (deposits) {
+    if (mask) {
+        vw_world_mask_colors(world, draw->depth_picked, n, draw->vertices);
+    } else if (deposits) {
         vw_world_deposit_colors(world, draw->depth_picked, n, draw->staging, draw->vertices);
     }
     upload(draw->depth_vbo, draw->vertices, n * sizeof(vw_vertex));
@@ -282,6 +287,7 @@ static wx_result update_depth_samples(vw_draw *draw, const vw_world *world, cons
     draw->depth_width = width;
     draw->depth_height = height;
     memcpy(draw->depth_cameras, show->cameras, (size_t)draw->camera_count * sizeof(bool));
+    draw->depth_mask = world->mask;
     draw->depth_valid = true;
     return WX_OK;
 }

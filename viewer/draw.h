@@ -1,6 +1,7 @@
 // draw.h: draws a world with OpenGL 3.3 core (thesis 4.8.5): camera frames,
 // emitters and bounding box from a static buffer; depth samples (with
-// <Substances>, tinted by the shown substance on their surface), live particles
+// <Substances>, tinted by the shown substance on their surface; while a
+// derived mask is shown, coloured by its value instead), live particles
 // (coloured by their load of the shown substance) and recent hit points from
 // buffers refilled as needed. Depth samples and particles are one-pixel points, reduced on the CPU
 // to the nearest per pixel before upload (points.h).
@@ -37,6 +38,7 @@ typedef struct vw_draw {
     float depth_mvp[16];           ///< the view the depth samples were picked for
     int depth_width, depth_height;
     bool *depth_cameras;           ///< cameras shown when they were picked
+    int depth_mask;                ///< the world's mask shown when they were coloured
     uint32_t *depth_picked;        ///< the picked samples (indices into world->points)
     int camera_count;
 
@@ -62,8 +64,8 @@ wx_result vw_draw_init(vw_draw *draw, int hit_capacity, wx_error *err);
 wx_result vw_draw_set_world(vw_draw *draw, const vw_world *world, wx_error *err);
 
 /// Refills the buffers for a frame seen through `mvp` on fb_width x fb_height
-/// pixels: the depth samples when the view or the shown cameras changed, the
-/// live particles, and the recent hits of shown cameras.
+/// pixels: the depth samples when the view, the shown cameras or the world's
+/// shown mask changed, the live particles, and the recent hits of shown cameras.
 wx_result vw_draw_update(vw_draw *draw, const vw_world *world, const vw_show *show,
                          const float mvp[16], int fb_width, int fb_height, wx_error *err);
 

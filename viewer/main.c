@@ -3,7 +3,7 @@
 //
 //   weathering-viewer SCENE.xml [--out DIR] [--threads N] [--size WxH]
 //                     [--screenshot FILE.png] [--frames N] [--steps-per-frame K]
-//                     [--substance NAME] [-v]
+//                     [--substance NAME] [--mask NAME] [-v]
 //
 // The scene is read (and baked, by `weathering bake` in a child process) before
 // any window opens, so bad input is reported with exit status 2 even without a
@@ -17,6 +17,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "bake_child.h"
 #include "core/usage.h"
@@ -59,6 +60,8 @@ typedef struct app {
     int steps_per_frame;    ///< with --frames
     bool gather_at_end;     ///< --gather: gather after the last of --frames
     const char *substance;  ///< --substance: shown first, or NULL (the first)
+    const char *mask;       ///< --mask: the derived mask shown first, or NULL (none)
+    int mask_request;       ///< M: a mask to compute after the frame that says so, or -1
     int width, height;
 
     vw_world *world;        ///< the running scene
@@ -103,6 +106,7 @@ static const char *const KEY_HELP[] = {
     "D        depth samples on / off",
     "P        particles on / off",
     "S        next substance: what particles and deposits show",
+    "M        next derived mask on the depth samples (<Masks>; off, 1, 2, ..., off)",
     "+ / -    simulation speed x2 / /2",
     "Backspace  start the simulation again",
     "Home     frame the cameras again",
@@ -117,6 +121,8 @@ static const char *const COLOUR_HELP[] = {
     "  particles pale blue (clean) to brown (carrying dirt), or to the",
     "  colour of the substance shown (S); with <Substances>, depth samples",
     "  tinted towards it where it lies on their surface;",
+    "  with a mask (M): depth samples dark violet (0) through crimson and",
+    "  orange to pale yellow (1); curvature blue concave, grey flat, red convex;",
     "  hits red absorbed, pale yellow bounced, pale green slid;",
     "  emitters pink; bounding box grey",
 };
@@ -141,6 +147,8 @@ static void print_usage(FILE *out)
             "  --steps-per-frame K   simulation steps per frame with --frames (default 1)\n"
             "  --gather              with --frames: save the dirt maps and the mask at the end\n"
             "  --substance NAME      show this substance first (default: the first)\n"
+            "  --mask NAME           show this derived mask (<Masks>) on the depth samples\n"
+            "                        (default: none; M cycles through them)\n"
             "  -v, --verbose         timing at exit on stderr\n"
             "  -h, --help            this help\n"
             "\n"
@@ -179,6 +187,75 @@ static void report(app *a, bool is_error, const char *fmt, ...)
     update_title(a);
 }
 
+static double now_s(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+// What the shown mask's colours mean; `seconds` it took to compute (< 0: it
+// was known), said only interactively (a run of --frames gives the same
+// pixels every time).
+static void report_mask(app *a, double seconds)
+{
+    const vw_world *w = a->world;
+    int m = w->mask;
+    if (m < 0) {
+        report(a, false, "mask off: depth samples in their cameras' colours%s",
+               vw_world_shows_deposits(w) ? ", tinted by the substance shown" : "");
+        return;
+    }
+    char took[64] = "";
+    if (seconds >= 0.0 && a->frames == 0) {
+        snprintf(took, sizeof took, " (computed in %.1f s)", seconds);
+    }
+    const wx_mask_def *md = &w->scene.masks[m];
+    if (md->kind == WX_MASK_CURVATURE) {
+        report(a, false,
+               "mask %s %d/%d (curvature) on the depth samples: blue concave, grey flat, red "
+               "convex, full colour at |curvature| %.3g per unit (99th percentile)%s",
+               md->name, m + 1, w->scene.mask_count, (double)w->mask_scale[m], took);
+    } else {
+        report(a, false,
+               "mask %s %d/%d (%s) on the depth samples: dark violet 0 to pale yellow 1%s",
+               md->name, m + 1, w->scene.mask_count, vw_world_mask_kind_name(w, m), took);
+    }
+}
+
+// Says that mask m is being computed: rays per sample, how many samples.
+static void report_computing(app *a, const char *prefix, int m)
+{
+    const vw_world *w = a->world;
+    const wx_mask_def *md = &w->scene.masks[m];
+    char rays[64] = "";
+    if (wx_mask_rays(md) > 0) {
+        snprintf(rays, sizeof rays, ", %d ray%s a sample", wx_mask_rays(md),
+                 wx_mask_rays(md) == 1 ? "" : "s");
+    }
+    report(a, false, "%scomputing mask %s (%s%s) at %d depth samples ...", prefix, md->name,
+           vw_world_mask_kind_name(w, m), rays, w->point_count);
+}
+
+// Computes the mask M asked for (after the frame that said so) and shows it.
+static void compute_requested_mask(app *a)
+{
+    int m = a->mask_request;
+    a->mask_request = -1;
+    if (m < 0 || m >= vw_world_mask_count(a->world)) {
+        return;
+    }
+    wx_error err;
+    double t0 = now_s();
+    if (vw_world_show_mask(a->world, m, &err) != WX_OK) {
+        report(a, true, "mask %s: %s", a->world->scene.masks[m].name, err.message);
+        return;
+    }
+    report_mask(a, now_s() - t0);
+    a->last_frame_s = glfwGetTime(); // the time it took is not owed to the simulation
+    a->step_debt = 0.0;
+}
+
 // --- arguments ------------------------------------------------------------------------
 
 static int usage_error(const char *fmt, const char *detail)
@@ -209,7 +286,7 @@ static int parse_args(int argc, char **argv, app *a)
         bool takes_value = strcmp(arg, "--out") == 0 || strcmp(arg, "--threads") == 0 ||
                            strcmp(arg, "--size") == 0 || strcmp(arg, "--screenshot") == 0 ||
                            strcmp(arg, "--frames") == 0 || strcmp(arg, "--steps-per-frame") == 0 ||
-                           strcmp(arg, "--substance") == 0;
+                           strcmp(arg, "--substance") == 0 || strcmp(arg, "--mask") == 0;
         if (takes_value && value == NULL) {
             return usage_error("%s needs a value", arg);
         }
@@ -251,6 +328,11 @@ static int parse_args(int argc, char **argv, app *a)
                 return usage_error("%s needs a substance name", arg);
             }
             a->substance = value;
+        } else if (strcmp(arg, "--mask") == 0) {
+            if (value[0] == '\0') {
+                return usage_error("%s needs a mask name", arg);
+            }
+            a->mask = value;
         } else if (strcmp(arg, "--frames") == 0) {
             if (!parse_int(value, 1, 100000000, &a->frames)) {
                 return usage_error("--frames takes a whole number from 1, not '%s'", value);
@@ -312,6 +394,11 @@ static void adopt_world(app *a, vw_world *world)
 {
     int old_cameras = a->world->scene.camera_count;
     vw_world_keep_substance(world, vw_world_substance_name(a->world));
+    // The mask shown (or about to be) is shown again by name, computed anew
+    // for the new maps after the next frame.
+    int old_mask = a->mask_request >= 0 ? a->mask_request : a->world->mask;
+    int mask = old_mask >= 0 ? vw_world_find_mask(world, a->world->scene.masks[old_mask].name) : -1;
+    a->mask_request = mask;
     vw_world_free(a->world);
     free(a->world);
     a->world = world;
@@ -324,7 +411,13 @@ static void adopt_world(app *a, vw_world *world)
     }
     reset_rates(a);
     a->playing = true;
-    report(a, false, "reloaded %s", world->scene.path);
+    if (mask >= 0) {
+        char prefix[WX_PATH_MAX + 32];
+        snprintf(prefix, sizeof prefix, "reloaded %s; ", world->scene.path);
+        report_computing(a, prefix, mask);
+    } else {
+        report(a, false, "reloaded %s", world->scene.path);
+    }
 }
 
 static void finish_reload(app *a, vw_world *world)
@@ -421,6 +514,17 @@ static int load_first_world(app *a)
         fprintf(stderr, ")\n");
         return WX_BAD_INPUT;
     }
+    int mask = a->mask != NULL ? vw_world_find_mask(a->world, a->mask) : -1;
+    if (a->mask != NULL && mask < 0) {
+        const wx_scene *scene = &a->world->scene;
+        fprintf(stderr, "weathering-viewer: --mask %s: %s has no such mask (%s", a->mask,
+                scene->path, scene->mask_count > 0 ? "it has" : "it has no <Masks>");
+        for (int m = 0; m < scene->mask_count; ++m) {
+            fprintf(stderr, "%s %s", m > 0 ? "," : "", scene->masks[m].name);
+        }
+        fprintf(stderr, ")\n");
+        return WX_BAD_INPUT;
+    }
     if (vw_world_needs_bake(a->world, NULL)) {
         fprintf(stderr, "weathering-viewer: baking the maps of %s into %s\n",
                 a->world->scene.path, a->world->opts.out_dir);
@@ -444,6 +548,16 @@ static int load_first_world(app *a)
         return r;
     }
     vw_world_show_substance(a->world, substance);
+    if (mask >= 0) {
+        report_computing(a, "", mask);
+        double t0 = now_s();
+        r = vw_world_show_mask(a->world, mask, &err);
+        if (r != WX_OK) {
+            fprintf(stderr, "weathering-viewer: mask %s: %s\n", a->mask, err.message);
+            return r;
+        }
+        report_mask(a, now_s() - t0);
+    }
     return -1;
 }
 
@@ -562,6 +676,11 @@ static void status_line(const app *a, bool live, char *out, size_t cap)
                       vw_world_substance_name(w), w->substance + 1,
                       vw_world_substance_count(w));
     }
+    if (w->mask >= 0 && n > 0 && (size_t)n < cap) {
+        n += snprintf(out + n, cap - (size_t)n, "  mask %s %d/%d (%s)",
+                      w->scene.masks[w->mask].name, w->mask + 1, w->scene.mask_count,
+                      vw_world_mask_kind_name(w, w->mask));
+    }
     if (live && n > 0 && (size_t)n < cap) {
         snprintf(out + n, cap - (size_t)n, " x%g  %.0f steps/s  %.0f fps", a->speed,
                  a->steps_per_s, a->frames_per_s);
@@ -604,6 +723,29 @@ static void next_substance(app *a)
            w->substance + 1, count, vw_world_substance_name(w), (double)w->load_scale);
 }
 
+// M: the next derived mask on the depth samples (off after the last); one not
+// computed yet is computed after the next frame, which says so.
+static void next_mask(app *a)
+{
+    vw_world *w = a->world;
+    if (vw_world_mask_count(w) == 0) {
+        report(a, false, "the scene has no <Masks>");
+        return;
+    }
+    int m = vw_world_next_mask(w);
+    if (!vw_world_mask_ready(w, m)) {
+        a->mask_request = m;
+        report_computing(a, "", m);
+        return;
+    }
+    wx_error err;
+    if (vw_world_show_mask(w, m, &err) != WX_OK) { // known: nothing to compute
+        report(a, true, "%s", err.message);
+        return;
+    }
+    report_mask(a, -1.0);
+}
+
 static void on_key(GLFWwindow *window, int key, int scancode, int action, int mods)
 {
     (void)scancode;
@@ -643,6 +785,11 @@ static void on_key(GLFWwindow *window, int key, int scancode, int action, int mo
         report(a, false, "particles %s", a->show.particles ? "on" : "off");
         break;
     case GLFW_KEY_S: next_substance(a); break;
+    case GLFW_KEY_M:
+        if (a->mask_request < 0) {
+            next_mask(a);
+        }
+        break;
     case GLFW_KEY_EQUAL:
     case GLFW_KEY_KP_ADD:
         a->speed = a->speed * 2.0 < MAX_SPEED ? a->speed * 2.0 : MAX_SPEED;
@@ -927,6 +1074,9 @@ static int run(app *a)
         if (last) {
             break;
         }
+        if (a->mask_request >= 0) {
+            compute_requested_mask(a); // the frame just shown says it is coming
+        }
     }
     a->timing.total_s = glfwGetTime() - start;
     if (a->gather_at_end) {
@@ -947,6 +1097,7 @@ int main(int argc, char **argv)
 {
     static app a; // large; zero-initialised
     a.speed = 1.0;
+    a.mask_request = -1;
     a.show.depth_samples = true;
     a.show.particles = true;
     a.show.hits = true;

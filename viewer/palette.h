@@ -48,6 +48,26 @@ static const uint8_t VW_SUBSTANCE_COLORS[8][3] = {
     { 0, 120, 120 },   // teal
 };
 
+/// Depth samples while a derived mask is shown (M, docs/viewer.md): a mask
+/// in [0, 1] along VW_MASK_RAMP, 0 dark violet through crimson and orange to
+/// 1 pale yellow (stops at 0, 1/4, 1/2, 3/4, 1, linear between), dark enough
+/// at 0 to stand out from the background; Curvature (signed) along
+/// VW_CURVATURE_RAMP, concave blue at -scale, flat grey at 0, convex red at
+/// +scale.
+enum { VW_MASK_RAMP_COUNT = 5, VW_CURVATURE_RAMP_COUNT = 3 };
+static const uint8_t VW_MASK_RAMP[VW_MASK_RAMP_COUNT][3] = {
+    { 48, 18, 86 },    // 0: dark violet
+    { 120, 28, 109 },  // plum
+    { 190, 55, 82 },   // crimson
+    { 240, 120, 40 },  // orange
+    { 250, 235, 150 }, // 1: pale yellow
+};
+static const uint8_t VW_CURVATURE_RAMP[VW_CURVATURE_RAMP_COUNT][3] = {
+    { 40, 100, 230 },  // concave (-scale and below)
+    { 190, 190, 190 }, // flat (0)
+    { 230, 60, 40 },   // convex (+scale and above)
+};
+
 /// Hit points by what the particle did: absorbed, bounced, slid.
 static const uint8_t VW_HIT_COLORS[3][3] = {
     { 255, 40, 40 },   // absorbed (or settled)

@@ -16,6 +16,7 @@
 
 #include "core/error.h"
 #include "model/maps.h"
+#include "pipeline/masks_phase.h"
 #include "pipeline/pipeline.h"
 #include "model/scene.h"
 #include "sim/simulate.h"
@@ -77,6 +78,20 @@ typedef struct vw_world {
     vw_range bbox_lines;
     float frame_lo[3];       ///< box around the camera frames (the initial view)
     float frame_hi[3];
+    int sample_stride;       ///< depth samples are every stride-th texel, from stride / 2
+
+    /// The derived mask shown on the depth samples (docs/design.md section
+    /// 12), an index into scene.masks; -1: none (the samples' own colours).
+    int mask;
+    /// Per mask once computed (vw_world_compute_mask): its value at every
+    /// depth sample, NaN where the sample's texel has no normal.
+    float *mask_values[WX_MAX_MASKS];
+    /// Per computed mask: the value drawn at the end of the ramp, 1, or for
+    /// Curvature the 99th percentile of |value| over the samples.
+    float mask_scale[WX_MAX_MASKS];
+    /// The collider over the input cameras' maps, built with the first mask
+    /// computed (NULL until then).
+    wx_mask_context *mask_context;
 } vw_world;
 
 /// Reads and validates the scene file and sets the run options (output folder,
@@ -173,6 +188,62 @@ float vw_world_deposit_scale(const vw_world *world, const uint32_t *picked, size
 /// `scratch` holds n floats.
 void vw_world_deposit_colors(const vw_world *world, const uint32_t *picked, size_t n,
                              float *scratch, vw_vertex *out);
+
+/// Derived masks (<Masks>, docs/design.md section 12) on the depth samples.
+/// A mask is computed once per world (per set of maps) at the samples' own
+/// points: for each camera, the grid of its sampled texels (every
+/// sample_stride-th texel; its own maps' depth and normal) is evaluated with
+/// the library's wx_masks_at_points (the same as wx_masks_at_camera when the
+/// stride is 1), with occlusion through the collider over the input cameras'
+/// maps, opts' seed and threads. Differences from the mask a gather writes:
+/// - Combine terms on substances read 0 (the viewer has no per-square-metre
+///   substances before a gather);
+/// - Height without min/max spans the y range of the surfaces the input
+///   cameras record (the viewer imports no geometry);
+/// - Curvature without a radius takes 4 texels of the camera's map, or twice
+///   the samples' spacing when they are more than 2 texels apart.
+int vw_world_mask_count(const vw_world *world);
+
+/// Index of the mask called `name`, or -1.
+int vw_world_find_mask(const vw_world *world, const char *name);
+
+/// What M shows next: -1 (none) -> 0 -> 1 -> ... -> the last -> -1; -1 when
+/// the scene has no masks.
+int vw_world_next_mask(const vw_world *world);
+
+/// The kind of mask m in words ("accessibility", "exposure", "curvature",
+/// "height", "combine").
+const char *vw_world_mask_kind_name(const vw_world *world, int m);
+
+/// True when mask m's values at the samples are known (-1: always).
+bool vw_world_mask_ready(const vw_world *world, int m);
+
+/// Computes mask m at every depth sample (and the masks it combines, kept
+/// too), unless known: may take seconds (accessibility's rays).
+wx_result vw_world_compute_mask(vw_world *world, int m, wx_error *err);
+
+/// Shows mask m (-1: none), computing it first when needed; on failure the
+/// shown mask is unchanged.
+wx_result vw_world_show_mask(vw_world *world, int m, wx_error *err);
+
+/// After a reload: shows the mask of that name if the new scene has one (it
+/// is computed), else none.
+wx_result vw_world_keep_mask(vw_world *world, const char *name, wx_error *err);
+
+/// Value of the shown mask at depth sample `point` (NaN: none shown, or no value).
+float vw_world_mask_value(const vw_world *world, int point);
+
+/// The ramp of the shown mask (palette.h): for a mask in [0, 1],
+/// VW_MASK_RAMP from 0 to 1 (values clamped); for Curvature,
+/// VW_CURVATURE_RAMP from -mask_scale (concave) through 0 to +mask_scale
+/// (convex), clamped.
+void vw_world_mask_color(const vw_world *world, float value, float out[3]);
+
+/// Copies depth samples picked[0..n) into out coloured by the shown mask
+/// (unshaded: equal values look equal); a sample without a value keeps its
+/// colour.
+void vw_world_mask_colors(const vw_world *world, const uint32_t *picked, size_t n,
+                          vw_vertex *out);
 
 /// Frees everything; the struct is zeroed.
 void vw_world_free(vw_world *world);
