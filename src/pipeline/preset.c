@@ -43,7 +43,7 @@ static const preset presets[] = {
                       0.3, 0.05, 0.8, 0.02, 0.1, 0.6 },
     [PRESET_SOOT] = { "soot drifting on a turbulent breeze: a sticky film on the windward side, "
                       "thinner on tops, some on undersides",
-                      0.4, 0.1, 30.0, 0.15, { 1.0, 0.0, 0.3 }, 0.25, 300000, 1, true,
+                      0.6, 0.02, 15.0, 0.03, { 1.0, 0.0, 0.3 }, 0.05, 300000, 1, true,
                       0.5, 0.05, 0.9, 0.01, 0.05, 0.8 },
     [PRESET_MOSS] = { "five rainy spells: the rain's water lingers, moss grows from it where it "
                       "stays wet, and a 'mossy' mask adds shelter and shade",
@@ -213,7 +213,7 @@ wx_result wx_scene_generate(const wx_init_def *def, char **out_text, wx_error *e
     const double g = 9.8 / unit * p->gravity, H = 0.75 * size, v = p->speed * size;
     const double fall = (-v + sqrt(v * v + 2.0 * g * H)) / g;
     const double dt = fall / 50.0, emit = 2.0 * fall;
-    const int steps = (int)ceil((emit + 2.0 * fall) / dt);
+    const int steps = (int)ceil((emit + 3.0 * fall) / dt);
     // The wind's drift over the fall widens the emitter upwind.
     double wind_len = sqrt(p->wind_dir[0] * p->wind_dir[0] + p->wind_dir[1] * p->wind_dir[1] +
                            p->wind_dir[2] * p->wind_dir[2]);
@@ -227,6 +227,19 @@ wx_result wx_scene_generate(const wx_init_def *def, char **out_text, wx_error *e
         // The drops drift by drift[k]: start them that far upwind.
         e_lo[k] -= fmax(0.0, drift[k]);
         e_hi[k] -= fmin(0.0, drift[k]);
+    }
+    double edir[3] = { 0.0, -1.0, 0.0 };
+    if (pi == PRESET_SOOT) {
+        // Soot drifts in from the side: a wall of emitters upwind of the mesh,
+        // blowing along the wind, over the mesh's height and depth.
+        e_lo[0] = e_hi[0] = lo[0] - H;
+        e_lo[1] = lo[1] - margin;
+        e_hi[1] = hi[1] + margin;
+        e_lo[2] = lo[2] - margin;
+        e_hi[2] = hi[2] + margin;
+        for (int k = 0; k < 3; ++k) {
+            edir[k] = p->wind_dir[k] / wind_len;
+        }
     }
     double box = 2.0 * fmax(size, fmax(e_hi[0] - e_lo[0], e_hi[2] - e_lo[2])) + 2.0 * H;
     double rate = p->particles / p->iterations / emit;
@@ -262,7 +275,7 @@ wx_result wx_scene_generate(const wx_init_def *def, char **out_text, wx_error *e
         "    <!-- A cube around the mesh and the emitter: particles leaving it are gone. -->\n"
         "    <BoundingBox size=\"%.6g\" centerX=\"%.6g\" centerY=\"%.6g\" centerZ=\"%.6g\"/>\n"
         "    <!-- A fall of 0.75 s from the emitter to the top takes %.3g s: 50 steps a fall;\n"
-        "         particles are emitted over two falls and fly two more. -->\n"
+        "         particles are emitted over two falls and fly three more. -->\n"
         "    <Simulation timeStep=\"%.6g\" steps=\"%d\" seed=\"1\"%s/>\n"
         "  </Solver>\n",
         box, c[0], c[1] + 0.5 * H, c[2], fall, dt, steps, iterations);
@@ -286,15 +299,17 @@ wx_result wx_scene_generate(const wx_init_def *def, char **out_text, wx_error *e
     put(&t, "  </ForceFields>\n");
     put(&t,
         "  <Emitters>\n"
-        "    <!-- A rectangle over the footprint (plus a margin of s/10), %.3g s above the top,\n"
-        "         %.0f particles over the run. -->\n"
+        "    <!-- A rectangle over the footprint (plus a margin of s/10), %.3g s above the top\n"
+        "         (for soot: upwind of the mesh, blowing along the wind), %.0f particles over\n"
+        "         the run. -->\n"
         "    <BoxEmitter name=\"%s\" minX=\"%.6g\" minY=\"%.6g\" minZ=\"%.6g\" maxX=\"%.6g\" "
         "maxY=\"%.6g\" maxZ=\"%.6g\"\n"
-        "                dirX=\"0\" dirY=\"-1\" dirZ=\"0\" spread=\"%.6g\" rate=\"%.6g\" start=\"0\" "
-        "end=\"%.6g\"\n"
+        "                dirX=\"%.6g\" dirY=\"%.6g\" dirZ=\"%.6g\" spread=\"%.6g\" rate=\"%.6g\" "
+        "start=\"0\" end=\"%.6g\"\n"
         "                speed=\"%.6g\" maxCollisions=\"60\"%s>\n",
         0.75, p->particles, wx_preset_names[pi], e_lo[0], e_lo[1], e_lo[2], e_hi[0], e_hi[1],
-        e_hi[2], p->spread, rate, emit, v, pi == PRESET_MOSS ? "" : " dirt=\"1\"");
+        e_hi[2], edir[0], edir[1], edir[2], p->spread, rate, emit, v,
+        pi == PRESET_MOSS ? "" : " dirt=\"1\"");
     if (pi == PRESET_MOSS) {
         put(&t, "      <Load substance=\"water\" amount=\"1\"/>\n");
     }
