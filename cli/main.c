@@ -1145,7 +1145,10 @@ int main(int argc, char **argv)
     for (int i = 0; i < COMMAND_COUNT; ++i) {
         if (strcmp(args.command, commands[i].name) == 0) {
             if (args.scene_path == NULL) {
-                return usage_error("%s needs a file", args.command);
+                return usage_error(strcmp(args.command, "init") == 0    ? "%s needs a mesh file"
+                                   : strcmp(args.command, "split") == 0 ? "%s needs an EXR file"
+                                                                        : "%s needs a scene file",
+                                   args.command);
             }
             bool mesh_options = args.preset != NULL || args.init_out != NULL ||
                                 args.resolution > 0 || args.units != NULL || args.force;
