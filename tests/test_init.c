@@ -149,7 +149,9 @@ TEST(sizes_scale_with_the_mesh)
         }
     }
     ensure_write_file(dir, "big.obj", big);
-    ensure_write_file(dir, "small.obj", ensure_read_file(data_file("texture_cube.obj")));
+    char *small = ensure_read_file(data_file("texture_cube.obj"));
+    ensure_write_file(dir, "small.obj", small != NULL ? small : "");
+    free(small);
     free(big);
     free(cube);
     ENSURE(run_in(dir, "init small.obj -o %s%s", "small.xml", "") == 0);
