@@ -476,26 +476,15 @@ static wx_result prepare_input(const wx_target *out, const double out_ctw[16],
                        "have the last column 0 0 0 1)",
                        index);
     }
-    const double wo = out->width, ho = out->height, wi = in->width, hi = in->height;
+    const double wo = out->width, ho = out->height;
     // [i j d 1] -> [u v d 1] of the output map: u = (i + 1/2)/W, v = 1 - (j + 1/2)/H.
     const double pre[16] = { 1.0 / wo, 0, 0, 0, //
                              0, -1.0 / ho, 0, 0, //
                              0, 0, 1, 0, //
                              0.5 / wo, 1.0 - 0.5 / ho, 0, 1 };
-    // [u v d 1] -> [x y d 1] of the input map: x = u W - 1/2, y = (1 - v) H - 1/2.
-    const double post[16] = { wi, 0, 0, 0, //
-                              0, -hi, 0, 0, //
-                              0, 0, 1, 0, //
-                              -0.5, hi - 0.5, 0, 1 };
-    double a[16], b[16], full[16];
+    double a[16];
     wx_matrix_mul(pre, out_ctw, a);
-    wx_matrix_mul(a, wtc, b);
-    wx_matrix_mul(b, post, full);
-    for (int r = 0; r < 4; ++r) {
-        cam->cx[r] = full[r * 4 + 0];
-        cam->cy[r] = full[r * 4 + 1];
-        cam->cd[r] = full[r * 4 + 2];
-    }
+    wx_gather_view_rows(in, wtc, a, cam->cx, cam->cy, cam->cd);
     cam->width = in->width;
     cam->height = in->height;
     cam->depth = in->depth;
@@ -513,6 +502,29 @@ static wx_result prepare_input(const wx_target *out, const double out_ctw[16],
     }
     cam->inv_head_area = (float)(1.0 / head_area);
     return WX_OK;
+}
+
+void wx_gather_view_rows(const wx_gather_view *view, const double wtc[16], const double from[16],
+                         double cx[4], double cy[4], double cd[4])
+{
+    const double wi = view->width, hi = view->height;
+    // [u v d 1] -> [x y d 1] of the input map: x = u W - 1/2, y = (1 - v) H - 1/2.
+    const double post[16] = { wi, 0, 0, 0, //
+                              0, -hi, 0, 0, //
+                              0, 0, 1, 0, //
+                              -0.5, hi - 0.5, 0, 1 };
+    double b[16], full[16];
+    if (from != NULL) {
+        wx_matrix_mul(from, wtc, b);
+    } else {
+        memcpy(b, wtc, sizeof b);
+    }
+    wx_matrix_mul(b, post, full);
+    for (int r = 0; r < 4; ++r) {
+        cx[r] = full[r * 4 + 0];
+        cy[r] = full[r * 4 + 1];
+        cd[r] = full[r * 4 + 2];
+    }
 }
 
 bool wx_gather_view_frame(const wx_gather_view *view, float ray_out[3], float *tol_world,

@@ -87,6 +87,14 @@ typedef struct wx_gather_stats {
     int64_t capped_texels;
 } wx_gather_stats;
 
+/// The rows mapping a point into the texel space of an input camera (texel
+/// centres at integers, row 0 at the top): x = cx . (p, 1), y = cy . (p, 1),
+/// depth = cd . (p, 1), p in world space, or in the space `from` maps to world
+/// (row vectors: [p 1] * from = [world 1]; NULL: p is a world point). `wtc` is
+/// the camera's affine world-to-map matrix (wx_matrix_to_affine).
+void wx_gather_view_rows(const wx_gather_view *view, const double wtc[16], const double from[16],
+                         double cx[4], double cy[4], double cd[4]);
+
 /// The frame of an input camera as the first pass uses it: the unit viewing
 /// direction, the visibility test's depth tolerance (WX_GATHER_DEPTH_TOL_TEXELS
 /// times the texel's larger side) and the area of a texel seen head-on. False

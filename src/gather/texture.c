@@ -365,6 +365,10 @@ static void sample_rows(int64_t begin, int64_t end, int worker, void *context)
             if (!wx_uv_raster_point(def->mesh, def->uv, def->raster, t, p, n)) {
                 continue;
             }
+            if (def->position != NULL && def->normal != NULL) {
+                memcpy(&def->position[3 * t], p, sizeof p);
+                memcpy(&def->normal[3 * t], n, sizeof n);
+            }
             float total = 0.0f;
             for (int c = 0; c < channels; ++c) {
                 sum[c] = 0.0f;
@@ -401,19 +405,7 @@ static bool prepare_view(const wx_gather_view *view, view_sampler *s)
         !wx_gather_view_frame(view, s->ray, &s->tol_world, &head_area)) {
         return false;
     }
-    const double wi = view->width, hi = view->height;
-    // [u v d 1] -> [x y d 1] of the map: x = u W - 1/2, y = (1 - v) H - 1/2.
-    const double post[16] = { wi, 0, 0, 0, //
-                              0, -hi, 0, 0, //
-                              0, 0, 1, 0, //
-                              -0.5, hi - 0.5, 0, 1 };
-    double full[16];
-    wx_matrix_mul(wtc, post, full);
-    for (int r = 0; r < 4; ++r) {
-        s->cx[r] = full[r * 4 + 0];
-        s->cy[r] = full[r * 4 + 1];
-        s->cd[r] = full[r * 4 + 2];
-    }
+    wx_gather_view_rows(view, wtc, NULL, s->cx, s->cy, s->cd);
     s->width = view->width;
     s->height = view->height;
     s->depth = view->depth;

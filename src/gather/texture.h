@@ -69,6 +69,11 @@ typedef struct wx_texture_def {
     const float *const *smoothed;
     int channels;
     int threads;
+    /// Optional (NULL: not kept): the covered texels' surface points as the
+    /// sampling makes them (3 doubles and 3 floats a texel; the others are
+    /// left alone), for what is evaluated at the same points (derived masks).
+    double *position;
+    float *normal;
 } wx_texture_def;
 
 /// Fills out[c] (width*height floats each, c < channels) and seen (the same

@@ -66,6 +66,17 @@ wx_result wx_gather_maps(const wx_scene *scene, const wx_run_def *opts, const wx
     return wx_gather_frame(scene, opts, in_maps, given_out, textures, 0, detail, err);
 }
 
+void wx_gather_views_of_substance(wx_gather_view *views, const wx_maps *in_maps, int count,
+                                  int substance)
+{
+    for (int v = 0; v < count; ++v) {
+        size_t plane = (size_t)substance * (size_t)in_maps[v].width * (size_t)in_maps[v].height;
+        views[v].dirt = in_maps[v].dirt != NULL ? in_maps[v].dirt + plane : NULL;
+        views[v].initial = in_maps[v].initial_dirt != NULL ? in_maps[v].initial_dirt + plane
+                                                           : NULL;
+    }
+}
+
 bool wx_frame_wanted(const wx_scene *scene, int frame)
 {
     if (scene->output_index >= 0 && scene->output_index < scene->camera_count) {
@@ -215,12 +226,7 @@ static wx_result write_mask(const wx_scene *scene, const wx_run_def *opts, const
     // A scene made in memory may leave substance_count 0: the one substance.
     const int substances = scene->substance_count > 0 ? scene->substance_count : 1;
     for (int s = 0; s < substances && result == WX_OK; ++s) {
-        for (int v = 0; v < k; ++v) {
-            size_t plane = (size_t)s * (size_t)in_maps[v].width * (size_t)in_maps[v].height;
-            views[v].dirt = in_maps[v].dirt != NULL ? in_maps[v].dirt + plane : NULL;
-            views[v].initial = in_maps[v].initial_dirt != NULL ? in_maps[v].initial_dirt + plane
-                                                               : NULL;
-        }
+        wx_gather_views_of_substance(views, in_maps, k, s);
         wx_gather_def def = wx_default_gather_def();
         def.target = wx_target_from_camera(&out->camera, om);
         def.inputs = views;

@@ -5,6 +5,7 @@
 #define WX_GATHER_PHASE_H
 
 #include "core/error.h"
+#include "gather/gather.h"
 #include "model/maps.h"
 #include "model/scene.h"
 #include "model/stats.h"
@@ -46,6 +47,12 @@ wx_result wx_gather_maps(const wx_scene *scene, const wx_run_def *opts, const wx
 wx_result wx_gather_frame(const wx_scene *scene, const wx_run_def *opts, const wx_maps *in_maps,
                           const wx_maps *out_maps, const struct wx_textures *textures, int frame,
                           wx_phase_detail *detail, wx_error *err);
+
+/// Points views[0..count) (made by wx_gather_view_from_maps) at substance
+/// `substance`'s amount and baseline planes of in_maps (model/maps.h: S planes
+/// one after the other), for one gather of that substance.
+void wx_gather_views_of_substance(wx_gather_view *views, const wx_maps *in_maps, int count,
+                                  int substance);
 
 /// Whether frame `frame` writes anything: the mask's or some TextureMap's
 /// `every` divides it (frame 0: always).
