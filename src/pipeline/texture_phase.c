@@ -50,6 +50,24 @@ static wx_result copy_mesh(const wx_mesh_data *from, int uv, wx_mesh_data *to, w
     return WX_OK;
 }
 
+// The surface area of a mesh.
+static double mesh_area(const wx_mesh_data *mesh)
+{
+    double area = 0.0;
+    for (int64_t k = 0; k < mesh->triangle_count; ++k) {
+        const uint32_t *idx = &mesh->indices[3 * k];
+        const float *a = &mesh->positions[3 * (size_t)idx[0]];
+        const float *b = &mesh->positions[3 * (size_t)idx[1]];
+        const float *c = &mesh->positions[3 * (size_t)idx[2]];
+        double e1[3] = { b[0] - a[0], b[1] - a[1], b[2] - a[2] };
+        double e2[3] = { c[0] - a[0], c[1] - a[1], c[2] - a[2] };
+        double x = e1[1] * e2[2] - e1[2] * e2[1], y = e1[2] * e2[0] - e1[0] * e2[2];
+        double z = e1[0] * e2[1] - e1[1] * e2[0];
+        area += 0.5 * sqrt(x * x + y * y + z * z);
+    }
+    return area;
+}
+
 wx_result wx_textures_prepare(const wx_scene *scene, const wx_geometry *geometry,
                               const wx_run_def *opts, wx_textures *out, wx_error *err)
 {
@@ -79,6 +97,8 @@ wx_result wx_textures_prepare(const wx_scene *scene, const wx_geometry *geometry
             break;
         }
         const wx_uv_raster *ras = &t->raster;
+        t->texel = ras->covered > 0 ? (float)sqrt(mesh_area(&t->mesh) / (double)ras->covered)
+                                    : 1.0f;
         double texels = (double)def->width * (double)def->height;
         wx_note(opts->quiet,
                 "texture %s: %d x %d texels over UV channel %d of '%s', %.1f%% covered "
@@ -156,12 +176,7 @@ static wx_result compute_planes(const wx_scene *scene, const wx_run_def *opts,
         float frame_w, frame_h;
         wx_camera_frame_size(&sc->camera, &frame_w, &frame_h);
         for (int c = 0; c < channels && r == WX_OK; ++c) {
-            for (int v = 0; v < k_count; ++v) {
-                size_t plane = (size_t)c * (size_t)in_maps[v].width * (size_t)in_maps[v].height;
-                views[v].dirt = in_maps[v].dirt != NULL ? in_maps[v].dirt + plane : NULL;
-                views[v].initial =
-                    in_maps[v].initial_dirt != NULL ? in_maps[v].initial_dirt + plane : NULL;
-            }
+            wx_gather_views_of_substance(views, in_maps, k_count, c);
             float **plane = &planes[(size_t)k * (size_t)channels + (size_t)c];
             *plane = malloc((size_t)m->width * (size_t)m->height * sizeof **plane + 1);
             if (*plane == NULL) {
@@ -203,55 +218,33 @@ static void free_planes(camera_planes *cache, int count, int planes)
 }
 
 // The derived masks at a texture's covered texels that are seen (channels
-// after the substances'): the surface points of the raster, the substances'
-// sampled values for the Combines, the texel size from the mesh's area.
+// after the substances'), at the surface points the sampling made
+// (position, normal), the substances' sampled values for the Combines.
 static wx_result texture_masks(const wx_scene *scene, const wx_run_def *opts,
                                const wx_mask_context *masks, const wx_texture_target *t,
-                               wx_image *image, wx_error *err)
+                               wx_image *image, const double *position, const float *normal,
+                               wx_error *err)
 {
     const wx_uv_raster *ras = &t->raster;
     const size_t texels = (size_t)ras->width * (size_t)ras->height;
     const float *seen = image->channels[image->channel_count - 1];
-    double *position = malloc(3 * texels * sizeof *position);
-    float *normal = calloc(3 * texels, sizeof *normal);
-    unsigned char *valid = calloc(texels, 1);
-    if (position == NULL || normal == NULL || valid == NULL) {
-        free(position);
-        free(normal);
-        free(valid);
+    unsigned char *valid = malloc(texels + 1);
+    if (valid == NULL) {
         return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "texture: out of memory (masks)");
     }
     for (size_t i = 0; i < texels; ++i) {
-        position[3 * i] = position[3 * i + 1] = position[3 * i + 2] = 0.0;
-        valid[i] = seen[i] > 0.5f &&
-                   wx_uv_raster_point(&t->mesh, t->def->uv, ras, i, &position[3 * i], &normal[3 * i]);
-    }
-    // A texel's world size: the mesh's area over the covered texels.
-    double area = 0.0;
-    for (int64_t k = 0; k < t->mesh.triangle_count; ++k) {
-        const uint32_t *idx = &t->mesh.indices[3 * k];
-        const float *a = &t->mesh.positions[3 * (size_t)idx[0]];
-        const float *b = &t->mesh.positions[3 * (size_t)idx[1]];
-        const float *c = &t->mesh.positions[3 * (size_t)idx[2]];
-        double e1[3] = { b[0] - a[0], b[1] - a[1], b[2] - a[2] };
-        double e2[3] = { c[0] - a[0], c[1] - a[1], c[2] - a[2] };
-        double x = e1[1] * e2[2] - e1[2] * e2[1], y = e1[2] * e2[0] - e1[0] * e2[2];
-        double z = e1[0] * e2[1] - e1[1] * e2[0];
-        area += 0.5 * sqrt(x * x + y * y + z * z);
+        valid[i] = seen[i] > 0.5f; // seen implies covered: its point was made
     }
     wx_mask_points points = { .width = ras->width,
                               .height = ras->height,
                               .position = position,
                               .normal = normal,
                               .valid = valid,
-                              .texel = ras->covered > 0 ? (float)sqrt(area / (double)ras->covered)
-                                                        : 1.0f };
+                              .texel = t->texel };
     const int S = image->channel_count - 1 - scene->mask_count;
     wx_result r = wx_masks_at_points(scene, opts, masks, &points,
                                      (const float *const *)image->channels, image->channels + S,
                                      err);
-    free(position);
-    free(normal);
     free(valid);
     return r;
 }
@@ -280,6 +273,17 @@ static wx_result write_texture(const wx_scene *scene, const wx_run_def *opts,
     if (r == WX_OK) {
         r = wx_image_alloc(image, def->width, def->height, channels, channel_names, err);
     }
+    // The surface points, kept for the derived masks.
+    const size_t texels = (size_t)def->width * (size_t)def->height;
+    double *position = NULL;
+    float *normal = NULL;
+    if (r == WX_OK && scene->mask_count > 0) {
+        position = calloc(3 * texels, sizeof *position);
+        normal = calloc(3 * texels, sizeof *normal);
+        if (position == NULL || normal == NULL) {
+            r = wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "texture: out of memory (masks)");
+        }
+    }
     if (r == WX_OK) {
         wx_texture_def td = { .mesh = &t->mesh,
                               .uv = def->uv,
@@ -288,14 +292,18 @@ static wx_result write_texture(const wx_scene *scene, const wx_run_def *opts,
                               .input_count = scene->input_count,
                               .smoothed = (const float *const *)planes,
                               .channels = channels - 1 - scene->mask_count,
-                              .threads = opts->threads };
+                              .threads = opts->threads,
+                              .position = position,
+                              .normal = normal };
         r = wx_texture_sample(&td, image->channels, image->channels[channels - 1], NULL, err);
     }
     // The derived masks at the texels whose point is seen, then the padding of
     // every channel.
     if (r == WX_OK && scene->mask_count > 0) {
-        r = texture_masks(scene, opts, masks, t, image, err);
+        r = texture_masks(scene, opts, masks, t, image, position, normal, err);
     }
+    free(position);
+    free(normal);
     if (r == WX_OK) {
         wx_texture_pad(&t->raster, image->channels, channels);
     }
@@ -312,7 +320,6 @@ static wx_result write_texture(const wx_scene *scene, const wx_run_def *opts,
     // Previews: transparent where no texel holds a value.
     float *alpha = NULL;
     if (r == WX_OK && frame == 0) {
-        size_t texels = (size_t)def->width * (size_t)def->height;
         alpha = malloc(texels * sizeof *alpha);
         if (alpha == NULL) {
             r = wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "texture: out of memory (preview)");

@@ -23,6 +23,7 @@ typedef struct wx_texture_target {
     const wx_texture_map *def;
     wx_mesh_data mesh;
     wx_uv_raster raster;
+    float texel; ///< a texel's world size: the mesh's area over the covered texels, square-rooted
 } wx_texture_target;
 
 /// Every <TextureMap> of a scene, in scene order.
