@@ -906,9 +906,17 @@ static void mesh_base(const char *path, char *out, size_t cap)
     }
 }
 
-// The scene text for the mesh of `args`, its path written as `mesh_ref`.
-static int generate(const cli_args *args, const char *mesh_ref, char **text)
+// The scene text for the mesh of `args`: its path written as given when
+// `as_given`, else absolute.
+static int generate(const cli_args *args, bool as_given, char **text)
 {
+    char mesh_ref[WX_PATH_MAX];
+    if (as_given) {
+        snprintf(mesh_ref, sizeof mesh_ref, "%s", args->scene_path);
+    } else if (realpath(args->scene_path, mesh_ref) == NULL) {
+        fprintf(stderr, "weathering: %s: mesh file not found\n", args->scene_path);
+        return WX_BAD_INPUT;
+    }
     wx_init_def def = { .mesh_path = args->scene_path,
                         .mesh_ref = mesh_ref,
                         .preset = args->preset,
@@ -958,15 +966,9 @@ static int command_init(const cli_args *args)
     }
     // The mesh as the scene names it: as given when the scene is written in the
     // current folder and the path is relative, else absolute.
-    char mesh_ref[WX_PATH_MAX];
-    if (strchr(scene_path, '/') == NULL && args->scene_path[0] != '/') {
-        snprintf(mesh_ref, sizeof mesh_ref, "%s", args->scene_path);
-    } else if (realpath(args->scene_path, mesh_ref) == NULL) {
-        fprintf(stderr, "weathering: %s: mesh file not found\n", args->scene_path);
-        return WX_BAD_INPUT;
-    }
+    bool as_given = strchr(scene_path, '/') == NULL && args->scene_path[0] != '/';
     char *text = NULL;
-    int status = generate(args, mesh_ref, &text);
+    int status = generate(args, as_given, &text);
     if (status != WX_OK) {
         return status;
     }
@@ -1004,19 +1006,15 @@ static int command_run(const cli_args *args)
         return run_phases(args, all);
     }
     // A mesh: its scene generated into the output folder as scene.xml, then run.
-    char out_dir[WX_PATH_MAX], base[256], mesh_ref[WX_PATH_MAX], scene_path[WX_PATH_MAX + 16];
+    char out_dir[WX_PATH_MAX], base[256], scene_path[WX_PATH_MAX + 16];
     mesh_base(args->scene_path, base, sizeof base);
     if (args->out_dir != NULL) {
         snprintf(out_dir, sizeof out_dir, "%s", args->out_dir);
     } else {
         snprintf(out_dir, sizeof out_dir, "out/%s", base);
     }
-    if (realpath(args->scene_path, mesh_ref) == NULL) {
-        fprintf(stderr, "weathering: %s: mesh file not found\n", args->scene_path);
-        return WX_BAD_INPUT;
-    }
     char *text = NULL;
-    int status = generate(args, mesh_ref, &text);
+    int status = generate(args, false, &text);
     if (status != WX_OK) {
         return status;
     }

@@ -83,14 +83,13 @@ void wx_memory_estimate(const wx_scene *scene, unsigned phases, wx_memory_need *
     // Derived masks (docs/masks.md): a plane each, and while they are computed
     // the points (a double position and a flag per texel); the collider's copy
     // of every input camera's depth with its pyramid, and zero impact planes.
-    double collider = 0.0;
     if (scene->mask_count > 0) {
         gather_out += WX_PLANE_BYTES_PER_TEXEL * scene->mask_count + 25.0;
-        collider = 0.0; // filled once the input texels are known, below
     }
-    if (scene->mask_count > 0) {
-        collider = WX_MASK_COLLIDER_BYTES_PER_TEXEL * input_texels + 8.0 * largest_input;
-    }
+    const double collider =
+        scene->mask_count > 0
+            ? WX_MASK_COLLIDER_BYTES_PER_TEXEL * input_texels + 8.0 * largest_input
+            : 0.0;
     bool textures = scene->texture_count > 0 && (phases & (WX_PHASE_SIMULATE | WX_PHASE_GATHER));
     bool texture_frames = false;
     for (int t = 0; textures && t < scene->texture_count; ++t) {
