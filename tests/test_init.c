@@ -14,29 +14,17 @@
 #include <libxml/xmlschemas.h>
 
 #include "ensure.h"
+#include "run_fixture.h"
 #include "io/exr.h"
 #include "model/image.h"
 
-static char out[65536];
-
+// `weathering` in `dir` with the arguments of `fmt` (two strings), its failures
+// expected as often as not (not shown).
 static int run_in(const char *dir, const char *fmt, const char *a, const char *b)
 {
-    char build[PATH_MAX], args[4 * PATH_MAX];
-    if (realpath(ensure_build_dir(), build) == NULL) {
-        return -1;
-    }
+    char args[4 * PATH_MAX];
     snprintf(args, sizeof args, fmt, a, b);
-    return ensure_shell(out, sizeof out, "cd '%s' && '%s/weathering' %s 2>&1", dir, build, args);
-}
-
-static const char *data_file(const char *name)
-{
-    static char path[PATH_MAX + 64], tests[PATH_MAX];
-    if (realpath(ensure_tests_dir(), tests) == NULL) {
-        return name;
-    }
-    snprintf(path, sizeof path, "%s/data/%s", tests, name);
-    return path;
+    return weathering_in(dir, args, false);
 }
 
 // Validates a scene against xml_scenes/weathering.xsd.
@@ -54,23 +42,6 @@ static bool schema_accepts(const char *path)
     xmlSchemaFree(schema);
     xmlSchemaFreeParserCtxt(pc);
     return ok;
-}
-
-static float *read_channel(const char *path, const char *name, int *w, int *h)
-{
-    const char *const names[1] = { name };
-    wx_image image;
-    wx_error err;
-    if (wx_exr_read(path, names, 1, &image, &err) != WX_OK) {
-        fprintf(stderr, "        %s\n", err.message);
-        return NULL;
-    }
-    *w = image.width;
-    *h = image.height;
-    float *plane = image.channels[0];
-    image.channels[0] = NULL;
-    wx_image_free(&image);
-    return plane;
 }
 
 // The mean of a texture's channel over an island of texture_cube.obj (first
@@ -194,7 +165,7 @@ TEST(run_a_mesh_and_split_its_texture)
     ENSURE(strstr(out, "dust/texture_cube_texture_Y.exr") != NULL);
     ENSURE(strstr(out, "dust/texture_cube_texture_seen.exr") != NULL);
     snprintf(path, sizeof path, "%s/dust/texture_cube_texture.exr", dir);
-    int w, h, w2, h2;
+    int w = 0, h = 0, w2 = -1, h2 = -1;
     float *y = read_channel(path, "Y", &w, &h);
     snprintf(path, sizeof path, "%s/dust/texture_cube_texture_Y.exr", dir);
     float *y2 = read_channel(path, "Y", &w2, &h2);

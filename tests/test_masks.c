@@ -16,41 +16,8 @@
 #include "io/exr.h"
 #include "model/image.h"
 #include "sim/masks.h"
+#include "run_fixture.h"
 #include "sphere_fixture.h"
-
-static char out[65536];
-
-static int run_in(const char *dir, const char *args)
-{
-    char build[PATH_MAX];
-    if (realpath(ensure_build_dir(), build) == NULL) {
-        return -1;
-    }
-    int status = ensure_shell(out, sizeof out, "cd '%s' && '%s/weathering' %s 2>&1", dir, build,
-                              args);
-    if (status != 0) {
-        fprintf(stderr, "        %s", out);
-    }
-    return status;
-}
-
-// One channel of an EXR (malloc'd), or NULL with a note.
-static float *read_channel(const char *path, const char *name, int *w, int *h)
-{
-    const char *const names[1] = { name };
-    wx_image image;
-    wx_error err;
-    if (wx_exr_read(path, names, 1, &image, &err) != WX_OK) {
-        fprintf(stderr, "        %s\n", err.message);
-        return NULL;
-    }
-    *w = image.width;
-    *h = image.height;
-    float *plane = image.channels[0];
-    image.channels[0] = NULL;
-    wx_image_free(&image);
-    return plane;
-}
 
 // Writes an OBJ of axis-aligned boxes: each line of `boxes` is x0 y0 z0 x1 y1 z1.
 static void write_boxes(const char *dir, const char *name, const double (*boxes)[6], int count)
@@ -146,7 +113,7 @@ TEST(open_plane)
                 "<Term constant=\"0.3\" weight=\"2\" offset=\"0.1\" steepness=\"10\"/>"
                 "<Term mask=\"h\" weight=\"-0.5\"/></Combine>",
                 "", NULL);
-    ENSURE(run_in(dir, "run plane.xml --out plane -q") == 0);
+    ENSURE(weathering_in(dir, "run plane.xml --out plane -q", true) == 0);
     char path[PATH_MAX];
     snprintf(path, sizeof path, "%s/plane/mask.exr", dir);
     const char *names[6] = { "ao.Y", "sun.Y", "sides.Y", "k.Y", "h.Y", "c.Y" };
@@ -189,7 +156,7 @@ TEST(floor_beside_a_wall)
     // A frame over x in [-1, 7]: x = 0 falls on a texel border (64 texels a metre).
     write_scene(dir, "wall.xml", "wall.obj", 3.0, 8.0, 512,
                 "<Accessibility name=\"ao\" rays=\"256\" distance=\"1\"/>", "", NULL);
-    ENSURE(run_in(dir, "run wall.xml --out wall -q") == 0);
+    ENSURE(weathering_in(dir, "run wall.xml --out wall -q", true) == 0);
     char path[PATH_MAX];
     snprintf(path, sizeof path, "%s/wall/mask.exr", dir);
     int w, h;
@@ -217,7 +184,7 @@ TEST(floor_beside_a_wall)
     write_boxes(dir, "low.obj", low, 2);
     write_scene(dir, "shadow.xml", "low.obj", 3.0, 8.0, 512,
                 "<Exposure name=\"sun\" elevation=\"45\" azimuth=\"180\"/>", "", NULL);
-    ENSURE(run_in(dir, "run shadow.xml --out shadow -q") == 0);
+    ENSURE(weathering_in(dir, "run shadow.xml --out shadow -q", true) == 0);
     snprintf(path, sizeof path, "%s/shadow/mask.exr", dir);
     float *sun = read_channel(path, "sun.Y", &w, &h);
     ENSURE(sun != NULL);
@@ -259,7 +226,7 @@ TEST(inside_a_closed_box)
                 "<Accessibility name=\"ao\" rays=\"64\" distance=\"0.5\"/>", "",
                 "<View eye=\"0 1.5 0\" target=\"0 0 0\" up=\"0 0 -1\" width=\"1.6\" "
                 "height=\"1.6\" resolution=\"64\"/>");
-    ENSURE(run_in(dir, "run box.xml --out box -q") == 0);
+    ENSURE(weathering_in(dir, "run box.xml --out box -q", true) == 0);
     char path[PATH_MAX];
     snprintf(path, sizeof path, "%s/box/mask.exr", dir);
     int w, h;
@@ -305,7 +272,7 @@ TEST(sphere_curvature_and_height)
         ENSURE(sphere_write_mesh_scaled(scaled, 128, 256, R));
         write_scene(dir, name, sname, 0.0, 2.4 * R, 512, masks, "", NULL);
         snprintf(args, sizeof args, "run %s --out %s -q", name, folder);
-        ENSURE(run_in(dir, args) == 0);
+        ENSURE(weathering_in(dir, args, true) == 0);
         char path[PATH_MAX];
         snprintf(path, sizeof path, "%s/%s/mask.exr", dir, folder);
         int w, h;
@@ -345,9 +312,7 @@ TEST(sphere_curvature_and_height)
 TEST(masks_in_a_texture)
 {
     const char *dir = ensure_tmpdir();
-    char mesh[PATH_MAX + 32], tests[PATH_MAX];
-    ENSURE(realpath(ensure_tests_dir(), tests) != NULL);
-    snprintf(mesh, sizeof mesh, "%s/data/texture_cube.obj", tests);
+    const char *mesh = data_file("texture_cube.obj");
     char text[8192];
     snprintf(text, sizeof text,
              "<Weathering>\n"
@@ -363,7 +328,7 @@ TEST(masks_in_a_texture)
              "</Weathering>\n",
              mesh);
     ensure_write_file(dir, "cube.xml", text);
-    ENSURE(run_in(dir, "run cube.xml --out cube -q") == 0);
+    ENSURE(weathering_in(dir, "run cube.xml --out cube -q", true) == 0);
     char path[PATH_MAX];
     snprintf(path, sizeof path, "%s/cube/cube.exr", dir);
     int w, h;
@@ -405,8 +370,8 @@ TEST(same_bytes_for_any_thread_count)
                 "<Exposure name=\"sun\" elevation=\"30\" azimuth=\"170\" sideWeight=\"0.3\" "
                 "sideSpread=\"40\"/><Curvature name=\"k\"/>",
                 "", NULL);
-    ENSURE(run_in(dir, "run t.xml --out one -q --threads 1") == 0);
-    ENSURE(run_in(dir, "run t.xml --out two -q --threads 2") == 0);
+    ENSURE(weathering_in(dir, "run t.xml --out one -q --threads 1", true) == 0);
+    ENSURE(weathering_in(dir, "run t.xml --out two -q --threads 2", true) == 0);
     ENSURE(ensure_shell(out, sizeof out, "cd '%s' && cmp one/mask.exr two/mask.exr", dir) == 0);
 }
 

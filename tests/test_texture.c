@@ -16,33 +16,8 @@
 #include "gather/texture.h"
 #include "io/exr.h"
 #include "model/image.h"
+#include "run_fixture.h"
 #include "sphere_fixture.h"
-
-static char out[65536];
-
-static const char *data_file(const char *name)
-{
-    static char path[PATH_MAX + 64], dir[PATH_MAX];
-    if (realpath(ensure_tests_dir(), dir) == NULL) {
-        return name;
-    }
-    snprintf(path, sizeof path, "%s/data/%s", dir, name);
-    return path;
-}
-
-static int run_in(const char *dir, const char *args)
-{
-    char build[PATH_MAX];
-    if (realpath(ensure_build_dir(), build) == NULL) {
-        return -1;
-    }
-    int status = ensure_shell(out, sizeof out, "cd '%s' && '%s/weathering' %s 2>&1", dir, build,
-                              args);
-    if (status != 0) {
-        fprintf(stderr, "        %s", out);
-    }
-    return status;
-}
 
 // Reads the named channels of an EXR; false with a note on failure.
 static bool read_channels(const char *path, const char *const *names, int count, wx_image *image)
@@ -204,7 +179,7 @@ TEST(cube_atlas_under_vertical_rain)
     char text[8192];
     snprintf(text, sizeof text, cube_scene, 1, 2 * particles, data_file("texture_cube.obj"), 0);
     ensure_write_file(dir, "cube.xml", text);
-    ENSURE(run_in(dir, "run cube.xml --out cube -q") == 0);
+    ENSURE(weathering_in(dir, "run cube.xml --out cube -q", true) == 0);
     char path[PATH_MAX];
     snprintf(path, sizeof path, "%s/cube/cube.exr", dir);
     static const char *const names[] = { "Y", "seen" };
@@ -286,7 +261,7 @@ TEST(cube_texture_frames)
     char text[8192];
     snprintf(text, sizeof text, cube_scene, 2, 100000, data_file("texture_cube.obj"), 1);
     ensure_write_file(dir, "frames.xml", text);
-    ENSURE(run_in(dir, "run frames.xml --out frames -q") == 0);
+    ENSURE(weathering_in(dir, "run frames.xml --out frames -q", true) == 0);
     char final_path[PATH_MAX], frame1[PATH_MAX], frame2[PATH_MAX], frame3[PATH_MAX];
     snprintf(final_path, sizeof final_path, "%s/frames/cube.exr", dir);
     snprintf(frame1, sizeof frame1, "%s/frames/cube.0001.exr", dir);
@@ -361,7 +336,7 @@ static const char *sphere_run(void)
         snprintf(text, sizeof text, sphere_scene, (int)sphere_particles,
                  data_file("uv_sphere.obj"));
         ensure_write_file(dir, "sphere.xml", text);
-        sphere_ran = run_in(dir, "run sphere.xml --out sphere -q") == 0;
+        sphere_ran = weathering_in(dir, "run sphere.xml --out sphere -q", true) == 0;
     }
     return sphere_ran ? dir : NULL;
 }
@@ -516,7 +491,7 @@ TEST(mesh_without_uvs_is_refused)
     char text[8192];
     snprintf(text, sizeof text, cube_scene, 1, 1000, data_file("bake_box.obj"), 0);
     ensure_write_file(dir, "nouv.xml", text);
-    ENSURE(run_in(dir, "run nouv.xml --out nouv -q") == 2);
+    ENSURE(weathering_in(dir, "run nouv.xml --out nouv -q", true) == 2);
     ENSURE(strstr(out, "nouv.xml:") != NULL);
     ENSURE(strstr(out, "bake_box.obj") != NULL);
     ENSURE(strstr(out, "texture coordinates") != NULL);

@@ -68,11 +68,6 @@ static bool write_variant(const char *text, const char *masks, const char *name)
     return ok;
 }
 
-static double median3(double a, double b, double c)
-{
-    return fmax(fmin(a, b), fmin(fmax(a, b), c));
-}
-
 int main(void)
 {
     const char *build = getenv("WX_BUILD") != NULL ? getenv("WX_BUILD") : "build";
@@ -115,8 +110,8 @@ int main(void)
         ao[k] = gather_seconds("ao.xml");
         sun[k] = gather_seconds("sun.xml");
     }
-    double b = median3(base[0], base[1], base[2]);
-    double a = median3(ao[0], ao[1], ao[2]) - b, s = median3(sun[0], sun[1], sun[2]) - b;
+    double b = bench_median(base, 3);
+    double a = bench_median(ao, 3) - b, s = bench_median(sun, 3) - b;
     printf("masks: the default house, 1024 x 1024 output texels, three 1024-px input cameras, "
            "2 threads (median of 3)\n");
     printf("  gather without masks %.2f s\n  accessibility, 32 rays over 2 m: %.2f s\n"

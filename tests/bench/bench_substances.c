@@ -35,11 +35,6 @@ static double steps_seconds(const char *scene)
     return s;
 }
 
-static double median3(double a, double b, double c)
-{
-    return fmax(fmin(a, b), fmin(fmax(a, b), c));
-}
-
 // `text` with every `from` replaced by `to`, written to dir/name.
 static bool write_variant(const char *text, const char *const *pairs, int n, const char *name)
 {
@@ -113,7 +108,7 @@ int main(void)
         t1[k] = steps_seconds("one.xml");
         t4[k] = steps_seconds("four.xml");
     }
-    double s1 = median3(t1[0], t1[1], t1[2]), s4 = median3(t4[0], t4[1], t4[2]);
+    double s1 = bench_median(t1, 3), s4 = bench_median(t4, 3);
     double share = s1 / s4;
     printf("substances: rusty tank, 600000 particles over 10 iterations, simulate steps "
            "(median of 3)\n");
