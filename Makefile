@@ -49,7 +49,7 @@ VIEWER_BIN := $(if $(VIEWER_SRC),$(BUILD)/weathering-viewer)
 # `weathering bake` in a child process when a scene's maps are still to bake.
 VIEWER_LIBS := -lglfw -lGL -lOpenEXRCore-3_1 -lxml2 -lpng -lm -lpthread
 
-.PHONY: all deps bench-deps test test-blender run bench clean sanitize tsan fuzz valgrind
+.PHONY: all deps bench-deps test test-blender run bench bench-build clean sanitize tsan fuzz valgrind
 all: $(BUILD)/weathering $(VIEWER_BIN)
 
 # Installs whatever Debian package is missing (apt-get update first), as root or
@@ -113,9 +113,10 @@ $(BUILD)/tests/%: $(BUILD)/obj/tests/%.o $(TEST_SUPPORT_OBJ) $(BUILD)/libweather
 	@mkdir -p $(dir $@)
 	$(CC) $(ALL_CFLAGS) -o $@ $^ $(LIBS)
 
-# A CPU renderer of a TextureMap through an orthographic camera (the header of
-# tests/tools/render_texture.c), built with the tests so that they can run it.
-$(BUILD)/tools/render_texture: tests/tools/render_texture.c $(BUILD)/libweathering.a | deps
+# Tools for people and tests (each file's header says what it does): the CPU
+# renderer of a TextureMap through an orthographic camera, built with the tests
+# so that they can run it; preview_noise, how speckled a mask preview is.
+$(BUILD)/tools/%: tests/tools/%.c $(BUILD)/libweathering.a | deps
 	@mkdir -p $(dir $@)
 	$(CC) $(filter-out -MMD -MP,$(ALL_CFLAGS)) -o $@ $^ $(LIBS)
 
@@ -135,6 +136,10 @@ test-blender: $(BUILD)/weathering
 # Like deps, for the packages only the benchmarks need.
 bench-deps:
 	$(call install_missing,$(BENCH_DEB_PACKAGES))
+
+# The benchmarks compiled but not run (a CI step: they are built against the
+# library's headers, which the tests alone would let drift).
+bench-build: $(BUILD)/weathering $(BENCH_BIN)
 
 # Each benchmark prints its own table and appends its figures to $(BENCH_CSV);
 # report.sh prints them as one table. A missed target is a MISSED row, never a

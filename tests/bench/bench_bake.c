@@ -128,9 +128,9 @@ static bool bake_rows(const char *mesh, const char *out_dir, int px, float dirt,
         snprintf(surf.material, sizeof surf.material, "*");
         surf.absorption = 0.2f;
         surf.bounce = 0.5f;
-        surf.dirt = dirt;
-        surf.deposit = 0.5f;
-        surf.erosion = 0.1f;
+        surf.initial[0] = dirt;
+        surf.deposit[0] = 0.5f;
+        surf.erosion[0] = 0.1f;
         m.surfaces = &surf;
         m.surface_count = 1;
         s.meshes = &m;
