@@ -375,6 +375,90 @@ TEST(same_bytes_for_any_thread_count)
     ENSURE(ensure_shell(out, sizeof out, "cd '%s' && cmp one/mask.exr two/mask.exr", dir) == 0);
 }
 
+// With frames (`every`), the masks that read only the geometry are computed at
+// the first frame and copied into the later ones (masks_phase.h): the unit
+// cube of tests/data/texture_cube.obj under rain, three iterations, a frame of
+// the mask and of the TextureMap after each. Exposure, Height and a Combine of
+// Height are the same in every frame and in the final files; a Combine reading
+// the dirt grows with it; and the final files are byte for byte those of the
+// same run without frames, where nothing is kept: the copy is the computation.
+static const char *frames_scene =
+    "<Weathering>\n"
+    "  <Solver><BoundingBox size=\"4\" centerY=\"1\"/>\n"
+    "    <Simulation timeStep=\"0.02\" steps=\"40\" seed=\"3\" iterations=\"3\"/></Solver>\n"
+    "  <Emitters><BoxEmitter minX=\"-0.8\" minY=\"2\" minZ=\"-0.8\" maxX=\"0.8\" maxY=\"2\" "
+    "maxZ=\"0.8\" rate=\"40000\" end=\"0.5\" speed=\"10\" dirt=\"0.01\"/></Emitters>\n"
+    "  <Collider><ProjectedMaps>\n"
+    "    <Ortho cameraName=\"top\"><View eye=\"0 5 0\" target=\"0 0 0\" up=\"0 0 -1\" "
+    "width=\"1.6\" height=\"1.6\" resolution=\"128\"/></Ortho>\n"
+    "    <Ortho cameraName=\"px\"><View eye=\"5 0.5 0\" target=\"0 0.5 0\" width=\"1.6\" "
+    "height=\"1.6\" resolution=\"128\"/></Ortho>\n"
+    "    <Ortho cameraName=\"shot\" out=\"true\"><View eye=\"5 5 5\" target=\"0 0.5 0\" "
+    "width=\"2.4\" height=\"2.4\" resolution=\"128\"/><OutputMap file=\"mask.exr\" every=\"%d\"/>"
+    "</Ortho>\n"
+    "  </ProjectedMaps></Collider>\n"
+    "  <Geometry><Mesh file=\"%s\"><Surface material=\"*\" absorption=\"1\"/>\n"
+    "    <TextureMap file=\"cube.exr\" width=\"192\" height=\"128\" every=\"%d\"/></Mesh></Geometry>\n"
+    "  <Masks><Exposure name=\"sun\" elevation=\"40\" azimuth=\"30\"/>"
+    "<Height name=\"h\" min=\"0\" max=\"1\"/>"
+    "<Combine name=\"low\"><Term mask=\"h\" weight=\"-1\"/><Term constant=\"1\"/></Combine>"
+    "<Combine name=\"wet\" scale=\"0.5\"><Term mask=\"sun\"/><Term substance=\"dirt\" "
+    "weight=\"0.001\"/></Combine></Masks>\n"
+    "</Weathering>\n";
+
+TEST(frames_copy_the_geometric_masks)
+{
+    const char *dir = ensure_tmpdir();
+    char text[8192];
+    for (int every = 0; every <= 1; ++every) {
+        snprintf(text, sizeof text, frames_scene, every, data_file("texture_cube.obj"), every);
+        char name[32], args[96];
+        snprintf(name, sizeof name, "frames%d.xml", every);
+        ensure_write_file(dir, name, text);
+        snprintf(args, sizeof args, "run %s --out f%d -q", name, every);
+        ENSURE(weathering_in(dir, args, true) == 0);
+    }
+    // The copy is the computation: the final files of both runs are the same.
+    ENSURE(ensure_shell(out, sizeof out, "cd '%s' && cmp f0/mask.exr f1/mask.exr && "
+                        "cmp f0/cube.exr f1/cube.exr", dir) == 0);
+    static const char *const files[2][3] = { { "mask.0001.exr", "mask.0002.exr", "mask.exr" },
+                                             { "cube.0001.exr", "cube.0002.exr", "cube.exr" } };
+    static const char *const geometric[3] = { "sun.Y", "h.Y", "low.Y" };
+    for (int f = 0; f < 2; ++f) {
+        char path[PATH_MAX];
+        int w = 0, h = 0, w2 = 0, h2 = 0;
+        for (int c = 0; c < 3; ++c) {
+            snprintf(path, sizeof path, "%s/f1/%s", dir, files[f][2]);
+            float *last = read_channel(path, geometric[c], &w, &h);
+            snprintf(path, sizeof path, "%s/f1/%s", dir, files[f][0]);
+            float *first = read_channel(path, geometric[c], &w2, &h2);
+            ENSURE(last != NULL && first != NULL && w == w2 && h == h2);
+            double lit = 0.0;
+            for (size_t t = 0; last != NULL && first != NULL && t < (size_t)w * (size_t)h; ++t) {
+                ENSURE(first[t] == last[t]);
+                lit += last[t];
+            }
+            ENSURE(lit > 0.0); // the mask is not trivially zero
+            free(last);
+            free(first);
+        }
+        // The Combine of the dirt grows from frame to frame.
+        double sums[3] = { 0.0, 0.0, 0.0 };
+        for (int k = 0; k < 3; ++k) {
+            snprintf(path, sizeof path, "%s/f1/%s", dir, files[f][k]);
+            float *wet = read_channel(path, "wet.Y", &w, &h);
+            ENSURE(wet != NULL);
+            for (size_t t = 0; wet != NULL && t < (size_t)w * (size_t)h; ++t) {
+                sums[k] += wet[t];
+            }
+            free(wet);
+        }
+        printf("        %s: wet sums %.1f, %.1f, %.1f over the three frames\n", files[f][2],
+               sums[0], sums[1], sums[2]);
+        ENSURE(sums[0] < sums[1] && sums[1] < sums[2]);
+    }
+}
+
 int main(void)
 {
     RUN(sigmoid_and_sun_direction);
@@ -384,5 +468,6 @@ int main(void)
     RUN(sphere_curvature_and_height);
     RUN(masks_in_a_texture);
     RUN(same_bytes_for_any_thread_count);
+    RUN(frames_copy_the_geometric_masks);
     return ensure_summary();
 }

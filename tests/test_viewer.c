@@ -867,8 +867,9 @@ TEST(masks_cycle_and_colour_the_depth_samples)
     ENSURE(zero != NULL && w.mask_context != NULL);
     for (int c = 0; c < 2; ++c) {
         ENSURE(w.maps[w.camera_maps[c]].width == 256);
-        ENSURE(wx_masks_at_camera(&w.scene, &w.opts, w.mask_context, &w.scene.cameras[c].camera,
-                                  &w.maps[w.camera_maps[c]], substances, planes, &err) == WX_OK);
+        ENSURE(wx_masks_at_camera(&w.scene, &w.opts, w.mask_context, -1,
+                                  &w.scene.cameras[c].camera, &w.maps[w.camera_maps[c]],
+                                  substances, planes, &err) == WX_OK);
         vw_range r = w.camera_points[c];
         for (int i = r.first; i < r.first + r.count; ++i) {
             for (int m = 0; m < 5; ++m) {

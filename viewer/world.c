@@ -897,7 +897,7 @@ wx_result vw_world_compute_mask(vw_world *world, int m, wx_error *err)
         if (ctx == NULL) {
             return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "masks: out of memory");
         }
-        r = wx_mask_context_init(scene, world->maps, ctx, err);
+        r = wx_mask_context_init(scene, world->maps, false, ctx, err);
         if (r != WX_OK) {
             free(ctx);
             return r;
@@ -964,8 +964,8 @@ wx_result vw_world_compute_mask(vw_world *world, int m, wx_error *err)
                                   .normal = g.normal,
                                   .valid = g.valid,
                                   .texel = g.texel };
-        r = wx_masks_at_points(copy, &world->opts, world->mask_context, &points, substances,
-                               planes, err);
+        r = wx_masks_at_points(copy, &world->opts, world->mask_context, -1, &points,
+                               substances, planes, err);
         for (int i = range.first; r == WX_OK && i < range.first + range.count; ++i) {
             ptrdiff_t q = grid_cell(world, c, &g, i);
             for (int k = 0; q >= 0 && g.valid[q] && k <= m; ++k) {

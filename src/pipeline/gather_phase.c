@@ -17,7 +17,7 @@
 #include "pipeline/texture_phase.h"
 
 static wx_result write_mask(const wx_scene *scene, const wx_run_def *opts, const wx_maps *in_maps,
-                            const wx_maps *given_out, const wx_mask_context *masks, int frame,
+                            const wx_maps *given_out, wx_mask_context *masks, int frame,
                             wx_phase_detail *detail, wx_error *err);
 
 wx_result wx_gather_scene(const wx_scene *scene, const wx_run_def *opts, wx_error *err)
@@ -29,7 +29,7 @@ wx_result wx_gather_scene(const wx_scene *scene, const wx_run_def *opts, wx_erro
     }
     wx_result result = wx_load_gather_maps(scene, opts, in_maps, err);
     if (result == WX_OK) {
-        result = wx_gather_maps(scene, opts, in_maps, NULL, NULL, NULL, err);
+        result = wx_gather_maps(scene, opts, in_maps, NULL, NULL, NULL, NULL, err);
     }
     for (int c = 0; c < input_count; ++c) {
         wx_maps_free(&in_maps[c]);
@@ -61,9 +61,9 @@ wx_result wx_gather_check(const wx_scene *scene, wx_error *err)
 
 wx_result wx_gather_maps(const wx_scene *scene, const wx_run_def *opts, const wx_maps *in_maps,
                          const wx_maps *given_out, const wx_textures *textures,
-                         wx_phase_detail *detail, wx_error *err)
+                         wx_mask_context *masks, wx_phase_detail *detail, wx_error *err)
 {
-    return wx_gather_frame(scene, opts, in_maps, given_out, textures, 0, detail, err);
+    return wx_gather_frame(scene, opts, in_maps, given_out, textures, masks, 0, detail, err);
 }
 
 void wx_gather_views_of_substance(wx_gather_view *views, const wx_maps *in_maps, int count,
@@ -94,8 +94,9 @@ bool wx_frame_wanted(const wx_scene *scene, int frame)
 }
 
 wx_result wx_gather_frame(const wx_scene *scene, const wx_run_def *opts, const wx_maps *in_maps,
-                          const wx_maps *given_out, const wx_textures *textures, int frame,
-                          wx_phase_detail *detail, wx_error *err)
+                          const wx_maps *given_out, const wx_textures *textures,
+                          wx_mask_context *given_masks, int frame, wx_phase_detail *detail,
+                          wx_error *err)
 {
     wx_phase_detail local;
     detail = detail != NULL ? detail : &local;
@@ -107,19 +108,27 @@ wx_result wx_gather_frame(const wx_scene *scene, const wx_run_def *opts, const w
                        "gather needs one",
                        scene->path);
     }
-    // The derived masks' collider, shared by the mask and every texture.
-    wx_mask_context masks;
-    wx_result r = wx_mask_context_init(scene, in_maps, &masks, err);
+    // The derived masks' collider, shared by the mask and every texture: the
+    // caller's, kept over the frames, or one for this frame.
+    wx_mask_context own;
+    wx_mask_context *masks = given_masks;
+    wx_result r = WX_OK;
+    if (masks == NULL) {
+        masks = &own;
+        r = wx_mask_context_init(scene, in_maps, false, &own, err);
+    }
     if (r == WX_OK && has_output) {
         int every = scene->cameras[scene->output_index].every;
         if (frame == 0 || (every > 0 && frame % every == 0)) {
-            r = write_mask(scene, opts, in_maps, given_out, &masks, frame, detail, err);
+            r = write_mask(scene, opts, in_maps, given_out, masks, frame, detail, err);
         }
     }
     if (r == WX_OK) {
-        r = wx_textures_write(scene, opts, textures, in_maps, &masks, frame, detail, err);
+        r = wx_textures_write(scene, opts, textures, in_maps, masks, frame, detail, err);
     }
-    wx_mask_context_free(&masks);
+    if (masks == &own) {
+        wx_mask_context_free(&own);
+    }
     return r;
 }
 
@@ -159,7 +168,7 @@ void wx_channel_preview_name(const char *mask_name, const char *channel, char *o
 
 // The mask of frame `frame` (0: the final file and its previews).
 static wx_result write_mask(const wx_scene *scene, const wx_run_def *opts, const wx_maps *in_maps,
-                            const wx_maps *given_out, const wx_mask_context *masks, int frame,
+                            const wx_maps *given_out, wx_mask_context *masks, int frame,
                             wx_phase_detail *detail, wx_error *err)
 {
     double t0 = wx_now_s();
@@ -253,7 +262,7 @@ static wx_result write_mask(const wx_scene *scene, const wx_run_def *opts, const
     }
     // The derived masks after the substances (a Combine reads them).
     if (result == WX_OK && scene->mask_count > 0) {
-        result = wx_masks_at_camera(scene, opts, masks, &out->camera, om,
+        result = wx_masks_at_camera(scene, opts, masks, WX_MASK_SLOT_OUTPUT, &out->camera, om,
                                     (const float *const *)image->channels,
                                     image->channels + substances, err);
     }

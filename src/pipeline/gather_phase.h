@@ -11,7 +11,8 @@
 #include "model/stats.h"
 #include "pipeline/pipeline.h"
 
-struct wx_textures; // pipeline/texture_phase.h
+struct wx_textures;     // pipeline/texture_phase.h
+struct wx_mask_context; // pipeline/masks_phase.h
 
 /// Checks what the gather would refuse about the scene, before any work: the
 /// output camera's second-pass radius must fit the gather's neighbourhood limit
@@ -34,19 +35,22 @@ wx_result wx_gather_scene(const wx_scene *scene, const wx_run_def *opts, wx_erro
 /// input camera in scene order: depth, normal and the dirt to gather): reads
 /// the output camera's maps (or takes `out_maps`, its depth and normal, when
 /// not NULL), computes and writes the mask and its preview, then every
-/// TextureMap of `textures` (may be NULL: none; texture_phase.h);
+/// TextureMap of `textures` (may be NULL: none; texture_phase.h). `masks` is
+/// the derived masks' context (masks_phase.h) made from the same in_maps and
+/// kept by the caller over several frames, or NULL: one is made for this call.
 /// `detail` (may be NULL) gets the read, compute and write times.
 wx_result wx_gather_maps(const wx_scene *scene, const wx_run_def *opts, const wx_maps *in_maps,
                          const wx_maps *out_maps, const struct wx_textures *textures,
-                         wx_phase_detail *detail, wx_error *err);
+                         struct wx_mask_context *masks, wx_phase_detail *detail, wx_error *err);
 
 /// wx_gather_maps for frame `frame` of an image sequence (docs/design.md
 /// section 10): frame 0 writes the final BASE.exr and its previews, frame k > 0
 /// BASE.NNNN.exr (k on four digits) without previews, for the mask when its
 /// `every` divides k and for each TextureMap whose `every` does.
 wx_result wx_gather_frame(const wx_scene *scene, const wx_run_def *opts, const wx_maps *in_maps,
-                          const wx_maps *out_maps, const struct wx_textures *textures, int frame,
-                          wx_phase_detail *detail, wx_error *err);
+                          const wx_maps *out_maps, const struct wx_textures *textures,
+                          struct wx_mask_context *masks, int frame, wx_phase_detail *detail,
+                          wx_error *err);
 
 /// Points views[0..count) (made by wx_gather_view_from_maps) at substance
 /// `substance`'s amount and baseline planes of in_maps (model/maps.h: S planes

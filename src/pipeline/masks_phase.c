@@ -5,7 +5,22 @@
 #include <stdlib.h>
 #include <string.h>
 
-wx_result wx_mask_context_init(const wx_scene *scene, const wx_maps *in_maps,
+#include "pipeline/gather_phase.h"
+
+bool wx_masks_worth_keeping(const wx_scene *scene)
+{
+    if (scene->mask_count == 0) {
+        return false;
+    }
+    for (int frame = 1; frame < scene->iterations; ++frame) {
+        if (wx_frame_wanted(scene, frame)) {
+            return true;
+        }
+    }
+    return false;
+}
+
+wx_result wx_mask_context_init(const wx_scene *scene, const wx_maps *in_maps, bool keep,
                                wx_mask_context *ctx, wx_error *err)
 {
     memset(ctx, 0, sizeof *ctx);
@@ -21,8 +36,14 @@ wx_result wx_mask_context_init(const wx_scene *scene, const wx_maps *in_maps,
         largest = texels > largest ? texels : largest;
     }
     ctx->zero_impact = calloc(2 * largest + 1, sizeof *ctx->zero_impact);
+    if (keep) {
+        ctx->mask_count = scene->mask_count;
+        ctx->slots = WX_MASK_SLOT_TEXTURE(scene->texture_count);
+        ctx->known = calloc((size_t)ctx->slots * (size_t)scene->mask_count, sizeof *ctx->known);
+    }
     wx_result r = WX_OK;
-    if (cams == NULL || maps == NULL || ctx->zero_impact == NULL) {
+    if (cams == NULL || maps == NULL || ctx->zero_impact == NULL ||
+        (keep && ctx->known == NULL)) {
         r = wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "masks: out of memory");
     }
     double ylo = INFINITY, yhi = -INFINITY;
@@ -75,29 +96,47 @@ void wx_mask_context_free(wx_mask_context *ctx)
         wx_collider_free(&ctx->collider);
     }
     free(ctx->zero_impact);
+    for (int k = 0; ctx->known != NULL && k < ctx->slots * ctx->mask_count; ++k) {
+        free(ctx->known[k]);
+    }
+    free(ctx->known);
     memset(ctx, 0, sizeof *ctx);
 }
 
-wx_result wx_masks_at_points(const wx_scene *scene, const wx_run_def *opts,
-                             const wx_mask_context *ctx, const wx_mask_points *points,
+wx_result wx_masks_at_points(const wx_scene *scene, const wx_run_def *opts, wx_mask_context *ctx,
+                             int slot, const wx_mask_points *points,
                              const float *const *substances, float *const *out, wx_error *err)
 {
+    const bool keep = ctx->known != NULL && slot >= 0 && slot < ctx->slots;
+    float **known = keep ? ctx->known + (size_t)slot * (size_t)scene->mask_count : NULL;
     wx_masks_def def = { .scene = scene,
                          .collider = ctx->ready ? &ctx->collider : NULL,
                          .points = *points,
                          .substances = substances,
                          .height_min = ctx->height_min,
                          .height_max = ctx->height_max,
+                         .known = (const float *const *)known,
                          .seed = opts->seed,
                          .threads = opts->threads,
                          .quiet = opts->quiet };
-    return wx_masks_compute(&def, out, err);
+    wx_result r = wx_masks_compute(&def, out, err);
+    // The geometric masks computed now are kept for the next frames (a copy
+    // that fails for want of memory only means computing them again).
+    const size_t texels = (size_t)points->width * (size_t)points->height;
+    for (int m = 0; r == WX_OK && keep && m < scene->mask_count; ++m) {
+        if (known[m] == NULL && wx_mask_is_geometric(scene, m)) {
+            known[m] = malloc(texels * sizeof *known[m] + 1);
+            if (known[m] != NULL) {
+                memcpy(known[m], out[m], texels * sizeof *known[m]);
+            }
+        }
+    }
+    return r;
 }
 
-wx_result wx_masks_at_camera(const wx_scene *scene, const wx_run_def *opts,
-                             const wx_mask_context *ctx, const wx_camera *camera,
-                             const wx_maps *maps, const float *const *substances,
-                             float *const *out, wx_error *err)
+wx_result wx_masks_at_camera(const wx_scene *scene, const wx_run_def *opts, wx_mask_context *ctx,
+                             int slot, const wx_camera *camera, const wx_maps *maps,
+                             const float *const *substances, float *const *out, wx_error *err)
 {
     const int W = maps->width, H = maps->height;
     const size_t texels = (size_t)W * (size_t)H;
@@ -130,7 +169,7 @@ wx_result wx_masks_at_camera(const wx_scene *scene, const wx_run_def *opts,
                               .normal = maps->normal,
                               .valid = valid,
                               .texel = frame_w / (float)W };
-    wx_result r = wx_masks_at_points(scene, opts, ctx, &points, substances, out, err);
+    wx_result r = wx_masks_at_points(scene, opts, ctx, slot, &points, substances, out, err);
     free(position);
     free(valid);
     return r;

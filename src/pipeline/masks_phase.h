@@ -15,35 +15,53 @@
 #include "sim/collider.h"
 #include "sim/masks.h"
 
-/// What every target of one frame shares: the collider over the input cameras
-/// and Height's default range.
+/// What every target shares, in one frame or over every frame of a run: the
+/// collider over the input cameras, Height's default range, and the masks that
+/// depend on the geometry alone as the first frame computed them.
 typedef struct wx_mask_context {
     bool ready;
     wx_collider collider;
     float *zero_impact; ///< the collider's impact planes (unused here), zeros
     float height_min, height_max;
+    /// When kept (the run gathers several frames): known[slot * mask_count + m],
+    /// geometric mask m (wx_mask_is_geometric) at the points of target `slot`
+    /// (WX_MASK_SLOT_OUTPUT, WX_MASK_SLOT_TEXTURE(t)) once computed, else NULL.
+    float **known;
+    int slots, mask_count;
 } wx_mask_context;
+
+/// The targets a context keeps masks for: the output camera, TextureMap t.
+#define WX_MASK_SLOT_OUTPUT 0
+#define WX_MASK_SLOT_TEXTURE(t) (1 + (t))
 
 /// Builds the context from the input cameras' maps (depth and normal), when the
 /// scene has masks (else leaves it not ready). Height's default range is the
 /// geometry's bounds when the run imported it (scene->has_bounds), else the y
-/// range of the surfaces the input cameras record.
-wx_result wx_mask_context_init(const wx_scene *scene, const wx_maps *in_maps,
+/// range of the surfaces the input cameras record. With `keep`, the context
+/// keeps the geometric masks of each target after their first computation and
+/// copies them in later frames (same values: they read only the depth and
+/// normal maps, which a simulation leaves alone); the maps must outlive it.
+wx_result wx_mask_context_init(const wx_scene *scene, const wx_maps *in_maps, bool keep,
                                wx_mask_context *ctx, wx_error *err);
+
+/// Whether a run of `scene` gathers more than its final frame (an `every` of the
+/// mask or of a TextureMap that some iteration before the last meets): a
+/// context kept over the frames saves the geometric masks' rays.
+bool wx_masks_worth_keeping(const wx_scene *scene);
 
 void wx_mask_context_free(wx_mask_context *ctx);
 
-/// The masks at a grid of points (sim/masks.h), `substances` their values of
-/// the scene's substances: out[m] per mask.
-wx_result wx_masks_at_points(const wx_scene *scene, const wx_run_def *opts,
-                             const wx_mask_context *ctx, const wx_mask_points *points,
+/// The masks at a grid of points (sim/masks.h), the points of target `slot`
+/// (-1, or a context that keeps nothing: none kept), `substances` their values
+/// of the scene's substances: out[m] per mask.
+wx_result wx_masks_at_points(const wx_scene *scene, const wx_run_def *opts, wx_mask_context *ctx,
+                             int slot, const wx_mask_points *points,
                              const float *const *substances, float *const *out, wx_error *err);
 
 /// The masks at the texels of a camera's depth and normal maps (the output
-/// camera's: the mask's surface points).
-wx_result wx_masks_at_camera(const wx_scene *scene, const wx_run_def *opts,
-                             const wx_mask_context *ctx, const wx_camera *camera,
-                             const wx_maps *maps, const float *const *substances,
-                             float *const *out, wx_error *err);
+/// camera's, slot WX_MASK_SLOT_OUTPUT: the mask's surface points).
+wx_result wx_masks_at_camera(const wx_scene *scene, const wx_run_def *opts, wx_mask_context *ctx,
+                             int slot, const wx_camera *camera, const wx_maps *maps,
+                             const float *const *substances, float *const *out, wx_error *err);
 
 #endif

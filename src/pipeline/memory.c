@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include "model/maps.h"
+#include "pipeline/masks_phase.h"
 #include "pipeline/outputs.h"
 #include "pipeline/texture_phase.h"
 #include "sim/emitter.h"
@@ -123,6 +124,19 @@ void wx_memory_estimate(const wx_scene *scene, unsigned phases, wx_memory_need *
         if (texture_frames) {
             need->frame_bytes = fmax(need->frame_bytes, planes * input_texels) +
                                 need->texture_write_bytes;
+        }
+        // With frames, the derived masks' collider lives through the simulation,
+        // with a plane per geometric mask at every target (masks_phase.h).
+        if (need->frame_bytes > 0.0 && wx_masks_worth_keeping(scene)) {
+            double targets = out != NULL ? output_texels : 0.0;
+            for (int t = 0; textures && t < scene->texture_count; ++t) {
+                targets += (double)scene->textures[t].width * (double)scene->textures[t].height;
+            }
+            int geometric = 0;
+            for (int m = 0; m < scene->mask_count; ++m) {
+                geometric += wx_mask_is_geometric(scene, m);
+            }
+            need->frame_bytes += collider + WX_PLANE_BYTES_PER_TEXEL * geometric * targets;
         }
         // Without frames, a run that bakes keeps the output camera's depth and
         // normal through the simulation for its gather.

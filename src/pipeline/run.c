@@ -12,6 +12,7 @@
 #include "pipeline/bake_phase.h"
 #include "pipeline/gather_phase.h"
 #include "pipeline/load.h"
+#include "pipeline/masks_phase.h"
 #include "pipeline/memory.h"
 #include "pipeline/outputs.h"
 #include "pipeline/simulate_phase.h"
@@ -47,6 +48,8 @@ wx_result wx_run_phases(wx_scene *scene, const wx_run_def *opts, unsigned phases
     wx_geometry geometry;
     memset(&geometry, 0, sizeof geometry);
     wx_maps *maps = NULL;
+    wx_mask_context masks;
+    memset(&masks, 0, sizeof masks);
     wx_maps output_maps;
     memset(&output_maps, 0, sizeof output_maps);
     char created[WX_PATH_MAX] = "";
@@ -119,10 +122,15 @@ wx_result wx_run_phases(wx_scene *scene, const wx_run_def *opts, unsigned phases
         r = maps != NULL ? wx_load_simulation_maps(scene, opts->threads, maps, err)
                          : wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (maps)");
         double t1 = wx_now_s();
+        // A run that gathers frames keeps the derived masks' context over
+        // them and the final gather: the geometric masks are computed once.
+        if (r == WX_OK && (phases & WX_PHASE_GATHER) && wx_masks_worth_keeping(scene)) {
+            r = wx_mask_context_init(scene, maps, true, &masks, err);
+        }
         if (r == WX_OK) {
             r = wx_simulate_maps(scene, opts, maps,
                                  output_maps.depth != NULL ? &output_maps : NULL, &textures,
-                                 &report->stats,
+                                 masks.ready ? &masks : NULL, &report->stats,
                                  &report->times.simulate_detail, err);
         }
         report->times.simulate_detail.read = t1 - t0;
@@ -149,7 +157,8 @@ wx_result wx_run_phases(wx_scene *scene, const wx_run_def *opts, unsigned phases
         double t0 = wx_now_s();
         if (maps != NULL) {
             r = wx_gather_maps(scene, opts, maps, output_maps.depth != NULL ? &output_maps : NULL,
-                               &textures, &report->times.gather_detail, err);
+                               &textures, masks.ready ? &masks : NULL,
+                               &report->times.gather_detail, err);
         } else {
             wx_maps *in = calloc((size_t)scene->input_count + 1, sizeof *in);
             r = in != NULL ? wx_load_gather_maps(scene, opts, in, err)
@@ -158,13 +167,14 @@ wx_result wx_run_phases(wx_scene *scene, const wx_run_def *opts, unsigned phases
             if (r == WX_OK) {
                 r = wx_gather_maps(scene, opts, in,
                                    output_maps.depth != NULL ? &output_maps : NULL, &textures,
-                                   &report->times.gather_detail, err);
+                                   NULL, &report->times.gather_detail, err);
             }
             report->times.gather_detail.read += t1 - t0;
             free_maps(in, scene->input_count);
         }
         report->times.gather = wx_now_s() - t0;
     }
+    wx_mask_context_free(&masks); // before the maps it borrows
     free_maps(maps, scene->input_count);
     wx_maps_free(&output_maps);
     wx_textures_free(&textures);

@@ -11,6 +11,7 @@
 #include "io/maps_file.h"
 #include "pipeline/gather_phase.h"
 #include "pipeline/load.h"
+#include "pipeline/masks_phase.h"
 #include "pipeline/outputs.h"
 #include "pipeline/texture_phase.h"
 
@@ -134,7 +135,8 @@ static wx_result write_one(const wx_scene *scene, const wx_run_def *opts, const 
 // the input maps' depth and normal borrowed, the dirt planes made for it.
 static wx_result write_frame(const wx_scene *scene, const wx_run_def *opts, const wx_sim *sim,
                              const wx_maps *maps, const wx_maps *out_maps,
-                             const wx_textures *textures, int frame, wx_error *err)
+                             const wx_textures *textures, wx_mask_context *masks, int frame,
+                             wx_error *err)
 {
     int n = wx_sim_input_count(sim);
     wx_maps *view = calloc((size_t)n + 1, sizeof *view);
@@ -152,7 +154,7 @@ static wx_result write_frame(const wx_scene *scene, const wx_run_def *opts, cons
                           err);
     }
     if (r == WX_OK) {
-        r = wx_gather_frame(scene, opts, view, out_maps, textures, frame, NULL, err);
+        r = wx_gather_frame(scene, opts, view, out_maps, textures, masks, frame, NULL, err);
     }
     for (int c = 0; c < n; ++c) {
         free(view[c].dirt);
@@ -185,7 +187,7 @@ wx_result wx_write_dirt_maps(const wx_scene *scene, const wx_run_def *opts, cons
 
 wx_result wx_simulate_maps(const wx_scene *scene, const wx_run_def *opts, wx_maps *maps,
                            const wx_maps *out_maps, const wx_textures *textures,
-                           wx_sim_stats *stats, wx_phase_detail *detail, wx_error *err)
+                           wx_mask_context *masks, wx_sim_stats *stats, wx_phase_detail *detail, wx_error *err)
 {
     wx_phase_detail local;
     detail = detail != NULL ? detail : &local;
@@ -228,7 +230,7 @@ wx_result wx_simulate_maps(const wx_scene *scene, const wx_run_def *opts, wx_map
         if (r == WX_OK && (s + 1) % scene->steps == 0 && done > 0 &&
             wx_frame_wanted(scene, (int)done)) {
             double f0 = wx_now_s();
-            r = write_frame(scene, opts, sim, maps, out_maps, textures, (int)done, err);
+            r = write_frame(scene, opts, sim, maps, out_maps, textures, masks, (int)done, err);
             frames_s += wx_now_s() - f0;
         }
     }
@@ -277,7 +279,7 @@ wx_result wx_simulate_scene(const wx_scene *scene, const wx_run_def *opts,
     }
     wx_result r = wx_load_simulation_maps(scene, opts->threads, maps, err);
     if (r == WX_OK) {
-        r = wx_simulate_maps(scene, opts, maps, NULL, NULL, stats, NULL, err);
+        r = wx_simulate_maps(scene, opts, maps, NULL, NULL, NULL, stats, NULL, err);
     }
     for (int c = 0; c < scene->input_count; ++c) {
         wx_maps_free(&maps[c]);

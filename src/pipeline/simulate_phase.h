@@ -11,7 +11,8 @@
 #include "pipeline/pipeline.h"
 #include "sim/simulate.h"
 
-struct wx_textures; // pipeline/texture_phase.h
+struct wx_textures;     // pipeline/texture_phase.h
+struct wx_mask_context; // pipeline/masks_phase.h
 
 /// Writes <camera>_dirt.exr for every input camera into the output folder: R
 /// the simulated dirt, G deposit and B erosion as in the input dirt map (the
@@ -25,12 +26,13 @@ wx_result wx_write_dirt_maps(const wx_scene *scene, const wx_run_def *opts, cons
 /// order, as wx_load_simulation_maps reads them): runs scene->steps steps,
 /// writes opts->out_dir/<camera>_dirt.exr for each input camera, fills
 /// Frames of image sequences (`every`) write the mask and the TextureMaps of
-/// `textures` (may be NULL). `stats` and the setup, compute and write times of `detail` (may be NULL),
+/// `textures` (may be NULL), with the derived masks' context `masks` kept over
+/// the frames (may be NULL: one per frame; gather_phase.h). `stats` and the setup, compute and write times of `detail` (may be NULL),
 /// and leaves in each maps[c].dirt the simulated dirt as written
 /// (impact, deposit and erosion released): what the gather reads next.
 wx_result wx_simulate_maps(const wx_scene *scene, const wx_run_def *opts, wx_maps *maps,
                            const wx_maps *out_maps, const struct wx_textures *textures,
-                           wx_sim_stats *stats, wx_phase_detail *detail, wx_error *err);
+                           struct wx_mask_context *masks, wx_sim_stats *stats, wx_phase_detail *detail, wx_error *err);
 
 /// The `simulate` phase: loads every input camera's maps from the scene's
 /// paths, runs scene->steps steps (progress bar unless opts->quiet), writes

@@ -221,7 +221,7 @@ static void free_planes(camera_planes *cache, int count, int planes)
 // after the substances'), at the surface points the sampling made
 // (position, normal), the substances' sampled values for the Combines.
 static wx_result texture_masks(const wx_scene *scene, const wx_run_def *opts,
-                               const wx_mask_context *masks, const wx_texture_target *t,
+                               wx_mask_context *masks, int slot, const wx_texture_target *t,
                                wx_image *image, const double *position, const float *normal,
                                wx_error *err)
 {
@@ -242,7 +242,7 @@ static wx_result texture_masks(const wx_scene *scene, const wx_run_def *opts,
                               .valid = valid,
                               .texel = t->texel };
     const int S = image->channel_count - 1 - scene->mask_count;
-    wx_result r = wx_masks_at_points(scene, opts, masks, &points,
+    wx_result r = wx_masks_at_points(scene, opts, masks, slot, &points,
                                      (const float *const *)image->channels, image->channels + S,
                                      err);
     free(valid);
@@ -253,7 +253,7 @@ static wx_result texture_masks(const wx_scene *scene, const wx_run_def *opts,
 // its previews (frame 0).
 static wx_result write_texture(const wx_scene *scene, const wx_run_def *opts,
                                const wx_texture_target *t, const wx_gather_view *views,
-                               float *const *planes, const wx_mask_context *masks, int frame,
+                               float *const *planes, wx_mask_context *masks, int slot, int frame,
                                char names[][WX_NAME_MAX], int channels, wx_phase_detail *detail,
                                wx_error *err)
 {
@@ -300,7 +300,7 @@ static wx_result write_texture(const wx_scene *scene, const wx_run_def *opts,
     // The derived masks at the texels whose point is seen, then the padding of
     // every channel.
     if (r == WX_OK && scene->mask_count > 0) {
-        r = texture_masks(scene, opts, masks, t, image, position, normal, err);
+        r = texture_masks(scene, opts, masks, slot, t, image, position, normal, err);
     }
     free(position);
     free(normal);
@@ -352,7 +352,7 @@ static wx_result write_texture(const wx_scene *scene, const wx_run_def *opts,
 
 wx_result wx_textures_write(const wx_scene *scene, const wx_run_def *opts,
                             const wx_textures *textures, const wx_maps *in_maps,
-                            const wx_mask_context *masks, int frame, wx_phase_detail *detail,
+                            wx_mask_context *masks, int frame, wx_phase_detail *detail,
                             wx_error *err)
 {
     if (textures == NULL || textures->count == 0) {
@@ -401,8 +401,8 @@ wx_result wx_textures_write(const wx_scene *scene, const wx_run_def *opts,
             }
         }
         if (r == WX_OK) {
-            r = write_texture(scene, opts, t, views, cache[slot].planes, masks, frame, names,
-                              channels, detail, err);
+            r = write_texture(scene, opts, t, views, cache[slot].planes, masks,
+                              WX_MASK_SLOT_TEXTURE(i), frame, names, channels, detail, err);
         }
         if (r != WX_OK) {
             wx_error_prefix(err, "texture %s", t->def->file);

@@ -47,12 +47,13 @@ bool wx_texture_writes_frame(const wx_texture_map *t, int frame);
 
 /// Writes the textures of frame `frame` from the input cameras' maps in memory
 /// (in_maps: one per input camera in scene order, depth, normal and the dirt
-/// planes a gather reads; `masks` the frame's derived-mask context): frame 0 every texture's BASE.exr and previews,
-/// frame k > 0 BASE.NNNN.exr for those whose `every` divides k. `detail` (may be
-/// NULL) gets the compute and write times added.
+/// planes a gather reads; `masks` the derived masks' context, texture t's
+/// points in its slot WX_MASK_SLOT_TEXTURE(t)): frame 0 every texture's
+/// BASE.exr and previews, frame k > 0 BASE.NNNN.exr for those whose `every`
+/// divides k. `detail` (may be NULL) gets the compute and write times added.
 wx_result wx_textures_write(const wx_scene *scene, const wx_run_def *opts,
                             const wx_textures *textures, const wx_maps *in_maps,
-                            const wx_mask_context *masks, int frame, wx_phase_detail *detail,
+                            wx_mask_context *masks, int frame, wx_phase_detail *detail,
                             wx_error *err);
 
 /// The texture's channels: the mask's (section 10) and `seen`. Returns the count.

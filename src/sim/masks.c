@@ -375,9 +375,15 @@ wx_result wx_masks_compute(const wx_masks_def *def, float *const *out, wx_error 
     wx_progress_begin(&progress, "masks", (int64_t)scene->mask_count * def->points.height,
                       def->quiet);
     jb.progress = &progress;
+    const wx_mask_points *g = &def->points;
     for (int m = 0; m < scene->mask_count; ++m) {
         const wx_mask_def *md = &scene->masks[m];
         jb.mask = m;
+        if (def->known != NULL && def->known[m] != NULL) {
+            memcpy(out[m], def->known[m], (size_t)g->width * (size_t)g->height * sizeof *out[m]);
+            wx_progress_update(&progress, (int64_t)(m + 1) * g->height);
+            continue;
+        }
         if (md->kind == WX_MASK_EXPOSURE) {
             // The main sun, and the two side suns at azimuth +- spread.
             wx_sun_direction(md->elevation, md->azimuth, jb.suns[0]);
@@ -392,9 +398,24 @@ wx_result wx_masks_compute(const wx_masks_def *def, float *const *out, wx_error 
             }
         }
         // Rays cost far more than the rest: rows in small work items.
-        wx_parallel_for(def->threads, def->points.height, wx_mask_rays(md) > 0 ? 1 : 16,
-                        mask_rows, &jb);
+        wx_parallel_for(def->threads, g->height, wx_mask_rays(md) > 0 ? 1 : 16, mask_rows, &jb);
     }
     wx_progress_end(&progress);
     return WX_OK;
+}
+
+bool wx_mask_is_geometric(const wx_scene *scene, int m)
+{
+    const wx_mask_def *md = &scene->masks[m];
+    if (md->kind != WX_MASK_COMBINE) {
+        return true;
+    }
+    for (int k = 0; k < md->term_count; ++k) {
+        const wx_term *term = &md->terms[k];
+        if (term->kind == WX_TERM_SUBSTANCE ||
+            (term->kind == WX_TERM_MASK && !wx_mask_is_geometric(scene, term->index))) {
+            return false;
+        }
+    }
+    return true;
 }

@@ -42,6 +42,11 @@ typedef struct wx_masks_def {
     /// substance of the scene: what a Combine's substance terms read.
     const float *const *substances;
     float height_min, height_max; ///< Height's range where a mask does not give it
+    /// Optional (NULL: every mask computed): known[m], when not NULL, holds mask
+    /// m's values at these very points (an earlier frame's, for a mask
+    /// wx_mask_is_geometric says depends on the geometry alone); they are
+    /// copied instead of computed.
+    const float *const *known;
     uint64_t seed;
     int threads;
     bool quiet; ///< no progress bar
@@ -50,6 +55,11 @@ typedef struct wx_masks_def {
 /// Fills out[m] (width*height floats) for every mask m of the scene, in order
 /// (a Combine reads the masks before it). WX_FAIL when out of memory.
 wx_result wx_masks_compute(const wx_masks_def *def, float *const *out, wx_error *err);
+
+/// Whether mask m depends on the geometry alone (every kind but a Combine; a
+/// Combine when none of its terms, through the masks it names, reads a
+/// substance): its values at a set of points are the same in every frame.
+bool wx_mask_is_geometric(const wx_scene *scene, int m);
 
 /// Riihiaho's sigmoid (his eq. 3.7): (x - o) / (2 sqrt(1/s + (x - o)^2)) + 1/2
 /// for steepness s > 0; x itself for s = 0.
