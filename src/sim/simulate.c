@@ -38,6 +38,7 @@ enum {
     DEFAULT_HIT_CAPACITY = 4096,
     PSEUDO_EMITTER = 0xFFFF, ///< emitter index of particles added by wx_sim_spawn
     DEFAULT_CHUNK = 8192,    ///< particles a thread takes at a time (a multiple of the block)
+    CHUNKS_PER_THREAD = 4,   ///< the fewest chunks a thread gets while the particles allow
 };
 
 // Event flags: the impact kind in the low bits.
@@ -138,7 +139,8 @@ struct wx_sim {
     int thread_count;
     sim_worker *workers;
     sim_chunk *chunks;
-    int64_t chunk_particles;             ///< particles per chunk
+    int64_t chunk_particles;             ///< particles per chunk in this step
+    int64_t chunk_limit;                 ///< the most particles a chunk takes
     int64_t chunk_count, chunk_capacity; ///< chunks of this step, allocated
     int64_t applied;                     ///< chunks whose events are applied
     wx_pool *pool; ///< the threads (core/parallel.h)
@@ -531,6 +533,18 @@ static void step_chunks(int64_t begin, int64_t end, int worker, void *context)
 // allocated.
 static wx_result prepare_chunks(wx_sim *sim, wx_error *err)
 {
+    // A small population (an emitter's first steps) goes in smaller chunks, at
+    // least CHUNKS_PER_THREAD a thread, so that no thread waits for one long
+    // chunk: whole blocks, at most the configured size. Results do not depend
+    // on the chunk size (the events are applied in particle order).
+    int64_t size = sim->chunk_limit;
+    if (sim->thread_count > 1) {
+        int64_t parts = (int64_t)sim->thread_count * CHUNKS_PER_THREAD;
+        int64_t share = (sim->particles.count + parts - 1) / parts;
+        share = (share + WX_PARTICLE_BLOCK - 1) / WX_PARTICLE_BLOCK * WX_PARTICLE_BLOCK;
+        size = share < WX_PARTICLE_BLOCK ? WX_PARTICLE_BLOCK : share < size ? share : size;
+    }
+    sim->chunk_particles = size;
     int64_t count = (sim->particles.count + sim->chunk_particles - 1) / sim->chunk_particles;
     if (count > sim->chunk_capacity) {
         int64_t capacity = count + count / 2;
@@ -908,7 +922,8 @@ wx_result wx_sim_create(const wx_scene *scene, const wx_sim_def *config, wx_sim 
     sim->thread_count = config->threads > 0 ? config->threads : wx_cpu_count();
     sim->hit_capacity = config->hit_capacity > 0 ? config->hit_capacity : DEFAULT_HIT_CAPACITY;
     int64_t chunk = config->chunk_particles > 0 ? config->chunk_particles : DEFAULT_CHUNK;
-    sim->chunk_particles = (chunk + WX_PARTICLE_BLOCK - 1) / WX_PARTICLE_BLOCK * WX_PARTICLE_BLOCK;
+    sim->chunk_limit = (chunk + WX_PARTICLE_BLOCK - 1) / WX_PARTICLE_BLOCK * WX_PARTICLE_BLOCK;
+    sim->chunk_particles = sim->chunk_limit;
 
     wx_result r = WX_OK;
     if (!(sim->dt > 0.0) || !isfinite(sim->dt)) {
