@@ -346,6 +346,79 @@ TEST(the_ledger_balances_on_every_shipped_scene)
     ENSURE(scenes >= 6);
 }
 
+// A scene of over a thousand <Surface>s (a city's materials): the bake and the
+// ageing look each texel's surface up by its global index with no cap. The
+// plane's two materials are the last two of 1100 surfaces (the others match
+// no material); iron grows 2 and stone 5 of moss per square metre per
+// iteration and stone starts with 3 of water per square metre, so after three
+// iterations, with no particle, moss is exactly 6 and 15 and water 0 and 3.
+TEST(surfaces_beyond_a_thousand_keep_their_rules)
+{
+    char dir[4200];
+    snprintf(dir, sizeof dir, "%s/many_surfaces", ensure_tmpdir());
+    mkdir(dir, 0777);
+    ensure_write_file(dir, "plane.obj", PLANE_OBJ);
+    ensure_write_file(dir, "plane.mtl", PLANE_MTL);
+    enum { SURFACES = 1100 };
+    size_t cap = 200000, n = 0;
+    char *xml = malloc(cap);
+    ENSURE(xml != NULL);
+    if (xml == NULL) {
+        return;
+    }
+    n += (size_t)snprintf(xml + n, cap - n,
+                          "<Weathering>\n"
+                          "  <Substances><Substance name=\"water\"/><Substance name=\"moss\"/>"
+                          "</Substances>\n"
+                          "  <Solver><Simulation timeStep=\"0.01\" steps=\"10\" iterations=\"3\"/>"
+                          "<BoundingBox size=\"8\"/></Solver>\n"
+                          "  <Collider><ProjectedMaps>\n"
+                          "    <Ortho cameraName=\"top\"><View eye=\"0 3 0\" target=\"0 0 0\" "
+                          "up=\"0 0 -1\" width=\"2.4\" height=\"2.4\" resolution=\"64\"/></Ortho>\n"
+                          "    <Ortho cameraName=\"shot\" out=\"true\"><View eye=\"0 3 0\" "
+                          "target=\"0 0 0\" up=\"0 0 -1\" width=\"2.4\" height=\"2.4\" "
+                          "resolution=\"64\"/><OutputMap file=\"mask.exr\" radius=\"0\"/></Ortho>\n"
+                          "  </ProjectedMaps></Collider>\n"
+                          "  <Geometry><Mesh file=\"plane.obj\">\n");
+    for (int k = 0; k < SURFACES - 2; ++k) {
+        n += (size_t)snprintf(xml + n, cap - n, "    <Surface material=\"unused%d\"/>\n", k);
+    }
+    n += (size_t)snprintf(xml + n, cap - n,
+                          "    <Surface material=\"iron\"><Grow substance=\"moss\" amount=\"2\"/>"
+                          "</Surface>\n"
+                          "    <Surface material=\"stone\"><Exchange substance=\"water\" "
+                          "initial=\"3\"/><Grow substance=\"moss\" amount=\"5\"/></Surface>\n"
+                          "  </Mesh></Geometry>\n"
+                          "</Weathering>\n");
+    ensure_write_file(dir, "scene.xml", xml);
+    free(xml);
+    char log[8192];
+    int status = ensure_shell(log, sizeof log, "'%s/weathering' run '%s/scene.xml' --out '%s/out' -q",
+                              ensure_build_dir(), dir, dir);
+    if (status != 0) {
+        fprintf(stderr, "        weathering run: status %d\n%s\n", status, log);
+    }
+    ENSURE(status == 0);
+    char path[4400];
+    snprintf(path, sizeof path, "%s/out/mask.exr", dir);
+    static const char *const channels[2] = { "water.Y", "moss.Y" };
+    wx_image *img = calloc(1, sizeof *img);
+    wx_error err;
+    ENSURE(img != NULL && wx_exr_read(path, channels, 2, img, &err) == WX_OK);
+    if (img != NULL && img->channels[0] != NULL) {
+        double iron_water = half_mean(img, 0, -1), stone_water = half_mean(img, 0, 1);
+        double iron_moss = half_mean(img, 1, -1), stone_moss = half_mean(img, 1, 1);
+        printf("        iron: water %g, moss %g; stone: water %g, moss %g\n", iron_water,
+               iron_moss, stone_water, stone_moss);
+        ENSURE_NEAR(iron_water, 0.0, 1e-6);
+        ENSURE_NEAR(stone_water, 3.0, 1e-4);
+        ENSURE_NEAR(iron_moss, 6.0, 1e-4);
+        ENSURE_NEAR(stone_moss, 15.0, 1e-4);
+        wx_image_free(img);
+    }
+    free(img);
+}
+
 int main(void)
 {
     RUN(water_and_rust_follow_the_recurrence_in_every_frame);
@@ -354,5 +427,6 @@ int main(void)
     RUN(the_ledger_balances_for_every_substance);
     RUN(several_substances_give_the_same_bytes_for_any_thread_count);
     RUN(the_ledger_balances_on_every_shipped_scene);
+    RUN(surfaces_beyond_a_thousand_keep_their_rules);
     return ensure_summary();
 }

@@ -108,6 +108,17 @@ int wx_scene_surface_count(const wx_scene *scene)
     return wx_scene_surface_base(scene, scene->mesh_count);
 }
 
+const wx_surface **wx_scene_surfaces_by_index(const wx_scene *scene)
+{
+    const wx_surface **table = malloc(((size_t)wx_scene_surface_count(scene) + 1) * sizeof *table);
+    for (int m = 0, g = 0; table != NULL && m < scene->mesh_count; ++m) {
+        for (int k = 0; k < scene->meshes[m].surface_count; ++k) {
+            table[g++] = &scene->meshes[m].surfaces[k];
+        }
+    }
+    return table;
+}
+
 void wx_scene_free(wx_scene *scene)
 {
     if (scene == NULL) {

@@ -319,6 +319,11 @@ bool wx_scene_has_grow(const wx_scene *scene);
 int wx_scene_surface_count(const wx_scene *scene);
 int wx_scene_surface_base(const wx_scene *scene, int mesh);
 
+/// Every <Surface> by its global index: a malloc'd array of
+/// wx_scene_surface_count(scene) pointers into the scene (the bake stores index
+/// + 1 in a map's `surface` channel), or NULL when out of memory.
+const wx_surface **wx_scene_surfaces_by_index(const wx_scene *scene);
+
 /// Frees everything the scene owns; the struct is zeroed.
 void wx_scene_free(wx_scene *scene);
 

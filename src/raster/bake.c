@@ -821,16 +821,14 @@ static int channel_index(const wx_image *image, const char *name)
 // The substances the renderer does not carry, from each texel's <Surface>
 // (surface index + 1 in `surface`): their initial density (turned into amounts
 // with the rendered one), deposit and erosion.
-static void fill_substances(const wx_scene *scene, const float *surface, wx_image *dirt,
-                            size_t texels)
+static wx_result fill_substances(const wx_scene *scene, const float *surface, wx_image *dirt,
+                                 size_t texels, wx_error *err)
 {
-    const wx_surface *by_index[1024];
-    int known = 0;
-    for (int m = 0; m < scene->mesh_count; ++m) {
-        for (int k = 0; k < scene->meshes[m].surface_count && known < 1024; ++k) {
-            by_index[known++] = &scene->meshes[m].surfaces[k];
-        }
+    const wx_surface **by_index = wx_scene_surfaces_by_index(scene);
+    if (by_index == NULL) {
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "bake: out of memory (surfaces)");
     }
+    const int known = wx_scene_surface_count(scene);
     int rendered = rendered_substance(scene);
     for (int s = 0; s < scene->substance_count; ++s) {
         if (s == rendered) {
@@ -846,6 +844,8 @@ static void fill_substances(const wx_scene *scene, const float *surface, wx_imag
             erosion[t] = sf != NULL ? sf->erosion[s] : 0.0f;
         }
     }
+    free(by_index);
+    return WX_OK;
 }
 
 // ---------------------------------------------------------------------------
@@ -933,14 +933,17 @@ static wx_result bake_camera(baker *b, int c, wx_error *err)
     if (r == WX_OK && input) {
         size_t texels = (size_t)sc->camera.width * (size_t)sc->camera.height;
         if (S > 1) {
-            fill_substances(scene, surface, &maps[3], texels);
+            r = fill_substances(scene, surface, &maps[3], texels, err);
         }
         float *planes[WX_MAX_SUBSTANCES];
         for (int s = 0; s < S; ++s) {
             planes[s] = maps[3].channels[3 * s];
         }
-        r = compute_initial_dirt(b, c, maps[0].channels[0], &maps[1], planes, S,
-                                 area_channel >= 0 ? maps[3].channels[area_channel] : NULL, err);
+        if (r == WX_OK) {
+            r = compute_initial_dirt(b, c, maps[0].channels[0], &maps[1], planes, S,
+                                     area_channel >= 0 ? maps[3].channels[area_channel] : NULL,
+                                     err);
+        }
     }
     if (surface_channel < 0) {
         free(surface);

@@ -124,6 +124,7 @@ struct wx_sim {
     double **baseline;
     float **grow_area;
     const float **surface_of; ///< the maps' surface planes (NULL entries: none)
+    const wx_surface **surfaces; ///< the scene's <Surface>s by global index (the rules')
     int64_t iterations_done;
     int camera_order[WX_MAX_INPUT_CAMERAS]; ///< coarse test order (speed only)
     /// Texel numbering for the particles' last slide: input camera c's texel t
@@ -752,16 +753,8 @@ static void age(wx_sim *sim)
         return;
     }
     // Surface rules by global surface index.
-    const wx_surface *by_index[1024];
-    int surface_total = wx_scene_surface_count(scene);
-    int known = surface_total < 1024 ? surface_total : 1024;
-    for (int m = 0, g = 0; m < scene->mesh_count; ++m) {
-        for (int k = 0; k < scene->meshes[m].surface_count; ++k, ++g) {
-            if (g < known) {
-                by_index[g] = &scene->meshes[m].surfaces[k];
-            }
-        }
-    }
+    const wx_surface **by_index = sim->surfaces;
+    const int known = wx_scene_surface_count(scene);
     int S = sim->substances;
     for (int c = 0; c < sim->input_count; ++c) {
         wx_dirt_map *map = &sim->dirt[c];
@@ -963,8 +956,9 @@ wx_result wx_sim_create(const wx_scene *scene, const wx_sim_def *config, wx_sim 
         sim->baseline = calloc((size_t)(sim->input_count + 1), sizeof *sim->baseline);
         sim->grow_area = calloc((size_t)(sim->input_count + 1), sizeof *sim->grow_area);
         sim->surface_of = calloc((size_t)(sim->input_count + 1), sizeof *sim->surface_of);
+        sim->surfaces = wx_scene_surfaces_by_index(scene);
         if (cameras == NULL || sim->dirt == NULL || sim->baseline == NULL ||
-            sim->grow_area == NULL || sim->surface_of == NULL) {
+            sim->grow_area == NULL || sim->surface_of == NULL || sim->surfaces == NULL) {
             r = wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (simulation)");
         }
     }
@@ -1056,6 +1050,7 @@ void wx_sim_destroy(wx_sim *sim)
     free(sim->baseline);
     free(sim->grow_area);
     free(sim->surface_of);
+    free(sim->surfaces);
     wx_collider_free(&sim->collider);
     wx_forces_free(&sim->forces);
     wx_particles_free(&sim->particles);
