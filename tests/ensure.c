@@ -1,7 +1,9 @@
 // ensure.c: counters, reports and small helpers for the test programs.
 #include "ensure.h"
 
+#include <math.h>
 #include <stdarg.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -195,6 +197,15 @@ char *ensure_read_file(const char *path)
     }
     fclose(f);
     return text;
+}
+
+double ensure_json_number(const char *json, const char *after, const char *key)
+{
+    const char *p = json != NULL && after != NULL ? strstr(json, after) : json;
+    char pattern[128];
+    snprintf(pattern, sizeof pattern, "\"%s\": ", key);
+    p = p != NULL ? strstr(p, pattern) : NULL;
+    return p != NULL ? strtod(p + strlen(pattern), NULL) : NAN;
 }
 
 bool ensure_contains(const char *haystack, const char *needle)

@@ -78,6 +78,11 @@ const char *ensure_write_file(const char *dir, const char *name, const char *tex
 /// Reads a whole file into a malloc'd NUL-terminated string (NULL on failure).
 char *ensure_read_file(const char *path);
 
+/// A number of a --stats JSON text: the first `"key": value` after the first
+/// occurrence of `after` (NULL: from the start); NaN when json is NULL or
+/// either is absent.
+double ensure_json_number(const char *json, const char *after, const char *key);
+
 /// What a bad input of tests/bad/ must do, from its first line
 /// "<!-- expect: LINE: CAUSE: substring -->": fail for WX_CAUSE_<CAUSE> with a
 /// message that starts "path:LINE: " (LINE 0: names no XML line) and contains

@@ -231,13 +231,20 @@ TEST(the_final_mask_is_the_last_frame_and_every_channel_has_a_preview)
     ENSURE(stat(path, &st) != 0); // frames have none
 }
 
-// Reads "KEY": NUMBER after position `from` in `text`.
-static double json_number(const char *from, const char *key)
+// The two sides of a substance's ledger (docs/design.md section 9) from its
+// --stats entry at `at`: what came in and where it went.
+static void ledger_sides(const char *at, double *in, double *out)
 {
-    char pattern[64];
-    snprintf(pattern, sizeof pattern, "\"%s\": ", key);
-    const char *at = strstr(from, pattern);
-    return at != NULL ? strtod(at + strlen(pattern), NULL) : NAN;
+    static const char *const ins[4] = { "initial_surface", "emitted", "grown", "transferred_in" };
+    static const char *const outs[5] = { "final_surface", "in_flight", "escaped", "decayed",
+                                         "transferred_out" };
+    *in = *out = 0.0;
+    for (int k = 0; k < 4; ++k) {
+        *in += ensure_json_number(at, NULL, ins[k]);
+    }
+    for (int k = 0; k < 5; ++k) {
+        *out += ensure_json_number(at, NULL, outs[k]);
+    }
 }
 
 TEST(the_ledger_balances_for_every_substance)
@@ -247,7 +254,7 @@ TEST(the_ledger_balances_for_every_substance)
     snprintf(path, sizeof path, "%s/substances/stats.json", ensure_tmpdir());
     char *json = ensure_read_file(path);
     ENSURE(json != NULL);
-    ENSURE(json_number(json, "iterations") == ITERATIONS);
+    ENSURE(ensure_json_number(json, NULL, "iterations") == ITERATIONS);
     ENSURE(strstr(json, "\"dirt\": {") == NULL); // the scene declares no substance dirt
     const char *names[3] = { "water", "rust", "moss" };
     for (int s = 0; s < 3; ++s) {
@@ -255,18 +262,16 @@ TEST(the_ledger_balances_for_every_substance)
         snprintf(key, sizeof key, "\"%s\": {", names[s]);
         const char *at = strstr(json, key);
         ENSURE(at != NULL);
-        double in = json_number(at, "initial_surface") + json_number(at, "emitted") +
-                    json_number(at, "grown") + json_number(at, "transferred_in");
-        double out = json_number(at, "final_surface") + json_number(at, "in_flight") +
-                     json_number(at, "escaped") + json_number(at, "decayed") +
-                     json_number(at, "transferred_out");
+        double in, out;
+        ledger_sides(at, &in, &out);
         printf("        %s: in %.17g, out %.17g\n", names[s], in, out);
         ENSURE(fabs(in - out) <= 1e-9 * (fabs(in) + 1.0));
     }
     // Rust comes only from water: what water gave, rust received.
     const char *water = strstr(json, "\"water\": {"), *rust = strstr(json, "\"rust\": {");
-    ENSURE_NEAR(json_number(water, "transferred_out"), json_number(rust, "transferred_in"),
-                1e-9 * json_number(rust, "transferred_in"));
+    double given = ensure_json_number(water, NULL, "transferred_out");
+    double received = ensure_json_number(rust, NULL, "transferred_in");
+    ENSURE_NEAR(given, received, 1e-9 * received);
     free(json);
 }
 
@@ -297,11 +302,8 @@ static int ledger_balances(const char *json)
     int checked = 0;
     for (at = strstr(at + 15, "\": { \"initial_surface\""); at != NULL;
          at = strstr(at + 1, "\": { \"initial_surface\"")) {
-        double in = json_number(at, "initial_surface") + json_number(at, "emitted") +
-                    json_number(at, "grown") + json_number(at, "transferred_in");
-        double out = json_number(at, "final_surface") + json_number(at, "in_flight") +
-                     json_number(at, "escaped") + json_number(at, "decayed") +
-                     json_number(at, "transferred_out");
+        double in, out;
+        ledger_sides(at, &in, &out);
         if (!(fabs(in - out) <= 1e-9 * (fabs(in) + 1.0))) {
             fprintf(stderr, "        in %.17g, out %.17g\n", in, out);
             return -1;
@@ -393,7 +395,8 @@ TEST(surfaces_beyond_a_thousand_keep_their_rules)
     ensure_write_file(dir, "scene.xml", xml);
     free(xml);
     char log[8192];
-    int status = ensure_shell(log, sizeof log, "'%s/weathering' run '%s/scene.xml' --out '%s/out' -q",
+    int status = ensure_shell(log, sizeof log,
+                              "'%s/weathering' run '%s/scene.xml' --out '%s/out' -q",
                               ensure_build_dir(), dir, dir);
     if (status != 0) {
         fprintf(stderr, "        weathering run: status %d\n%s\n", status, log);

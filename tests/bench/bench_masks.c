@@ -33,9 +33,7 @@ static double gather_seconds(const char *scene)
     char path[PATH_MAX + 16];
     snprintf(path, sizeof path, "%s/stats.json", dir);
     char *json = ensure_read_file(path);
-    const char *at = json != NULL ? strstr(json, "\"gather_seconds\"") : NULL;
-    at = at != NULL ? strstr(at, "\"compute\": ") : NULL;
-    double s = at != NULL ? atof(at + 11) : NAN;
+    double s = ensure_json_number(json, "\"gather_seconds\"", "compute");
     free(json);
     return s;
 }

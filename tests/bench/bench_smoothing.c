@@ -29,16 +29,6 @@
 static char dir[PATH_MAX];
 static char program[PATH_MAX];
 
-// A number from the --stats JSON: the first "key": value after `after`.
-static double json_number(const char *json, const char *after, const char *key)
-{
-    const char *p = after != NULL ? strstr(json, after) : json;
-    char pattern[128];
-    snprintf(pattern, sizeof pattern, "\"%s\": ", key);
-    p = p != NULL ? strstr(p, pattern) : NULL;
-    return p != NULL ? atof(p + strlen(pattern)) : NAN;
-}
-
 // Runs `weathering ARGS` in the bench folder; returns the --stats JSON (malloc'd)
 // read from stats.json, or NULL.
 static char *run(const char *args)
@@ -125,8 +115,8 @@ static bool fly(const char *kind, const char *emitter_fmt, double bbox, int step
         if (json == NULL) {
             return false;
         }
-        double total = json_number(json, "\"seconds\"", "total");
-        double gather = json_number(json, "\"seconds\"", "gather");
+        double total = ensure_json_number(json, "\"seconds\"", "total");
+        double gather = ensure_json_number(json, "\"seconds\"", "gather");
         free(json);
         s->particles[k] = counts[k];
         s->adaptive_time[k] = total;
@@ -143,7 +133,7 @@ static bool fly(const char *kind, const char *emitter_fmt, double bbox, int step
             if (json == NULL) {
                 return false;
             }
-            double fixed_gather = json_number(json, "\"seconds\"", "gather");
+            double fixed_gather = ensure_json_number(json, "\"seconds\"", "gather");
             free(json);
             double e = mask_error(kind, exact, counts[k]);
             if (e < s->fixed_error[k]) {
@@ -260,9 +250,9 @@ static bool simulate_scaling(const char *name, int pairs, double *speedup, doubl
             if (json == NULL) {
                 return false;
             }
-            phase[t] = json_number(json, "\"seconds\"", "simulate");
+            phase[t] = ensure_json_number(json, "\"seconds\"", "simulate");
             if (t == 2) {
-                write = json_number(json, "\"simulate_seconds\"", "write");
+                write = ensure_json_number(json, "\"simulate_seconds\"", "write");
             }
             free(json);
         }
@@ -294,8 +284,8 @@ static void phase_targets(bool quick)
         if (json == NULL) {
             return;
         }
-        double gather = json_number(json, "\"seconds\"", "gather");
-        double compute = json_number(json, "\"gather_seconds\"", "compute");
+        double gather = ensure_json_number(json, "\"seconds\"", "gather");
+        double compute = ensure_json_number(json, "\"gather_seconds\"", "compute");
         free(json);
         double ratio = gather / compute;
         printf("gather phase at 2048 px, 3 input cameras, %s: %.3f s, compute %.3f s: %.2fx\n",

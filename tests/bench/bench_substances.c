@@ -30,8 +30,7 @@ static double steps_seconds(const char *scene)
     char path[PATH_MAX + 16];
     snprintf(path, sizeof path, "%s/stats.json", dir);
     char *json = ensure_read_file(path);
-    const char *at = json != NULL ? strstr(json, "\"steps\": ") : NULL;
-    double s = at != NULL ? atof(at + 9) : NAN;
+    double s = ensure_json_number(json, NULL, "steps");
     free(json);
     return s;
 }
