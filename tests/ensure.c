@@ -10,6 +10,9 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "io/exr.h"
+#include "model/image.h"
+
 int ensure_failed_checks;
 static int passed;
 static int failed;
@@ -197,6 +200,23 @@ char *ensure_read_file(const char *path)
     }
     fclose(f);
     return text;
+}
+
+float *ensure_read_channel(const char *path, const char *name, int *width, int *height)
+{
+    const char *const names[1] = { name };
+    wx_image image;
+    wx_error err;
+    if (wx_exr_read(path, names, 1, &image, &err) != WX_OK) {
+        fprintf(stderr, "        %s\n", err.message);
+        return NULL;
+    }
+    *width = image.width;
+    *height = image.height;
+    float *plane = image.channels[0];
+    image.channels[0] = NULL;
+    wx_image_free(&image);
+    return plane;
 }
 
 double ensure_json_number(const char *json, const char *after, const char *key)

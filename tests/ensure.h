@@ -78,6 +78,9 @@ const char *ensure_write_file(const char *dir, const char *name, const char *tex
 /// Reads a whole file into a malloc'd NUL-terminated string (NULL on failure).
 char *ensure_read_file(const char *path);
 
+/// One channel of an EXR (malloc'd), or NULL with the error on stderr.
+float *ensure_read_channel(const char *path, const char *name, int *width, int *height);
+
 /// A number of a --stats JSON text: the first `"key": value` after the first
 /// occurrence of `after` (NULL: from the start); NaN when json is NULL or
 /// either is absent.

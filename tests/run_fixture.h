@@ -1,6 +1,6 @@
 // run_fixture.h: what the tests that run the `weathering` command on scenes of
 // their own share: running it in a folder (its output kept in `out`), the
-// path of a file in tests/data, and one channel of an EXR it wrote. Include
+// path of a file in tests/data (ensure_read_channel reads what it wrote). Include
 // after defining _XOPEN_SOURCE 700 (realpath).
 #ifndef WX_RUN_FIXTURE_H
 #define WX_RUN_FIXTURE_H
@@ -42,24 +42,6 @@ static inline const char *data_file(const char *name)
     }
     snprintf(path, sizeof path, "%s/data/%s", tests, name);
     return path;
-}
-
-/// One channel of an EXR (malloc'd), or NULL with a note on stderr.
-static inline float *read_channel(const char *path, const char *name, int *w, int *h)
-{
-    const char *const names[1] = { name };
-    wx_image image;
-    wx_error err;
-    if (wx_exr_read(path, names, 1, &image, &err) != WX_OK) {
-        fprintf(stderr, "        %s\n", err.message);
-        return NULL;
-    }
-    *w = image.width;
-    *h = image.height;
-    float *plane = image.channels[0];
-    image.channels[0] = NULL;
-    wx_image_free(&image);
-    return plane;
 }
 
 #endif

@@ -110,24 +110,6 @@ static inline const char *sphere_write_scene(const char *dir, const char *name,
     return ensure_write_file(dir, name, text);
 }
 
-// The mask's Y channel (malloc'd), or NULL with a note on stderr.
-static inline float *sphere_read_mask(const char *path, int *w, int *h)
-{
-    static const char *const names[] = { "Y" };
-    wx_image image;
-    wx_error err;
-    if (wx_exr_read(path, names, 1, &image, &err) != WX_OK) {
-        fprintf(stderr, "        %s\n", err.message);
-        return NULL;
-    }
-    *w = image.width;
-    *h = image.height;
-    float *mask = image.channels[0];
-    image.channels[0] = NULL;
-    wx_image_free(&image);
-    return mask;
-}
-
 /// The exact density at the sphere point with normal n (n.y given).
 typedef double (*sphere_density_fn)(double ny, double particles);
 

@@ -55,7 +55,7 @@ TEST(sphere_under_rain_from_a_box)
         ENSURE(run_scene(dir, name, folder));
         snprintf(path, sizeof path, "%s/%s/mask.exr", dir, folder);
         int w, h;
-        float *mask = sphere_read_mask(path, &w, &h);
+        float *mask = ensure_read_channel(path, "Y", &w, &h);
         ENSURE(mask != NULL && w == 1024 && h == 1024);
         double rmse, ring;
         sphere_errors(mask, w, h, sphere_box_density, counts[k], &rmse, &ring);
@@ -85,7 +85,7 @@ TEST(sphere_under_a_dome_aimed_at_its_foot)
     ENSURE(run_scene(dir, "dome.xml", "dome"));
     snprintf(path, sizeof path, "%s/dome/mask.exr", dir);
     int w, h;
-    float *mask = sphere_read_mask(path, &w, &h);
+    float *mask = ensure_read_channel(path, "Y", &w, &h);
     ENSURE(mask != NULL);
     double rmse, ring;
     sphere_errors(mask, w, h, sphere_dome_density, 2e6, &rmse, &ring);
@@ -150,7 +150,7 @@ TEST(wall_under_an_overhang_in_slanting_rain)
     char path[4300];
     snprintf(path, sizeof path, "%s/overhang/mask.exr", dir);
     int w, h;
-    float *mask = sphere_read_mask(path, &w, &h);
+    float *mask = ensure_read_channel(path, "Y", &w, &h);
     ENSURE(mask != NULL && w == 512 && h == 512);
     // Rows averaged over |x| < 1.5; row j at y = 3.6 - 4 (j + 0.5) / 512.
     double profile[512];

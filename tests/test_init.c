@@ -85,7 +85,7 @@ TEST(presets_make_valid_scenes_and_rain_dirties_the_top)
     char path[PATH_MAX + 64];
     snprintf(path, sizeof path, "%s/rain/texture_cube_texture.exr", dir);
     int w, h;
-    float *y = read_channel(path, "Y", &w, &h);
+    float *y = ensure_read_channel(path, "Y", &w, &h);
     ENSURE(y != NULL);
     if (y != NULL) {
         double top = island_mean(y, w, h, 16, 16), bottom = island_mean(y, w, h, 272, 16);
@@ -166,9 +166,9 @@ TEST(run_a_mesh_and_split_its_texture)
     ENSURE(strstr(out, "dust/texture_cube_texture_seen.exr") != NULL);
     snprintf(path, sizeof path, "%s/dust/texture_cube_texture.exr", dir);
     int w = 0, h = 0, w2 = -1, h2 = -1;
-    float *y = read_channel(path, "Y", &w, &h);
+    float *y = ensure_read_channel(path, "Y", &w, &h);
     snprintf(path, sizeof path, "%s/dust/texture_cube_texture_Y.exr", dir);
-    float *y2 = read_channel(path, "Y", &w2, &h2);
+    float *y2 = ensure_read_channel(path, "Y", &w2, &h2);
     ENSURE(y != NULL && y2 != NULL && w == w2 && h == h2);
     if (y != NULL && y2 != NULL && w == w2 && h == h2) {
         ENSURE(memcmp(y, y2, (size_t)w * (size_t)h * sizeof(float)) == 0);

@@ -122,7 +122,7 @@ TEST(open_plane)
     const double tol[6] = { 0.02, 1e-4, 1e-4, 1e-3, 1e-4, 1e-4 };
     for (int c = 0; c < 6; ++c) {
         int w, h;
-        float *m = read_channel(path, names[c], &w, &h);
+        float *m = ensure_read_channel(path, names[c], &w, &h);
         ENSURE(m != NULL);
         if (m == NULL) {
             continue;
@@ -160,7 +160,7 @@ TEST(floor_beside_a_wall)
     char path[PATH_MAX];
     snprintf(path, sizeof path, "%s/wall/mask.exr", dir);
     int w, h;
-    float *ao = read_channel(path, "ao.Y", &w, &h);
+    float *ao = ensure_read_channel(path, "ao.Y", &w, &h);
     ENSURE(ao != NULL);
     if (ao != NULL) {
         const double xs[5] = { 0.1, 0.25, 0.5, 0.75, 1.5 };
@@ -186,7 +186,7 @@ TEST(floor_beside_a_wall)
                 "<Exposure name=\"sun\" elevation=\"45\" azimuth=\"180\"/>", "", NULL);
     ENSURE(weathering_in(dir, "run shadow.xml --out shadow -q", true) == 0);
     snprintf(path, sizeof path, "%s/shadow/mask.exr", dir);
-    float *sun = read_channel(path, "sun.Y", &w, &h);
+    float *sun = ensure_read_channel(path, "sun.Y", &w, &h);
     ENSURE(sun != NULL);
     if (sun != NULL) {
         // Row by row, the first lit texel right of the wall: its centre within
@@ -230,10 +230,10 @@ TEST(inside_a_closed_box)
     char path[PATH_MAX];
     snprintf(path, sizeof path, "%s/box/mask.exr", dir);
     int w, h;
-    float *ao = read_channel(path, "ao.Y", &w, &h);
+    float *ao = ensure_read_channel(path, "ao.Y", &w, &h);
     float *depth = NULL;
     snprintf(path, sizeof path, "%s/box/shot_depth.exr", dir);
-    depth = read_channel(path, "R", &w, &h);
+    depth = ensure_read_channel(path, "R", &w, &h);
     ENSURE(ao != NULL && depth != NULL);
     if (ao != NULL && depth != NULL) {
         double largest = 0.0;
@@ -276,8 +276,8 @@ TEST(sphere_curvature_and_height)
         char path[PATH_MAX];
         snprintf(path, sizeof path, "%s/%s/mask.exr", dir, folder);
         int w, h;
-        float *kk = read_channel(path, "k.Y", &w, &h);
-        float *hh = read_channel(path, "h.Y", &w, &h);
+        float *kk = ensure_read_channel(path, "k.Y", &w, &h);
+        float *hh = ensure_read_channel(path, "h.Y", &w, &h);
         ENSURE(kk != NULL && hh != NULL);
         if (kk != NULL && hh != NULL) {
             double sum = 0.0, worst_h = 0.0;
@@ -332,9 +332,9 @@ TEST(masks_in_a_texture)
     char path[PATH_MAX];
     snprintf(path, sizeof path, "%s/cube/cube.exr", dir);
     int w, h;
-    float *hh = read_channel(path, "h.Y", &w, &h);
-    float *sun = read_channel(path, "sun.Y", &w, &h);
-    float *seen = read_channel(path, "seen", &w, &h);
+    float *hh = ensure_read_channel(path, "h.Y", &w, &h);
+    float *sun = ensure_read_channel(path, "sun.Y", &w, &h);
+    float *seen = ensure_read_channel(path, "seen", &w, &h);
     ENSURE(hh != NULL && sun != NULL && seen != NULL);
     if (hh != NULL && sun != NULL && seen != NULL) {
         double worst_h = 0.0, worst_sun = 0.0, side = 0.0;
@@ -429,9 +429,9 @@ TEST(frames_copy_the_geometric_masks)
         int w = 0, h = 0, w2 = 0, h2 = 0;
         for (int c = 0; c < 3; ++c) {
             snprintf(path, sizeof path, "%s/f1/%s", dir, files[f][2]);
-            float *last = read_channel(path, geometric[c], &w, &h);
+            float *last = ensure_read_channel(path, geometric[c], &w, &h);
             snprintf(path, sizeof path, "%s/f1/%s", dir, files[f][0]);
-            float *first = read_channel(path, geometric[c], &w2, &h2);
+            float *first = ensure_read_channel(path, geometric[c], &w2, &h2);
             ENSURE(last != NULL && first != NULL && w == w2 && h == h2);
             double lit = 0.0;
             for (size_t t = 0; last != NULL && first != NULL && t < (size_t)w * (size_t)h; ++t) {
@@ -446,7 +446,7 @@ TEST(frames_copy_the_geometric_masks)
         double sums[3] = { 0.0, 0.0, 0.0 };
         for (int k = 0; k < 3; ++k) {
             snprintf(path, sizeof path, "%s/f1/%s", dir, files[f][k]);
-            float *wet = read_channel(path, "wet.Y", &w, &h);
+            float *wet = ensure_read_channel(path, "wet.Y", &w, &h);
             ENSURE(wet != NULL);
             for (size_t t = 0; wet != NULL && t < (size_t)w * (size_t)h; ++t) {
                 sums[k] += wet[t];

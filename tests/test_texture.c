@@ -401,7 +401,7 @@ TEST(uv_sphere_follows_the_flux_without_a_seam)
 
     snprintf(path, sizeof path, "%s/sphere/mask.exr", dir);
     int mw, mh;
-    float *mask = sphere_read_mask(path, &mw, &mh);
+    float *mask = ensure_read_channel(path, "Y", &mw, &mh);
     ENSURE(mask != NULL);
     double mask_rmse = 0.0, mask_ring = 0.0;
     if (mask != NULL) {
@@ -445,7 +445,7 @@ TEST(texture_through_the_output_camera_equals_the_mask)
     ENSURE(read_channels(path, names, 2, &img));
     snprintf(path, sizeof path, "%s/sphere/mask.exr", dir);
     int mw, mh;
-    float *mask = sphere_read_mask(path, &mw, &mh);
+    float *mask = ensure_read_channel(path, "Y", &mw, &mh);
     ENSURE(mask != NULL && mw == img.width && mh == img.height);
     if (mask == NULL || mw != img.width || mh != img.height) {
         free(mask);

@@ -50,7 +50,7 @@ static double mask_error(const char *folder, sphere_density_fn exact, double par
     char path[PATH_MAX + 64];
     snprintf(path, sizeof path, "%s/%s/mask.exr", dir, folder);
     int w = 0, h = 0;
-    float *mask = sphere_read_mask(path, &w, &h);
+    float *mask = ensure_read_channel(path, "Y", &w, &h);
     if (mask == NULL) {
         return NAN;
     }
