@@ -31,8 +31,9 @@
 #include "model/scene.h"
 #include "pipeline/bake_phase.h"
 #include "pipeline/gather_phase.h"
-#include "pipeline/pilot.h"
+#include "pipeline/masks_phase.h"
 #include "pipeline/memory.h"
+#include "pipeline/pilot.h"
 #include "pipeline/outputs.h"
 #include "pipeline/pipeline.h"
 #include "pipeline/preset.h"
@@ -478,8 +479,11 @@ static void print_masks(const wx_scene *scene, int threads)
         rays += points * wx_mask_rays(md);
     }
     if (rays > 0.0) {
-        printf("  rays: at most %.0f million over %.0f target texels, about %.0f s on %d thread%s\n",
+        printf("  rays: at most %.0f million over %.0f target texels, about %.0f s on %d thread%s",
                rays / 1e6, points, rays / (1.3e6 * threads), threads, threads == 1 ? "" : "s");
+        // With frames, the masks that read only the geometry are computed once
+        // (pipeline/masks_phase.h); a Combine of a substance costs no rays.
+        printf(wx_masks_worth_keeping(scene) ? ", once for all the frames\n" : "\n");
     }
 }
 
