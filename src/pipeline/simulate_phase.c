@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/parallel.h"
 #include "core/progress.h"
 #include "io/exr.h"
 #include "io/maps_file.h"
@@ -15,19 +16,61 @@
 #include "pipeline/outputs.h"
 #include "pipeline/texture_phase.h"
 
-// The planes the gather reads from the simulation's state for input camera k
-// (model/maps.h layout: substance s at s*W*H): the amounts, the amounts
-// without the particles (the baseline, or the planes the simulation started
-// from when the scene has no rules) and the hits. The caller frees them.
-static wx_result gather_planes(const wx_sim *sim, const wx_maps *m, int k, float **dirt,
-                               float **initial, float **hits, wx_error *err)
+// The planes the gather reads from the simulation's state for input camera k,
+// into the caller's planes of its W*H texels: per substance s the amount
+// (dirt[s]) and the amount without the particles (initial[s]: the baseline,
+// or the planes the simulation started from when the scene has no rules), and
+// the hits. Rows in parallel on `threads`: the same values for any count.
+typedef struct planes_job {
+    const wx_dirt_map *map;
+    const double *baseline;
+    const float *start; ///< the starting amounts (S planes), or NULL
+    float *const *dirt, *const *initial;
+    float *hits;
+} planes_job;
+
+static void planes_rows(int64_t begin, int64_t end, int worker, void *context)
+{
+    (void)worker;
+    const planes_job *job = context;
+    const wx_dirt_map *map = job->map;
+    const size_t n = (size_t)map->width * (size_t)map->height, S = (size_t)map->substances;
+    for (size_t t = (size_t)begin * (size_t)map->width; t < (size_t)end * (size_t)map->width;
+         ++t) {
+        const wx_dirt_texel *x = &map->texels[t * S];
+        for (size_t s = 0; s < S; ++s) {
+            job->dirt[s][t] = (float)x[s].dirt;
+            job->initial[s][t] = job->baseline != NULL ? (float)job->baseline[t * S + s]
+                                 : job->start != NULL  ? job->start[s * n + t]
+                                                       : 0.0f;
+        }
+        job->hits[t] = x[0].hits;
+    }
+}
+
+static void gather_planes(const wx_sim *sim, const wx_maps *m, int k, float *const *dirt,
+                          float *const *initial, float *hits, int threads)
 {
     const wx_dirt_map *map = wx_sim_dirt_map(sim, k);
-    const double *baseline = wx_sim_baseline(sim, k);
+    planes_job job = { .map = map,
+                       .baseline = wx_sim_baseline(sim, k),
+                       .start = m->dirt,
+                       .dirt = dirt,
+                       .initial = initial,
+                       .hits = hits };
+    wx_parallel_for(threads, map->height, 16, planes_rows, &job);
+}
+
+// The planes of gather_planes in one block each (dirt and initial: S planes
+// one after the other, model/maps.h), for a frame's gather; the caller frees them.
+static wx_result gather_plane_blocks(const wx_sim *sim, const wx_maps *m, int k, int threads,
+                                     float **dirt, float **initial, float **hits, wx_error *err)
+{
+    const wx_dirt_map *map = wx_sim_dirt_map(sim, k);
     size_t n = (size_t)map->width * (size_t)map->height;
-    size_t S = (size_t)map->substances;
-    *dirt = malloc(n * S * sizeof **dirt + 1);
-    *initial = malloc(n * S * sizeof **initial + 1);
+    int S = map->substances;
+    *dirt = malloc(n * (size_t)S * sizeof **dirt + 1);
+    *initial = malloc(n * (size_t)S * sizeof **initial + 1);
     *hits = malloc(n * sizeof **hits + 1);
     if (*dirt == NULL || *initial == NULL || *hits == NULL) {
         free(*dirt);
@@ -36,19 +79,12 @@ static wx_result gather_planes(const wx_sim *sim, const wx_maps *m, int k, float
         *dirt = *initial = *hits = NULL;
         return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (dirt maps)");
     }
-    for (size_t s = 0; s < S; ++s) {
-        float *d = *dirt + s * n, *i0 = *initial + s * n;
-        const float *start = m->dirt != NULL ? m->dirt + s * n : NULL;
-        for (size_t t = 0; t < n; ++t) {
-            d[t] = (float)map->texels[t * S + s].dirt;
-            i0[t] = baseline != NULL ? (float)baseline[t * S + s]
-                    : start != NULL  ? start[t]
-                                     : 0.0f;
-        }
+    float *dirt_planes[WX_MAX_SUBSTANCES], *initial_planes[WX_MAX_SUBSTANCES];
+    for (int s = 0; s < S; ++s) {
+        dirt_planes[s] = *dirt + (size_t)s * n;
+        initial_planes[s] = *initial + (size_t)s * n;
     }
-    for (size_t t = 0; t < n; ++t) {
-        (*hits)[t] = map->texels[t * S].hits;
-    }
+    gather_planes(sim, m, k, dirt_planes, initial_planes, *hits, threads);
     return WX_OK;
 }
 
@@ -76,28 +112,28 @@ static wx_result write_one(const wx_scene *scene, const wx_run_def *opts, const 
         channels[c] = names[c];
     }
     r = wx_image_alloc(image, map->width, map->height, count, channels, err);
-    float *dirt = NULL, *initial = NULL, *hits = NULL;
-    if (r == WX_OK) {
-        r = gather_planes(sim, maps, k, &dirt, &initial, &hits, err);
-    }
     if (r != WX_OK) {
         wx_image_free(image);
         return r;
     }
     size_t n = (size_t)map->width * (size_t)map->height;
     int S = map->substances;
+    // The simulated planes straight into the image's channels.
+    float *dirt[WX_MAX_SUBSTANCES], *initial[WX_MAX_SUBSTANCES];
+    for (int s = 0; s < S; ++s) {
+        dirt[s] = image->channels[3 * s];
+        initial[s] = image->channels[3 * S + s];
+    }
+    gather_planes(sim, maps, k, dirt, initial, image->channels[4 * S], opts->threads);
     for (int s = 0; s < S; ++s) {
         size_t plane = (size_t)s * n;
-        memcpy(image->channels[3 * s], dirt + plane, n * sizeof(float));
         if (maps->deposit != NULL) {
             memcpy(image->channels[3 * s + 1], maps->deposit + plane, n * sizeof(float));
         }
         if (maps->erosion != NULL) {
             memcpy(image->channels[3 * s + 2], maps->erosion + plane, n * sizeof(float));
         }
-        memcpy(image->channels[3 * S + s], initial + plane, n * sizeof(float));
     }
-    memcpy(image->channels[4 * S], hits, n * sizeof(float));
     int next = 4 * S + 1;
     if (next < count && strcmp(names[next], WX_SURFACE_CHANNEL) == 0) {
         if (maps->surface != NULL) {
@@ -108,9 +144,6 @@ static wx_result write_one(const wx_scene *scene, const wx_run_def *opts, const 
     if (next < count && strcmp(names[next], WX_AREA_CHANNEL) == 0 && maps->area != NULL) {
         memcpy(image->channels[next], maps->area, n * sizeof(float));
     }
-    free(dirt);
-    free(initial);
-    free(hits);
     // The input dirt map's header travels with it (kept when the map was read).
     for (int a = 0; a < maps->dirt_attr_count && image->attr_count < WX_IMAGE_MAX_ATTRS; ++a) {
         image->attrs[image->attr_count++] = maps->dirt_attrs[a];
@@ -150,8 +183,8 @@ static wx_result write_frame(const wx_scene *scene, const wx_run_def *opts, cons
         view[c].substances = maps[c].substances;
         view[c].depth = maps[c].depth;
         view[c].normal = maps[c].normal;
-        r = gather_planes(sim, &maps[c], c, &view[c].dirt, &view[c].initial_dirt, &view[c].hits,
-                          err);
+        r = gather_plane_blocks(sim, &maps[c], c, opts->threads, &view[c].dirt,
+                                &view[c].initial_dirt, &view[c].hits, err);
     }
     if (r == WX_OK) {
         r = wx_gather_frame(scene, opts, view, out_maps, textures, masks, frame, NULL, err);
@@ -251,7 +284,7 @@ wx_result wx_simulate_maps(const wx_scene *scene, const wx_run_def *opts, wx_map
     for (int c = 0; c < wx_sim_input_count(sim) && r == WX_OK; ++c) {
         wx_maps *m = &maps[c];
         float *dirt = NULL, *initial = NULL, *hits = NULL;
-        r = gather_planes(sim, m, c, &dirt, &initial, &hits, err);
+        r = gather_plane_blocks(sim, m, c, opts->threads, &dirt, &initial, &hits, err);
         if (r != WX_OK) {
             break;
         }
