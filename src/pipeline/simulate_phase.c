@@ -220,7 +220,8 @@ wx_result wx_write_dirt_maps(const wx_scene *scene, const wx_run_def *opts, cons
 
 wx_result wx_simulate_maps(const wx_scene *scene, const wx_run_def *opts, wx_maps *maps,
                            const wx_maps *out_maps, const wx_textures *textures,
-                           wx_mask_context *masks, wx_sim_stats *stats, wx_phase_detail *detail, wx_error *err)
+                           wx_mask_context *masks, wx_sim_stats *stats, wx_phase_detail *detail,
+                           wx_error *err)
 {
     wx_phase_detail local;
     detail = detail != NULL ? detail : &local;

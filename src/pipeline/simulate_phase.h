@@ -23,16 +23,18 @@ wx_result wx_write_dirt_maps(const wx_scene *scene, const wx_run_def *opts, cons
                              const wx_maps *maps, wx_error *err);
 
 /// The `simulate` phase on maps already in memory (one per input camera, scene
-/// order, as wx_load_simulation_maps reads them): runs scene->steps steps,
-/// writes opts->out_dir/<camera>_dirt.exr for each input camera, fills
+/// order, as wx_load_simulation_maps reads them): runs scene->steps steps per
+/// iteration and writes opts->out_dir/<camera>_dirt.exr for each input camera.
 /// Frames of image sequences (`every`) write the mask and the TextureMaps of
 /// `textures` (may be NULL), with the derived masks' context `masks` kept over
-/// the frames (may be NULL: one per frame; gather_phase.h). `stats` and the setup, compute and write times of `detail` (may be NULL),
-/// and leaves in each maps[c].dirt the simulated dirt as written
-/// (impact, deposit and erosion released): what the gather reads next.
+/// the frames (may be NULL: one per frame; gather_phase.h). Fills `stats` and
+/// the setup, compute and write times of `detail` (either may be NULL), and
+/// leaves in each maps[c].dirt the simulated dirt as written (impact, deposit
+/// and erosion released): what the gather reads next.
 wx_result wx_simulate_maps(const wx_scene *scene, const wx_run_def *opts, wx_maps *maps,
                            const wx_maps *out_maps, const struct wx_textures *textures,
-                           struct wx_mask_context *masks, wx_sim_stats *stats, wx_phase_detail *detail, wx_error *err);
+                           struct wx_mask_context *masks, wx_sim_stats *stats,
+                           wx_phase_detail *detail, wx_error *err);
 
 /// The `simulate` phase: loads every input camera's maps from the scene's
 /// paths, runs scene->steps steps (progress bar unless opts->quiet), writes
