@@ -768,6 +768,57 @@ TEST(adaptive_radius_doubles_for_a_quarter_of_the_impacts)
     ENSURE(capped.capped_texels > 128 * 128 / 2);
 }
 
+static double one_on_the_left_half(int i, int j)
+{
+    (void)j;
+    return i < 64 ? 1.0 : 0.0;
+}
+
+// Capped means noisier than aimed at: a texel whose radius stops at max_radius
+// with some impact inside it. The same wall with one impact per texel on its
+// left half and none on the right, max_radius 1 m (10 texels): every texel of
+// the left half is capped (sqrt(937.5 / pi) = 17.3 texels would be needed).
+// The right half is not: beside the edge its texels are clean (an empty
+// half-rectangle where their density would have put 12 impacts), and beyond
+// 1 m no impact comes near them. Beyond 2 m (the reach of a capped kernel
+// from the lit side) it is exactly 0. (Between the clean band and 2 m, the
+// lit side's capped kernels leave a faint trace: docs/mask.md, "Adaptive
+// smoothing", notes it.)
+TEST(adaptive_counts_as_capped_only_what_impacts_reach)
+{
+    quad wall = big_wall();
+    test_maps in = render(wall_camera(), &wall, 1, NULL);
+    test_maps out = render(wall_camera(), &wall, 1, NULL);
+    simulated sim = simulate_hits(&in, one_on_the_left_half, 0.0f, 9);
+    wx_gather_stats st;
+    float *mask = run_adaptive(&out, &in, &sim, 0.04f, 1.0f, 2, &st);
+    ENSURE(mask != NULL);
+    double far = 0.0, near = 0.0, lit = 0.0;
+    for (int j = 0; mask != NULL && j < 128; ++j) {
+        for (int i = 0; i < 128; ++i) {
+            double v = fabs(mask[j * 128 + i]);
+            if (i >= 64 + 20) {
+                far = fmax(far, v); // beyond twice max_radius: no kernel reaches
+            } else if (i >= 64 + 2) {
+                near = fmax(near, v);
+            } else if (i < 54 && j >= 10 && j < 118) {
+                lit += v / (54.0 * 108.0);
+            }
+        }
+    }
+    printf("        lit half %.1f per texel; 2-20 texels right of the edge at most %.1f\n", lit,
+           near);
+    printf("        capped %lld of %lld texels (the left half: %d), far right at most %g\n",
+           (long long)st.capped_texels, (long long)st.surface_texels, 128 * 64, far);
+    ENSURE(st.capped_texels >= 128 * 64 && st.capped_texels <= 128 * 66);
+    ENSURE(far == 0.0);
+    free(mask);
+    free(sim.initial);
+    free(sim.hits);
+    maps_free(&in);
+    maps_free(&out);
+}
+
 // The dirt the bake gave (initial) is exact and is never smoothed: a map with
 // a sharp pattern of initial dirt and no impacts comes out as the first pass,
 // whatever the smoothing; and a map no simulation wrote (no initial, no hits
@@ -1261,6 +1312,7 @@ int main(void)
     RUN(radius_check_counts_the_neighbourhood);
     RUN(adaptive_noise_follows_the_impacts);
     RUN(adaptive_radius_doubles_for_a_quarter_of_the_impacts);
+    RUN(adaptive_counts_as_capped_only_what_impacts_reach);
     RUN(adaptive_keeps_the_initial_dirt_exact);
     RUN(adaptive_does_not_cross_a_shadow_edge);
     RUN(adaptive_keeps_the_dirt_and_its_bytes);

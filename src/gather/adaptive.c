@@ -51,6 +51,11 @@ enum {
 // spreads an impact bilinearly over up to four texels).
 #define EMPTY_IMPACTS 0.5
 
+// Step 2's verdict on a texel (job.clean): clean, and, for a texel whose
+// radius reached max_radius, whether some impact lies within it (a surface no
+// particle comes near is not noisy, only unreached).
+enum { TEXEL_CLEAN = 1, TEXEL_SPARSE = 2 };
+
 // A neighbour (di, dj): its distance across the view, its world offset
 // a = di*step_i + dj*step_j (with a depth difference dd the points are
 // a + dd*step_d apart: r^2 = a2 + dd * (az2 + dd * z2)), and the plane
@@ -76,7 +81,7 @@ typedef struct job {
     // Unpadded.
     float *delta;         // change per unit area
     float *radius;        // h (world units) of a sample, 0 elsewhere
-    unsigned char *clean; // step 2's verdict
+    unsigned char *clean; // step 2's verdict: TEXEL_CLEAN, TEXEL_SPARSE bits
     double *sat;          // (width + 1) * (height + 1) summed impacts
     double *sat_surface;  // the same for the texels with a surface
     float *tile_bound;
@@ -192,11 +197,13 @@ static void radii_row(const job *jb, int j)
         float cos_view = fabsf(jb->pzn[p]) * jb->inv_z;
         double want = jb->target_hits / (cos_view > MIN_SLOPE_COS ? cos_view : MIN_SLOPE_COS);
         double lo = jb->min_radius, hi = jb->max_radius;
-        double h;
+        double h, at_max;
+        unsigned char sparse = 0;
         if (impacts_within(jb, i, j, lo) >= want) {
             h = lo;
-        } else if (impacts_within(jb, i, j, hi) < want) {
+        } else if ((at_max = impacts_within(jb, i, j, hi)) < want) {
             h = hi;
+            sparse = at_max >= EMPTY_IMPACTS ? TEXEL_SPARSE : 0;
         } else {
             for (int k = 0; k < BISECTIONS; ++k) {
                 double mid = 0.5 * (lo + hi);
@@ -214,8 +221,9 @@ static void radii_row(const job *jb, int j)
             double texels = 3.14159265358979323846 * (h / jb->texel_i) * (h / jb->texel_j);
             double density = impacts_within(jb, i, j, h) / texels;
             int k_min = (int)ceil(0.5 * h / fmax(jb->texel_i, jb->texel_j));
-            jb->clean[t] = is_clean(jb, i, j, density, k_min, k_max);
+            jb->clean[t] = is_clean(jb, i, j, density, k_min, k_max) ? TEXEL_CLEAN : 0;
         }
+        jb->clean[t] |= sparse;
     }
 }
 
@@ -492,7 +500,7 @@ wx_result wx_adaptive_smooth(const wx_adaptive_def *def, float *out, wx_adaptive
             size_t t = (size_t)j * (size_t)W + (size_t)i;
             size_t p = jb.base + (size_t)j * jb.stride + (size_t)i;
             float h = jb.radius[t];
-            if (jb.clean[t]) {
+            if (jb.clean[t] & TEXEL_CLEAN) {
                 jb.pnx[p] = jb.pny[p] = jb.pnz[p] = 0.0f; // neither gives nor takes
                 jb.radius[t] = h = 0.0f;
             }
@@ -501,7 +509,7 @@ wx_result wx_adaptive_smooth(const wx_adaptive_def *def, float *out, wx_adaptive
                 jb.pweight[p] = 1.0f / (h * h);
                 jb.pcoef[p] = jb.pweight[p] * jb.delta[t];
                 samples++;
-                capped += h >= jb.max_radius;
+                capped += h >= jb.max_radius && (jb.clean[t] & TEXEL_SPARSE);
                 largest = h > largest ? h : largest;
                 size_t tile = (size_t)(j / TILE) * (size_t)jb.tiles_x + (size_t)(i / TILE);
                 tile_max[tile] = h > tile_max[tile] ? h : tile_max[tile];

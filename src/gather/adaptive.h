@@ -53,7 +53,9 @@ typedef struct wx_adaptive_stats {
     double target_hits;     ///< K
     double median_radius;   ///< over the texels that hold what the particles changed (world units)
     double max_radius_used; ///< largest radius given to such a texel
-    int64_t capped;         ///< such texels whose K impacts lie beyond max_radius
+    /// Such texels whose K impacts lie beyond max_radius, with some impact
+    /// within it (a surface no impact comes near is not noisy, only unreached).
+    int64_t capped;
 } wx_adaptive_stats;
 
 /// Writes the smoothed mask (dirt per unit area: the initial dirt exactly plus

@@ -79,8 +79,8 @@ typedef struct wx_gather_stats {
     double first_pass_s;    ///< wall-clock seconds of the first pass
     double second_pass_s;   ///< wall-clock seconds of the second pass
     /// Adaptive smoothing only: the impacts aimed at, the median and the largest
-    /// radius given (world units), and the texels whose impacts lay beyond
-    /// max_radius (their noise stays above the aim).
+    /// radius given (world units), and the texels with some impact within
+    /// max_radius but fewer than K (their noise stays above the aim).
     double target_hits;
     double median_radius;
     double largest_radius;
