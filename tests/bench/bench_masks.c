@@ -13,6 +13,7 @@
 #include <string.h>
 
 #include "bench_report.h"
+#include "bench_run.h"
 #include "ensure.h"
 
 static char dir[PATH_MAX];
@@ -21,18 +22,9 @@ static char program[PATH_MAX];
 // The gather's compute seconds of `scene` on the maps in dir/out.
 static double gather_seconds(const char *scene)
 {
-    char cmd[3 * PATH_MAX];
-    snprintf(cmd, sizeof cmd,
-             "cd '%s' && rm -f stats.json && '%s' gather '%s' --out out -q --threads 2 "
-             "--stats stats.json",
-             dir, program, scene);
-    if (system(cmd) != 0) {
-        fprintf(stderr, "bench_masks: failed: %s\n", cmd);
-        return NAN;
-    }
-    char path[PATH_MAX + 16];
-    snprintf(path, sizeof path, "%s/stats.json", dir);
-    char *json = ensure_read_file(path);
+    char args[PATH_MAX];
+    snprintf(args, sizeof args, "gather '%s' --out out --threads 2", scene);
+    char *json = bench_run(program, dir, args);
     double s = ensure_json_number(json, "\"gather_seconds\"", "compute");
     free(json);
     return s;
@@ -57,30 +49,17 @@ static bool write_variant(const char *text, const char *masks, const char *name)
         return false;
     }
     sprintf(root, "%s\n</Weathering>\n", masks);
-    char path[PATH_MAX + 64];
-    snprintf(path, sizeof path, "%s/%s", dir, name);
-    FILE *f = fopen(path, "w");
-    bool ok = f != NULL && fputs(out, f) >= 0;
-    ok = f != NULL && fclose(f) == 0 && ok;
+    bool ok = ensure_write_file(dir, name, out) != NULL;
     free(out);
     return ok;
 }
 
 int main(void)
 {
-    const char *build = getenv("WX_BUILD") != NULL ? getenv("WX_BUILD") : "build";
-    char path[PATH_MAX];
-    snprintf(path, sizeof path, "%s/weathering", build);
-    if (realpath(path, program) == NULL) {
-        fprintf(stderr, "bench_masks: no %s\n", path);
+    if (!bench_workdir("bench_masks", program, dir)) {
         return 1;
     }
     char cmd[3 * PATH_MAX];
-    snprintf(cmd, sizeof cmd, "mkdir -p '%s/tmp/bench_masks/meshes'", build);
-    snprintf(path, sizeof path, "%s/tmp/bench_masks", build);
-    if (system(cmd) != 0 || realpath(path, dir) == NULL) {
-        return 1;
-    }
     snprintf(cmd, sizeof cmd,
              "cp xml_scenes/meshes/building.obj xml_scenes/meshes/building.mtl '%s/meshes/'", dir);
     char *scene = ensure_read_file("xml_scenes/building.xml");
@@ -97,8 +76,9 @@ int main(void)
                             "sideWeight=\"0.5\" sideElevation=\"0.6\" sideSpread=\"50\"/></Masks>",
                             "sun.xml");
     free(scene);
-    snprintf(cmd, sizeof cmd, "cd '%s' && '%s' run none.xml --out out -q --threads 2", dir, program);
-    if (!ok || system(cmd) != 0) {
+    char *json = ok ? bench_run(program, dir, "run none.xml --out out --threads 2") : NULL;
+    free(json);
+    if (json == NULL) {
         fprintf(stderr, "bench_masks: cannot run the house\n");
         return 1;
     }

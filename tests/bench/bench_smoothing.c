@@ -24,26 +24,11 @@
 #include <string.h>
 
 #include "bench_report.h"
+#include "bench_run.h"
 #include "sphere_fixture.h"
 
 static char dir[PATH_MAX];
 static char program[PATH_MAX];
-
-// Runs `weathering ARGS` in the bench folder; returns the --stats JSON (malloc'd)
-// read from stats.json, or NULL.
-static char *run(const char *args)
-{
-    char cmd[3 * PATH_MAX];
-    snprintf(cmd, sizeof cmd, "cd '%s' && rm -f stats.json && '%s' %s --stats stats.json -q",
-             dir, program, args);
-    if (system(cmd) != 0) {
-        fprintf(stderr, "bench_smoothing: failed: %s\n", cmd);
-        return NULL;
-    }
-    char path[PATH_MAX + 16];
-    snprintf(path, sizeof path, "%s/stats.json", dir);
-    return ensure_read_file(path);
-}
 
 static double mask_error(const char *folder, sphere_density_fn exact, double particles)
 {
@@ -111,7 +96,7 @@ static bool fly(const char *kind, const char *emitter_fmt, double bbox, int step
         snprintf(scene, sizeof scene, "%s.xml", kind);
         sphere_write_scene(dir, scene, emitter, bbox, 0.02, steps, "");
         snprintf(args, sizeof args, "run %s --out %s", scene, kind);
-        char *json = run(args);
+        char *json = bench_run(program, dir, args);
         if (json == NULL) {
             return false;
         }
@@ -129,7 +114,7 @@ static bool fly(const char *kind, const char *emitter_fmt, double bbox, int step
             snprintf(fixed_scene, sizeof fixed_scene, "%s_fixed.xml", kind);
             sphere_write_scene(dir, fixed_scene, emitter, bbox, 0.02, steps, attrs);
             snprintf(args, sizeof args, "gather %s --out %s", fixed_scene, kind);
-            json = run(args);
+            json = bench_run(program, dir, args);
             if (json == NULL) {
                 return false;
             }
@@ -239,14 +224,14 @@ static bool simulate_scaling(const char *name, int pairs, double *speedup, doubl
 {
     char args[256];
     snprintf(args, sizeof args, "bake building_%s.xml --out %s", name, name);
-    free(run(args));
+    free(bench_run(program, dir, args));
     double speedups[3], shares[3];
     for (int p = 0; p < pairs; ++p) {
         double phase[3] = { 0 }, write = 0.0;
         for (int t = 1; t <= 2; ++t) {
             snprintf(args, sizeof args, "simulate building_%s.xml --out %s --threads %d", name,
                      name, t);
-            char *json = run(args);
+            char *json = bench_run(program, dir, args);
             if (json == NULL) {
                 return false;
             }
@@ -280,7 +265,7 @@ static void phase_targets(bool quick)
             return;
         }
         snprintf(args, sizeof args, "run building_%s.xml --out %s", name, name);
-        char *json = run(args);
+        char *json = bench_run(program, dir, args);
         if (json == NULL) {
             return;
         }
@@ -321,21 +306,11 @@ static void phase_targets(bool quick)
 
 int main(void)
 {
-    const char *build = getenv("WX_BUILD") != NULL ? getenv("WX_BUILD") : "build";
     bool quick = bench_env_long("WX_BENCH_QUICK", 0) > 0;
-    char path[PATH_MAX];
-    snprintf(path, sizeof path, "%s/weathering", build);
-    if (realpath(path, program) == NULL) {
-        fprintf(stderr, "bench_smoothing: no %s\n", path);
+    if (!bench_workdir("bench_smoothing", program, dir)) {
         return 1;
     }
-    snprintf(path, sizeof path, "%s/tmp", build);
-    char cmd[PATH_MAX + 64];
-    snprintf(cmd, sizeof cmd, "mkdir -p '%s/bench_smoothing'", path);
-    if (system(cmd) != 0 || realpath(path, dir) == NULL) {
-        return 1;
-    }
-    strncat(dir, "/bench_smoothing", sizeof dir - strlen(dir) - 1);
+    char path[PATH_MAX + 64];
     snprintf(path, sizeof path, "%s/sphere.ply", dir);
     if (!sphere_write_mesh(path, 256, 512)) {
         fprintf(stderr, "bench_smoothing: cannot write %s\n", path);

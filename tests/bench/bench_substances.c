@@ -12,6 +12,7 @@
 #include <string.h>
 
 #include "bench_report.h"
+#include "bench_run.h"
 #include "ensure.h"
 
 static char dir[PATH_MAX];
@@ -19,17 +20,9 @@ static char program[PATH_MAX];
 
 static double steps_seconds(const char *scene)
 {
-    char cmd[3 * PATH_MAX];
-    snprintf(cmd, sizeof cmd,
-             "cd '%s' && rm -f stats.json && '%s' run '%s' --out out -q --stats stats.json", dir,
-             program, scene);
-    if (system(cmd) != 0) {
-        fprintf(stderr, "bench_substances: failed: %s\n", cmd);
-        return NAN;
-    }
-    char path[PATH_MAX + 16];
-    snprintf(path, sizeof path, "%s/stats.json", dir);
-    char *json = ensure_read_file(path);
+    char args[PATH_MAX];
+    snprintf(args, sizeof args, "run '%s' --out out", scene);
+    char *json = bench_run(program, dir, args);
     double s = ensure_json_number(json, NULL, "steps");
     free(json);
     return s;
@@ -54,30 +47,17 @@ static bool write_variant(const char *text, const char *const *pairs, int n, con
         memmove(at + to, at + from, strlen(at + from) + 1);
         memcpy(at, pairs[2 * k + 1], to);
     }
-    char path[PATH_MAX + 64];
-    snprintf(path, sizeof path, "%s/%s", dir, name);
-    FILE *f = fopen(path, "w");
-    bool ok = f != NULL && fputs(out, f) >= 0;
-    ok = f != NULL && fclose(f) == 0 && ok;
+    bool ok = ensure_write_file(dir, name, out) != NULL;
     free(out);
     return ok;
 }
 
 int main(void)
 {
-    const char *build = getenv("WX_BUILD") != NULL ? getenv("WX_BUILD") : "build";
-    char path[PATH_MAX];
-    snprintf(path, sizeof path, "%s/weathering", build);
-    if (realpath(path, program) == NULL) {
-        fprintf(stderr, "bench_substances: no %s\n", path);
+    if (!bench_workdir("bench_substances", program, dir)) {
         return 1;
     }
     char cmd[2 * PATH_MAX];
-    snprintf(cmd, sizeof cmd, "mkdir -p '%s/tmp/bench_substances/meshes'", build);
-    snprintf(path, sizeof path, "%s/tmp/bench_substances", build);
-    if (system(cmd) != 0 || realpath(path, dir) == NULL) {
-        return 1;
-    }
     snprintf(cmd, sizeof cmd, "cp xml_scenes/meshes/tank.obj xml_scenes/meshes/tank.mtl '%s/meshes/'",
              dir);
     char *scene = ensure_read_file("xml_scenes/rusty_tank.xml");
