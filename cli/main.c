@@ -38,6 +38,7 @@
 #include "pipeline/pipeline.h"
 #include "pipeline/preset.h"
 #include "pipeline/run.h"
+#include "pipeline/split.h"
 #include "pipeline/texture_phase.h"
 #include "sim/emitter.h"
 #include "sim/masks.h"
@@ -61,6 +62,9 @@ typedef struct cli_args {
     int resolution;       // 0: 1024
     const char *units;    // NULL: m
     bool force;
+    // run MESH: the scene generated in memory, loaded as scene_path's file
+    // and written there once the run's checks pass.
+    const char *scene_text;
 } cli_args;
 
 typedef int (*command_fn)(const cli_args *args);
@@ -249,12 +253,16 @@ static int parse_args(int argc, char **argv, cli_args *args)
 static int load_scene(const cli_args *args, wx_scene *scene, wx_run_def *opts)
 {
     wx_error err;
-    wx_result r = wx_scene_load(args->scene_path, scene, &err);
+    wx_result r = args->scene_text != NULL
+                      ? wx_scene_load_text(args->scene_path, args->scene_text,
+                                           strlen(args->scene_text), scene, &err)
+                      : wx_scene_load(args->scene_path, scene, &err);
     if (r != WX_OK) {
         fprintf(stderr, "weathering: %s\n", err.message);
         return r;
     }
     *opts = wx_default_run_def(scene);
+    opts->scene_text = args->scene_text;
     if (args->out_dir != NULL) {
         snprintf(opts->out_dir, sizeof opts->out_dir, "%s", args->out_dir);
     }
@@ -893,26 +901,23 @@ static int command_gather(const cli_args *args)
 
 // --- init, run MESH, split (docs/presets.md) -------------------------------------
 
+// An Ogre mesh (.mesh.xml) is XML too, but not a scene.
+static bool is_ogre_mesh(const char *path)
+{
+    size_t n = strlen(path);
+    return n >= 9 && strcasecmp(path + n - 9, ".mesh.xml") == 0;
+}
+
 // A scene file is an .xml; anything else given to `run` is a mesh.
 static bool is_scene_file(const char *path)
 {
     size_t n = strlen(path);
-    return n >= 4 && strcasecmp(path + n - 4, ".xml") == 0;
-}
-
-static void mesh_base(const char *path, char *out, size_t cap)
-{
-    const char *slash = strrchr(path, '/');
-    snprintf(out, cap, "%s", slash != NULL ? slash + 1 : path);
-    char *dot = strrchr(out, '.');
-    if (dot != NULL && dot != out) {
-        *dot = '\0';
-    }
+    return n >= 4 && strcasecmp(path + n - 4, ".xml") == 0 && !is_ogre_mesh(path);
 }
 
 // The scene text for the mesh of `args`: its path written as given when
-// `as_given`, else absolute.
-static int generate(const cli_args *args, bool as_given, char **text)
+// `as_given`, else absolute; `scene_name` (may be NULL) becomes <Weathering name>.
+static int generate(const cli_args *args, bool as_given, const char *scene_name, char **text)
 {
     char mesh_ref[WX_PATH_MAX];
     if (as_given) {
@@ -925,7 +930,8 @@ static int generate(const cli_args *args, bool as_given, char **text)
                         .mesh_ref = mesh_ref,
                         .preset = args->preset,
                         .resolution = args->resolution,
-                        .unit_m = args->units != NULL ? wx_unit_metres(args->units) : 1.0 };
+                        .unit_m = args->units != NULL ? wx_unit_metres(args->units) : 1.0,
+                        .scene_name = scene_name };
     wx_error err;
     wx_result r = wx_scene_generate(&def, text, &err);
     if (r != WX_OK) {
@@ -934,62 +940,86 @@ static int generate(const cli_args *args, bool as_given, char **text)
     return r;
 }
 
-// Creates `path` and its parents (mkdir -p).
-static bool make_folder(const char *path)
+// Where `init` may write its scene: a new or regular file (with --force) in a
+// folder that exists, never the mesh. Exit 2 with the reason otherwise.
+static int check_init_target(const cli_args *args, const char *scene_path)
 {
-    char buf[WX_PATH_MAX];
-    snprintf(buf, sizeof buf, "%s", path);
-    for (char *p = buf + 1; *p != '\0'; ++p) {
-        if (*p == '/') {
-            *p = '\0';
-            if (mkdir(buf, 0777) != 0 && errno != EEXIST) {
-                return false;
-            }
-            *p = '/';
+    struct stat st, target, mesh;
+    if (lstat(scene_path, &st) == 0) {
+        bool same = stat(scene_path, &target) == 0 && stat(args->scene_path, &mesh) == 0 &&
+                    target.st_dev == mesh.st_dev && target.st_ino == mesh.st_ino;
+        if (same) {
+            fprintf(stderr,
+                    "weathering: %s: is the mesh itself; the scene never replaces it (give -o "
+                    "SCENE.xml)\n",
+                    scene_path);
+            return WX_BAD_INPUT;
+        }
+        if (!S_ISREG(st.st_mode)) {
+            fprintf(stderr, "weathering: %s: exists and is %s; choose another -o\n", scene_path,
+                    wx_file_kind(st.st_mode));
+            return WX_BAD_INPUT;
+        }
+        if (!args->force) {
+            fprintf(stderr, "weathering: %s exists; give --force to replace it\n", scene_path);
+            return WX_BAD_INPUT;
         }
     }
-    return mkdir(buf, 0777) == 0 || errno == EEXIST;
+    char folder[WX_PATH_MAX] = ".";
+    const char *slash = strrchr(scene_path, '/');
+    if (slash != NULL) { // "/x.xml": "/"
+        int len = slash == scene_path ? 1 : (int)(slash - scene_path);
+        snprintf(folder, sizeof folder, "%.*s", len, scene_path);
+    }
+    struct stat dir;
+    if (stat(folder, &dir) != 0 || !S_ISDIR(dir.st_mode)) {
+        fprintf(stderr, "weathering: -o %s: folder %s does not exist\n", scene_path, folder);
+        return WX_BAD_INPUT;
+    }
+    return WX_OK;
 }
 
 static int command_init(const cli_args *args)
 {
     char scene_path[WX_PATH_MAX], base[256];
-    mesh_base(args->scene_path, base, sizeof base);
+    wx_mesh_name(args->scene_path, base, sizeof base);
     if (args->init_out != NULL) {
         snprintf(scene_path, sizeof scene_path, "%s", args->init_out);
     } else {
         snprintf(scene_path, sizeof scene_path, "%s.xml", base);
     }
     if (!is_scene_file(scene_path)) {
-        return usage_error("-o %s: the scene's name must end in .xml", scene_path);
+        return usage_error("-o %s: the scene's name must end in .xml (and not .mesh.xml)",
+                           scene_path);
     }
-    struct stat st;
-    if (!args->force && stat(scene_path, &st) == 0) {
-        fprintf(stderr, "weathering: %s exists; give --force to replace it\n", scene_path);
-        return WX_BAD_INPUT;
+    int status = check_init_target(args, scene_path);
+    if (status != WX_OK) {
+        return status;
     }
     // The mesh as the scene names it: as given when the scene is written in the
     // current folder and the path is relative, else absolute.
     bool as_given = strchr(scene_path, '/') == NULL && args->scene_path[0] != '/';
     char *text = NULL;
-    int status = generate(args, as_given, &text);
+    status = generate(args, as_given, NULL, &text);
     if (status != WX_OK) {
         return status;
     }
+    // What the scene says, checked as a run would read it, before it is written.
     wx_error err;
-    wx_result r = wx_write_file_atomic(scene_path, text, strlen(text), &err);
-    free(text);
-    if (r != WX_OK) {
-        fprintf(stderr, "weathering: %s\n", err.message);
-        return r;
-    }
-    // What the scene says, checked as a run would read it.
     wx_scene scene;
-    r = wx_scene_load(scene_path, &scene, &err);
+    wx_result r = wx_scene_load_text(scene_path, text, strlen(text), &scene, &err);
     if (r != WX_OK) {
         fprintf(stderr, "weathering: the generated scene does not load (a bug): %s\n",
                 err.message);
+        free(text);
         return WX_FAIL;
+    }
+    r = wx_write_file_atomic(scene_path, text, strlen(text), &err);
+    free(text);
+    if (r != WX_OK) {
+        fprintf(stderr, "weathering: %s\n", err.message);
+        wx_scene_free(&scene);
+        return r;
     }
     if (!args->quiet) {
         fprintf(stderr,
@@ -1009,97 +1039,46 @@ static int command_run(const cli_args *args)
     if (is_scene_file(args->scene_path)) {
         return run_phases(args, all);
     }
-    // A mesh: its scene generated into the output folder as scene.xml, then run.
+    // A mesh: its scene generated in memory, named after the mesh, run as
+    // OUT/scene.xml and written there once the run's checks pass.
     char out_dir[WX_PATH_MAX], base[256], scene_path[WX_PATH_MAX + 16];
-    mesh_base(args->scene_path, base, sizeof base);
+    wx_mesh_name(args->scene_path, base, sizeof base);
     if (args->out_dir != NULL) {
         snprintf(out_dir, sizeof out_dir, "%s", args->out_dir);
     } else {
         snprintf(out_dir, sizeof out_dir, "out/%s", base);
     }
     char *text = NULL;
-    int status = generate(args, false, &text);
+    int status = generate(args, false, base, &text);
     if (status != WX_OK) {
         return status;
     }
     snprintf(scene_path, sizeof scene_path, "%s/scene.xml", out_dir);
-    wx_error err;
-    wx_result r = make_folder(out_dir)
-                      ? wx_write_file_atomic(scene_path, text, strlen(text), &err)
-                      : wx_fail(&err, WX_CAUSE_UNREADABLE, "%s: cannot create the folder",
-                                out_dir);
-    free(text);
-    if (r != WX_OK) {
-        fprintf(stderr, "weathering: %s\n", err.message);
-        return r;
-    }
     cli_args scene_args = *args;
     scene_args.scene_path = scene_path;
     scene_args.out_dir = out_dir;
-    return run_phases(&scene_args, all);
+    scene_args.scene_text = text;
+    status = run_phases(&scene_args, all);
+    free(text);
+    return status;
 }
 
-// Every channel of an EXR as a single-channel file BASE_NAME.exr (channel Y
-// inside; NAME.Y gives BASE_NAME), for programs that read one layer at a time
-// (Blender 3.4's shader nodes). Prints the written paths.
+static void print_written(const char *path, void *context)
+{
+    (void)context;
+    printf("%s\n", path);
+}
+
+// Every channel of an EXR as a single-channel file BASE_NAME.exr (split.h);
+// prints the written paths on stdout.
 static int command_split(const cli_args *args)
 {
-    wx_image *in = calloc(1, sizeof *in), *one = calloc(1, sizeof *one);
+    wx_split_def def = { .input = args->scene_path,
+                         .out_dir = args->out_dir,
+                         .on_written = print_written };
     wx_error err;
-    wx_result r = in != NULL && one != NULL ? wx_exr_read_header(args->scene_path, in, &err)
-                                            : wx_fail(&err, WX_CAUSE_OUT_OF_MEMORY, "out of memory");
-    int count = r == WX_OK ? in->channel_count : 0;
-    char names[WX_IMAGE_MAX_CHANNELS][WX_NAME_MAX];
-    const char *wanted[WX_IMAGE_MAX_CHANNELS];
-    for (int c = 0; c < count; ++c) {
-        snprintf(names[c], WX_NAME_MAX, "%s", in->channel_names[c]);
-        wanted[c] = names[c];
-    }
-    if (in != NULL) {
-        wx_image_free(in);
-    }
-    if (r == WX_OK) {
-        r = wx_exr_read(args->scene_path, wanted, count, in, &err);
-    }
-    char dir[WX_PATH_MAX], base[256];
-    const char *slash = strrchr(args->scene_path, '/');
-    if (args->out_dir != NULL) {
-        snprintf(dir, sizeof dir, "%s", args->out_dir);
-    } else if (slash != NULL) {
-        snprintf(dir, sizeof dir, "%.*s", (int)(slash - args->scene_path), args->scene_path);
-    } else {
-        snprintf(dir, sizeof dir, ".");
-    }
-    mesh_base(args->scene_path, base, sizeof base);
-    static const char *const y[1] = { "Y" };
-    for (int c = 0; c < count && r == WX_OK; ++c) {
-        char name[WX_NAME_MAX], path[WX_PATH_MAX + 512];
-        snprintf(name, sizeof name, "%s", names[c]);
-        size_t n = strlen(name);
-        if (n > 2 && strcmp(name + n - 2, ".Y") == 0) {
-            name[n - 2] = '\0';
-        }
-        snprintf(path, sizeof path, "%s/%s_%s.exr", dir, base, name);
-        r = wx_image_alloc(one, in->width, in->height, 1, y, &err);
-        if (r == WX_OK) {
-            memcpy(one->channels[0], in->channels[c],
-                   (size_t)in->width * (size_t)in->height * sizeof(float));
-            r = wx_exr_write(path, one, &err);
-            wx_image_free(one);
-        }
-        if (r == WX_OK) {
-            printf("%s\n", path);
-        }
-    }
-    if (r != WX_OK) {
-        fprintf(stderr, "weathering: %s\n", err.message);
-    }
-    if (in != NULL) {
-        wx_image_free(in);
-    }
-    free(in);
-    free(one);
-    return r;
+    wx_result r = wx_split_exr(&def, &err);
+    return report(r, &err);
 }
 
 // --- interrupts -------------------------------------------------------------------

@@ -9,6 +9,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include <libxml/parser.h>
 #include <libxml/xmlschemas.h>
@@ -203,11 +204,118 @@ TEST(bad_input_is_exit_2)
     ENSURE(run_in(dir, "info keep.xml --preset %s%s", "rain", "") == 2);
 }
 
+// `run MESH` names its folder and scene after the mesh by the scene-name rule
+// (issue 24): "...obj" writes into out/__/, never into out/.. (the current
+// folder); the scene it writes there runs into the same folder again.
+TEST(run_mesh_folder_is_plain_and_named_after_the_mesh)
+{
+    char dir[PATH_MAX + 16];
+    snprintf(dir, sizeof dir, "%s/dots", ensure_tmpdir());
+    ENSURE(ensure_shell(NULL, 0, "mkdir -p '%s' && cp '%s' '%s/...obj'", dir,
+                        data_file("texture_cube.obj"), dir) == 0);
+    ensure_write_file(dir, "scene.xml", "mine");
+    ENSURE(run_in(dir, "run %s --resolution 48 -q%s", "...obj", "") == 0);
+    char path[PATH_MAX + 64];
+    snprintf(path, sizeof path, "%s/scene.xml", dir);
+    char *kept = ensure_read_file(path);
+    ENSURE(kept != NULL && strcmp(kept, "mine") == 0);
+    free(kept);
+    snprintf(path, sizeof path, "%s/mask.exr", dir);
+    ENSURE(access(path, F_OK) != 0);
+    snprintf(path, sizeof path, "%s/out/__/scene.xml", dir);
+    char *scene = ensure_read_file(path);
+    ENSURE(scene != NULL && strstr(scene, "<Weathering name=\"__\">") != NULL);
+    free(scene);
+    // Run again from its own scene: the same folder, not out/scene.
+    ENSURE(run_in(dir, "run out/__/scene.xml -q%s%s", "", "") == 0);
+    snprintf(path, sizeof path, "%s/out/scene", dir);
+    ENSURE(access(path, F_OK) != 0);
+}
+
+// `run MESH --out DIR` never replaces a DIR/scene.xml of the user's (one that
+// no `run MESH` generated), and a refusal leaves no folder and no scene.
+TEST(run_mesh_keeps_a_users_scene_and_leaves_nothing_on_refusal)
+{
+    char dir[PATH_MAX + 16];
+    snprintf(dir, sizeof dir, "%s/users", ensure_tmpdir());
+    ENSURE(ensure_shell(NULL, 0, "mkdir -p '%s/mine'", dir) == 0);
+    ensure_write_file(dir, "mine/scene.xml", "<Weathering/>");
+    ENSURE(run_in(dir, "run '%s' --out mine --resolution 48 -q%s", data_file("texture_cube.obj"),
+                  "") == 2);
+    ENSURE(strstr(out, "mine/scene.xml: exists and is not a scene that `weathering run MESH` "
+                       "generated") != NULL);
+    char path[PATH_MAX + 64];
+    snprintf(path, sizeof path, "%s/mine/scene.xml", dir);
+    char *kept = ensure_read_file(path);
+    ENSURE(kept != NULL && strcmp(kept, "<Weathering/>") == 0);
+    free(kept);
+    // A generated scene is replaced by the next run of a mesh.
+    ENSURE(run_in(dir, "run '%s' --out gen --resolution 48 -q%s", data_file("texture_cube.obj"),
+                  "") == 0);
+    ENSURE(run_in(dir, "run '%s' --out gen --resolution 48 --preset dust -q%s",
+                  data_file("texture_cube.obj"), "") == 0);
+    // Refused for memory: nothing at all is made.
+    char build[PATH_MAX];
+    ENSURE(realpath(ensure_build_dir(), build) != NULL);
+    int status = ensure_shell(out, sizeof out,
+                              "cd '%s' && WX_MEMORY_AVAILABLE_MB=50 '%s/weathering' run '%s' "
+                              "--out fresh/sub -q",
+                              dir, build, data_file("texture_cube.obj"));
+    ENSURE(status == 2 && strstr(out, "memory") != NULL);
+    snprintf(path, sizeof path, "%s/fresh", dir);
+    ENSURE(access(path, F_OK) != 0);
+}
+
+// `init` never writes over the mesh (an Ogre X.mesh.xml, with or without
+// --force); -o into a missing folder or onto a folder is exit 2, nothing written.
+TEST(init_never_writes_over_the_mesh_and_checks_its_target)
+{
+    char dir[PATH_MAX + 16];
+    snprintf(dir, sizeof dir, "%s/ogre", ensure_tmpdir());
+    ENSURE(ensure_shell(NULL, 0, "mkdir -p '%s'", dir) == 0);
+    static const char ogre[] =
+        "<mesh><submeshes><submesh material=\"wall\" usesharedvertices=\"false\" "
+        "operationtype=\"triangle_list\"><faces count=\"2\"><face v1=\"0\" v2=\"1\" "
+        "v3=\"2\"/><face v1=\"0\" v2=\"2\" v3=\"3\"/></faces><geometry vertexcount=\"4\">"
+        "<vertexbuffer positions=\"true\"><vertex><position x=\"0\" y=\"0\" z=\"0\"/></vertex>"
+        "<vertex><position x=\"1\" y=\"0\" z=\"0\"/></vertex><vertex><position x=\"1\" "
+        "y=\"0\" z=\"1\"/></vertex><vertex><position x=\"0\" y=\"0.5\" z=\"1\"/></vertex>"
+        "</vertexbuffer></geometry></submesh></submeshes></mesh>\n";
+    ensure_write_file(dir, "cube.mesh.xml", ogre);
+    ENSURE(run_in(dir, "init cube.mesh.xml --force -q%s%s", "", "") == 0);
+    char path[PATH_MAX + 64];
+    snprintf(path, sizeof path, "%s/cube.mesh.xml", dir);
+    char *mesh = ensure_read_file(path);
+    ENSURE(mesh != NULL && strcmp(mesh, ogre) == 0);
+    free(mesh);
+    snprintf(path, sizeof path, "%s/cube.xml", dir);
+    ENSURE(schema_accepts(path));
+    // The mesh under another name (a hard link) is still the mesh.
+    ENSURE(ensure_shell(NULL, 0, "cd '%s' && ln cube.mesh.xml same.xml && mkdir folder.xml",
+                        dir) == 0);
+    ENSURE(run_in(dir, "init cube.mesh.xml -o %s --force%s", "same.xml", "") == 2);
+    ENSURE(strstr(out, "is the mesh itself") != NULL);
+    ENSURE(run_in(dir, "init cube.mesh.xml -o %s --force%s", "cube.mesh.xml", "") == 2);
+    ENSURE(run_in(dir, "init cube.mesh.xml -o %s --force%s", "folder.xml", "") == 2);
+    ENSURE(strstr(out, "folder.xml: exists and is a folder") != NULL);
+    ENSURE(run_in(dir, "init cube.mesh.xml -o %s%s", "missing/x.xml", "") == 2);
+    ENSURE(strstr(out, "folder missing does not exist") != NULL);
+    snprintf(path, sizeof path, "%s/missing", dir);
+    ENSURE(access(path, F_OK) != 0);
+    snprintf(path, sizeof path, "%s/cube.mesh.xml", dir);
+    mesh = ensure_read_file(path);
+    ENSURE(mesh != NULL && strcmp(mesh, ogre) == 0);
+    free(mesh);
+}
+
 int main(void)
 {
     RUN(presets_make_valid_scenes_and_rain_dirties_the_top);
     RUN(sizes_scale_with_the_mesh);
     RUN(run_a_mesh_and_split_its_texture);
     RUN(bad_input_is_exit_2);
+    RUN(run_mesh_folder_is_plain_and_named_after_the_mesh);
+    RUN(run_mesh_keeps_a_users_scene_and_leaves_nothing_on_refusal);
+    RUN(init_never_writes_over_the_mesh_and_checks_its_target);
     return ensure_summary();
 }

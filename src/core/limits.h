@@ -27,6 +27,12 @@
 #define WX_NAME_MAX 64
 #define WX_ATTR_STRING_MAX 1024
 
+/// Longest file name (one path component) the file systems take (NAME_MAX),
+/// and what a temporary ".NAME.tmpPID" adds to a name: '.', ".tmp" and a
+/// process id of up to 10 digits. So an output's name has at most 240 bytes.
+#define WX_FILE_NAME_MAX 255
+#define WX_TEMP_NAME_EXTRA 15
+
 /// Longest plain file name the program writes into an output folder.
 #define WX_OUTPUT_NAME_MAX 320
 

@@ -320,6 +320,26 @@ static void list_alternatives(const char *wanted, char *buf, size_t cap)
 
 // Finds the channel for `wanted` ("R|Z": the first alternative the file has).
 // Returns its index in the channel list, or -1 with the error set.
+/// Channel c when its pixels can be read as floats, else -1 with the reason.
+static int check_channel(const char *path, const exr_attr_chlist_t *chlist, int c, wx_error *err)
+{
+    const exr_attr_chlist_entry_t *e = &chlist->entries[c];
+    int len = e->name.length > 0 ? e->name.length : 0;
+    const char *name = e->name.str != NULL ? e->name.str : "";
+    if (e->pixel_type != EXR_PIXEL_FLOAT && e->pixel_type != EXR_PIXEL_HALF) {
+        wx_fail(err, WX_CAUSE_BAD_MAP, "%s: channel %.*s holds integers (float or half expected)",
+                path, len, name);
+        return -1;
+    }
+    if (e->x_sampling != 1 || e->y_sampling != 1) {
+        wx_fail(err, WX_CAUSE_BAD_MAP,
+                "%s: channel %.*s is subsampled (%d x %d), which is not supported", path, len,
+                name, e->x_sampling, e->y_sampling);
+        return -1;
+    }
+    return c;
+}
+
 static int find_channel(const char *path, const exr_attr_chlist_t *chlist, const char *wanted,
                         wx_error *err)
 {
@@ -327,23 +347,9 @@ static int find_channel(const char *path, const exr_attr_chlist_t *chlist, const
         const char *bar = strchr(p, '|');
         size_t len = bar != NULL ? (size_t)(bar - p) : strlen(p);
         for (int c = 0; c < chlist->num_channels; c++) {
-            const exr_attr_chlist_entry_t *e = &chlist->entries[c];
-            if (!name_equals(&e->name, p, len)) {
-                continue;
+            if (name_equals(&chlist->entries[c].name, p, len)) {
+                return check_channel(path, chlist, c, err);
             }
-            if (e->pixel_type != EXR_PIXEL_FLOAT && e->pixel_type != EXR_PIXEL_HALF) {
-                wx_fail(err, WX_CAUSE_BAD_MAP,
-                        "%s: channel %.*s holds integers (float or half expected)", path, (int)len,
-                        p);
-                return -1;
-            }
-            if (e->x_sampling != 1 || e->y_sampling != 1) {
-                wx_fail(err, WX_CAUSE_BAD_MAP,
-                        "%s: channel %.*s is subsampled (%d x %d), which is not supported", path,
-                        (int)len, p, e->x_sampling, e->y_sampling);
-                return -1;
-            }
-            return c;
         }
         if (bar == NULL) {
             break;
@@ -549,7 +555,7 @@ static wx_result read_channels(const char *path, const char *const *wanted, int 
                                bool planar, int threads, wx_image *out, float **interleaved,
                                wx_error *err)
 {
-    if (wanted == NULL || wanted_count < 1 || wanted_count > WX_IMAGE_MAX_CHANNELS) {
+    if ((wanted != NULL && wanted_count < 1) || wanted_count > WX_IMAGE_MAX_CHANNELS) {
         return wx_fail(err, WX_CAUSE_INTERNAL, "%s: cannot read %d channels (1 to %d)", path,
                             wanted_count, WX_IMAGE_MAX_CHANNELS);
     }
@@ -559,9 +565,25 @@ static wx_result read_channels(const char *path, const char *const *wanted, int 
     if (result != WX_OK) {
         return result;
     }
+    if (wanted == NULL) { // every channel, in the file's order
+        wanted_count = chlist->num_channels;
+        if (wanted_count > WX_IMAGE_MAX_CHANNELS) {
+            reader_close(&r);
+            return wx_fail(err, WX_CAUSE_BAD_MAP, "%s: %d channels, more than the %d supported",
+                           path, wanted_count, WX_IMAGE_MAX_CHANNELS);
+        }
+    }
     read_target targets[WX_IMAGE_MAX_CHANNELS];
     for (int i = 0; i < wanted_count; i++) {
-        int c = find_channel(path, chlist, wanted[i], err);
+        int length = chlist->entries[i].name.length;
+        if (wanted == NULL && length >= WX_NAME_MAX) {
+            reader_close(&r); // frees chlist
+            return wx_fail(err, WX_CAUSE_BAD_MAP,
+                           "%s: channel %d's name has %d characters, more than the %d supported",
+                           path, i + 1, length, WX_NAME_MAX - 1);
+        }
+        int c = wanted != NULL ? find_channel(path, chlist, wanted[i], err)
+                               : check_channel(path, chlist, i, err);
         if (c < 0) {
             reader_close(&r);
             return WX_BAD_INPUT;
@@ -643,7 +665,15 @@ wx_result wx_exr_read_header(const char *path, wx_image *out, wx_error *err)
                             chlist->num_channels, WX_IMAGE_MAX_CHANNELS);
     }
     for (int c = 0; c < chlist->num_channels; c++) {
-        copy_string(out->channel_names[c], sizeof out->channel_names[c], &chlist->entries[c].name);
+        const exr_attr_string_t *name = &chlist->entries[c].name;
+        int length = name->length;
+        if (length >= WX_NAME_MAX) {
+            reader_close(&r); // frees chlist
+            return wx_fail(err, WX_CAUSE_BAD_MAP,
+                           "%s: channel %d's name has %d characters, more than the %d supported",
+                           path, c + 1, length, WX_NAME_MAX - 1);
+        }
+        copy_string(out->channel_names[c], sizeof out->channel_names[c], name);
     }
     out->channel_count = chlist->num_channels;
     out->width = r.width;
@@ -657,6 +687,11 @@ wx_result wx_exr_read(const char *path, const char *const *wanted, int wanted_co
                       wx_error *err)
 {
     return wx_exr_read_parallel(path, wanted, wanted_count, 1, out, err);
+}
+
+wx_result wx_exr_read_all(const char *path, wx_image *out, wx_error *err)
+{
+    return wx_exr_read_parallel(path, NULL, 0, 1, out, err);
 }
 
 wx_result wx_exr_read_parallel(const char *path, const char *const *wanted, int wanted_count,

@@ -27,6 +27,10 @@ wx_result wx_exr_read_header(const char *path, wx_image *out, wx_error *err);
 wx_result wx_exr_read(const char *path, const char *const *wanted, int wanted_count,
                       wx_image *out, wx_error *err);
 
+/// Reads every channel of `path`, in the file's order (names taken as they
+/// are: no '|' alternatives), as wx_exr_read does.
+wx_result wx_exr_read_all(const char *path, wx_image *out, wx_error *err);
+
 /// wx_exr_read with the chunks decoded on `threads` workers (<= 1: the calling
 /// thread): the same planes and the same messages for any count.
 wx_result wx_exr_read_parallel(const char *path, const char *const *wanted, int wanted_count,

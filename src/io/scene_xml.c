@@ -256,18 +256,17 @@ static wx_result read_file(const char *path, char **text, size_t *size, wx_error
     return WX_OK;
 }
 
-static wx_result read_document(const char *path, xmlDocPtr *out, wx_error *err)
+/// Parses `size` bytes of scene text; `path` names it in messages.
+static wx_result parse_document(const char *path, const char *text, size_t size, xmlDocPtr *out,
+                                wx_error *err)
 {
     *out = NULL;
-    char *text;
-    size_t size;
-    wx_result r = read_file(path, &text, &size, err);
-    if (r != WX_OK) {
-        return r;
+    if (size > (size_t)SCENE_MAX_BYTES) {
+        return wx_fail(err, WX_CAUSE_TOO_MANY, "%s: scene file too large (over %ld bytes)", path,
+                       SCENE_MAX_BYTES);
     }
     xmlParserCtxtPtr ctxt = xmlNewParserCtxt();
     if (ctxt == NULL) {
-        free(text);
         return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "%s: out of memory", path);
     }
     xml_errors st = { 0 };
@@ -281,7 +280,6 @@ static wx_result read_document(const char *path, xmlDocPtr *out, wx_error *err)
     bool well_formed = ctxt->wellFormed != 0;
     xmlSetStructuredErrorFunc(old_context, old_handler);
     xmlFreeParserCtxt(ctxt);
-    free(text);
     if (st.set || doc == NULL || !well_formed) {
         xmlFreeDoc(doc);
         if (st.set) {
@@ -291,6 +289,19 @@ static wx_result read_document(const char *path, xmlDocPtr *out, wx_error *err)
     }
     *out = doc;
     return WX_OK;
+}
+
+static wx_result read_document(const char *path, xmlDocPtr *out, wx_error *err)
+{
+    *out = NULL;
+    char *text;
+    size_t size;
+    wx_result r = read_file(path, &text, &size, err);
+    if (r == WX_OK) {
+        r = parse_document(path, text, size, out, err);
+        free(text);
+    }
+    return r;
 }
 
 // ---------------------------------------------------------------------------
@@ -2894,6 +2905,13 @@ static wx_result check_texture_names(parser *p)
     return WX_OK;
 }
 
+/// `name` replaces the name the scene file's own name gives (the default
+/// output folder out/NAME/): a scene that `run MESH` generated as scene.xml
+/// keeps its mesh's name (docs/scene-format-notes.md).
+static const attr_spec root_attrs[] = {
+    { "name", T_NAME, offsetof(wx_scene, name), .size = sizeof(((wx_scene *)0)->name) },
+};
+
 static wx_result parse_root(parser *p, const xmlNode *node)
 {
     if (node == NULL) {
@@ -2904,7 +2922,8 @@ static wx_result parse_root(parser *p, const xmlNode *node)
                     "the root element is <%s>, expected <Weathering>", name_of(node));
     }
     wx_result r = check_content(p, node);
-    if (r != WX_OK || (r = NO_ATTRS()) != WX_OK || (r = read_substances_first(p, node)) != WX_OK ||
+    if (r != WX_OK || (r = ATTRS(root_attrs, p->scene, NULL)) != WX_OK ||
+        (r = read_substances_first(p, node)) != WX_OK ||
         (r = CHILDREN(root_children, NULL, NULL)) != WX_OK) {
         return r;
     }
@@ -2961,13 +2980,16 @@ static wx_result scene_init(wx_scene *s, const char *path, wx_error *err)
     return WX_OK;
 }
 
-wx_result wx_scene_load(const char *path, wx_scene *out, wx_error *err)
+/// Loads the scene from its file, or from `text` (size bytes) when not NULL.
+static wx_result scene_load(const char *path, const char *text, size_t size, wx_scene *out,
+                            wx_error *err)
 {
     memset(out, 0, sizeof *out);
     wx_result r = scene_init(out, path, err);
     xmlDocPtr doc = NULL;
     if (r == WX_OK) {
-        r = read_document(path, &doc, err);
+        r = text != NULL ? parse_document(path, text, size, &doc, err)
+                         : read_document(path, &doc, err);
     }
     if (r == WX_OK) {
         // Numbers are read with '.' as the decimal point whatever the locale.
@@ -2985,4 +3007,15 @@ wx_result wx_scene_load(const char *path, wx_scene *out, wx_error *err)
         wx_scene_free(out);
     }
     return r;
+}
+
+wx_result wx_scene_load(const char *path, wx_scene *out, wx_error *err)
+{
+    return scene_load(path, NULL, 0, out, err);
+}
+
+wx_result wx_scene_load_text(const char *path, const char *text, size_t size, wx_scene *out,
+                             wx_error *err)
+{
+    return scene_load(path, text, size, out, err);
 }

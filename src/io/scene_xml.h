@@ -14,4 +14,10 @@
 /// to free) and err holds "path:LINE: message" (WX_BAD_INPUT) or an I/O error.
 wx_result wx_scene_load(const char *path, wx_scene *out, wx_error *err);
 
+/// wx_scene_load of a scene held in memory (`size` bytes of `text`), as if it
+/// were the file `path`: relative paths inside it are relative to path's
+/// folder, messages name path. The file itself is never opened.
+wx_result wx_scene_load_text(const char *path, const char *text, size_t size, wx_scene *out,
+                             wx_error *err);
+
 #endif

@@ -12,11 +12,13 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <dirent.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include "core/array.h"
 #include "core/atomic_file.h"
+#include "pipeline/preset.h"
 
 void wx_preview_name(const char *mask_name, char *out, size_t cap)
 {
@@ -128,8 +130,7 @@ void wx_output_names_free(wx_output_names *names)
     memset(names, 0, sizeof *names);
 }
 
-// mkdir -p: creates every missing folder of `path`; `created` gets the first one made.
-static wx_result make_folders(const char *path, char created[WX_PATH_MAX], wx_error *err)
+wx_result wx_make_folders(const char *path, char created[WX_PATH_MAX], wx_error *err)
 {
     char partial[WX_PATH_MAX];
     size_t len = strlen(path);
@@ -187,7 +188,7 @@ wx_result wx_output_prepare(const wx_scene *scene, const wx_run_def *opts,
                             char created[WX_PATH_MAX], wx_error *err)
 {
     char made[WX_PATH_MAX];
-    wx_result r = make_folders(opts->out_dir, made, err);
+    wx_result r = wx_make_folders(opts->out_dir, made, err);
     if (created != NULL) {
         memcpy(created, made, sizeof made);
     }
@@ -302,8 +303,7 @@ wx_result wx_output_path(const wx_scene *scene, const wx_run_def *opts, const ch
     return WX_OK;
 }
 
-// What a path that is not a regular file is, for messages (lstat: a link is a link).
-static const char *file_kind(mode_t mode)
+const char *wx_file_kind(unsigned mode)
 {
     return S_ISLNK(mode)    ? "a symbolic link"
            : S_ISDIR(mode)  ? "a folder"
@@ -380,7 +380,7 @@ static wx_result check_stats_path(const wx_scene *scene, const wx_run_def *opts,
             return wx_fail(err, WX_CAUSE_OUTPUT_CONFLICT,
                            "--stats %s: exists and is %s; the statistics are written only "
                            "to a new or a regular file",
-                           path, file_kind(st.st_mode));
+                           path, wx_file_kind(st.st_mode));
         }
         if (is_scene_input(scene, &st)) {
             return wx_fail(err, WX_CAUSE_OUTPUT_CONFLICT,
@@ -414,11 +414,77 @@ static wx_result check_stats_path(const wx_scene *scene, const wx_run_def *opts,
     return WX_OK;
 }
 
+// The scene `run MESH` generated (opts->scene_text) replaces only a regular
+// file that an earlier `run MESH` generated: never a user's own scene.xml, a
+// link or a folder.
+static wx_result check_scene_copy(const wx_scene *scene, wx_error *err)
+{
+    struct stat st;
+    if (lstat(scene->path, &st) != 0) {
+        return WX_OK;
+    }
+    if (!S_ISREG(st.st_mode)) {
+        return wx_fail(err, WX_CAUSE_OUTPUT_CONFLICT,
+                       "%s: exists and is %s, where the run writes the scene it generated; "
+                       "remove it or choose another --out folder",
+                       scene->path, wx_file_kind(st.st_mode));
+    }
+    char head[512] = "";
+    FILE *f = fopen(scene->path, "rb");
+    if (f != NULL) {
+        size_t n = fread(head, 1, sizeof head - 1, f);
+        head[n] = '\0';
+        fclose(f);
+    }
+    if (strstr(head, WX_GENERATED_SCENE_MARK) == NULL) {
+        return wx_fail(err, WX_CAUSE_OUTPUT_CONFLICT,
+                       "%s: exists and is not a scene that `weathering run MESH` generated; "
+                       "it is kept: choose another --out folder or remove it",
+                       scene->path);
+    }
+    return WX_OK;
+}
+
+wx_result wx_output_write_scene(const wx_scene *scene, const wx_run_def *opts, wx_error *err)
+{
+    if (opts->scene_text == NULL) {
+        return WX_OK;
+    }
+    return wx_write_file_atomic(scene->path, opts->scene_text, strlen(opts->scene_text), err);
+}
+
+void wx_output_remove_scene(const wx_scene *scene, const wx_run_def *opts, const char *created)
+{
+    if (opts->scene_text == NULL || created == NULL || created[0] == '\0') {
+        return;
+    }
+    // Only from a folder this run made, and only when the scene is all it holds.
+    DIR *dir = opendir(opts->out_dir);
+    if (dir == NULL) {
+        return;
+    }
+    const char *slash = strrchr(scene->path, '/');
+    const char *base = slash != NULL ? slash + 1 : scene->path;
+    int others = 0;
+    for (struct dirent *e = readdir(dir); e != NULL; e = readdir(dir)) {
+        others += strcmp(e->d_name, ".") != 0 && strcmp(e->d_name, "..") != 0 &&
+                  strcmp(e->d_name, base) != 0;
+    }
+    closedir(dir);
+    if (others == 0) {
+        unlink(scene->path);
+    }
+}
+
 wx_result wx_check_outputs(const wx_scene *scene, const wx_run_def *opts, unsigned phases,
                            wx_error *err)
 {
     wx_output_names names;
-    wx_result r = wx_output_names_list(scene, phases, &names, err);
+    wx_result r = opts->scene_text != NULL ? check_scene_copy(scene, err) : WX_OK;
+    if (r != WX_OK) {
+        return r;
+    }
+    r = wx_output_names_list(scene, phases, &names, err);
     for (int k = 0; k < names.count && r == WX_OK; ++k) {
         char path[WX_PATH_MAX];
         r = wx_output_path(scene, opts, names.names[k], path, err);
@@ -427,7 +493,7 @@ wx_result wx_check_outputs(const wx_scene *scene, const wx_run_def *opts, unsign
             r = wx_fail(err, WX_CAUSE_OUTPUT_CONFLICT,
                         "%s: exists and is %s, where the run writes its output %s; remove "
                         "it or choose another --out folder",
-                        path, file_kind(st.st_mode), names.names[k]);
+                        path, wx_file_kind(st.st_mode), names.names[k]);
         }
     }
     if (r == WX_OK && opts->stats_path != NULL) {

@@ -20,6 +20,10 @@ typedef struct wx_output_names {
     char (*names)[WX_OUTPUT_NAME_MAX];
 } wx_output_names;
 
+/// What a path that is not a regular file is, for messages, from its
+/// st_mode (lstat's: a link is "a symbolic link"): "a folder", "a FIFO"...
+const char *wx_file_kind(unsigned mode);
+
 /// Lists every file that the phases in `phases` write for `scene`: the maps
 /// `bake` writes (<camera>_depth.exr ... for each <View> camera without map
 /// files), the dirt map `simulate` writes for each input camera
@@ -50,6 +54,21 @@ wx_result wx_check_outputs(const wx_scene *scene, const wx_run_def *opts, unsign
 /// "" when the folder existed.
 wx_result wx_output_prepare(const wx_scene *scene, const wx_run_def *opts,
                             char created[WX_PATH_MAX], wx_error *err);
+
+/// `run MESH`: writes the generated scene (opts->scene_text) to the scene's
+/// path in the output folder; nothing when there is none. wx_check_outputs
+/// has made sure it replaces no file but one an earlier `run MESH` generated.
+wx_result wx_output_write_scene(const wx_scene *scene, const wx_run_def *opts, wx_error *err);
+
+/// After a failed run: removes the generated scene written by
+/// wx_output_write_scene when the run made the output folder (`created` not
+/// empty) and the scene is the only file in it, so that the folder goes too.
+void wx_output_remove_scene(const wx_scene *scene, const wx_run_def *opts, const char *created);
+
+/// mkdir -p: creates every missing folder of `path`; `created` gets the
+/// topmost one made ("" when the folder existed). WX_BAD_INPUT when `path`
+/// exists and is not a folder, WX_FAIL when a folder cannot be made.
+wx_result wx_make_folders(const char *path, char created[WX_PATH_MAX], wx_error *err);
 
 /// After a failed run: removes the output folder and the parents up to
 /// `created` (what wx_output_prepare made) when they are empty.

@@ -18,6 +18,9 @@ typedef struct wx_run_def {
     int threads;               ///< worker threads, >= 1 (default: all cores)
     bool quiet;                ///< -q: no progress bars, no notes on stderr
     const char *stats_path;    ///< --stats FILE.json, or NULL
+    /// `run MESH`: the text of the scene generated in memory, written to the
+    /// scene's path (OUT/scene.xml) once every check passed, or NULL.
+    const char *scene_text;
 } wx_run_def;
 
 /// Default run options for a scene: out/<scene name>/ (the name made safe: see

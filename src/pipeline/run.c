@@ -97,6 +97,9 @@ wx_result wx_run_phases(wx_scene *scene, const wx_run_def *opts, unsigned phases
     if (r == WX_OK) {
         r = wx_output_prepare(scene, opts, created, err);
     }
+    if (r == WX_OK) {
+        r = wx_output_write_scene(scene, opts, err);
+    }
     wx_textures textures;
     memset(&textures, 0, sizeof textures);
     if (r == WX_OK && textures_needed) {
@@ -179,6 +182,7 @@ wx_result wx_run_phases(wx_scene *scene, const wx_run_def *opts, unsigned phases
     wx_maps_free(&output_maps);
     wx_textures_free(&textures);
     if (r != WX_OK) {
+        wx_output_remove_scene(scene, opts, created);
         wx_output_remove_empty(opts->out_dir, created); // a failed run leaves no empty folder
     }
     return r;
