@@ -787,8 +787,6 @@ static int report(wx_result r, const wx_error *err)
     return r;
 }
 
-// Runs the phases in `phases` in order, in one process; a phase that is not run
-// reads what an earlier command left in the output folder.
 // One output's line of the summary: its size and channels.
 static void print_output(const wx_run_def *opts, const char *name)
 {
@@ -800,31 +798,46 @@ static void print_output(const wx_run_def *opts, const char *name)
     }
     wx_image *image = calloc(1, sizeof *image);
     wx_error err;
-    fprintf(stderr, "  %-28s %8.1f MB", name, (double)st.st_size / 1e6);
+    printf("  %-28s %8.1f MB", name, (double)st.st_size / 1e6);
     if (image != NULL && wx_exr_read_header(path, image, &err) == WX_OK) {
-        fprintf(stderr, "  %d x %d, channels", image->width, image->height);
+        printf("  %d x %d, channels", image->width, image->height);
         for (int c = 0; c < image->channel_count; ++c) {
-            fprintf(stderr, "%s %s", c > 0 ? "," : "", image->channel_names[c]);
+            printf("%s %s", c > 0 ? "," : "", image->channel_names[c]);
         }
         wx_image_free(image);
     }
     free(image);
-    fprintf(stderr, "\n");
+    printf("\n");
 }
 
-// After a run: what the particles left (each substance on the surfaces at the
-// start and at the end, and what they brought) and the main files written.
-static void print_summary(const wx_scene *scene, const wx_run_def *opts, const wx_run_report *run,
-                          unsigned phases)
+// Where the emitters' particles ended: each one hit the model, left the
+// bounding box without a hit, or is still flying without one, so the three
+// shares add up to 100%; and how many are still flying, hit or not.
+static void print_particles(const wx_sim_stats *st)
 {
+    double n = (double)st->particles_emitted;
+    int64_t hit = st->particles_emitted - st->escaped_without_hit - st->alive_without_hit;
+    printf("  particles  %lld emitted: %.1f%% hit the model, %.1f%% left without a hit, %.1f%% "
+           "still flying without a hit; %lld hits; %lld (%.1f%%) still flying at the end\n",
+           (long long)st->particles_emitted, 100.0 * (double)hit / n,
+           100.0 * (double)st->escaped_without_hit / n, 100.0 * (double)st->alive_without_hit / n,
+           (long long)st->collisions, (long long)st->alive, 100.0 * (double)st->alive / n);
+}
+
+// After a run, on stdout: where the particles ended, what they left (each
+// substance on the surfaces at the start and at the end, and what they
+// brought), and the main files written.
+static void print_summary(const wx_scene *scene, const wx_run_def *opts, const wx_run_report *run,
+                          const char *command_name, unsigned phases)
+{
+    printf("%s done in %.2f s; outputs in %s\n", command_name, run->times.total, opts->out_dir);
     const wx_sim_stats *st = &run->stats;
     if ((phases & WX_PHASE_SIMULATE) && st->particles_emitted > 0) {
-        double hit = 100.0 * (1.0 - (double)st->escaped_without_hit / (double)st->particles_emitted);
-        fprintf(stderr, "  %.1f%% of the particles hit the model\n", hit);
+        print_particles(st);
         for (int k = 0; k < st->substance_count; ++k) {
             const wx_substance_ledger *l = &st->substance[k];
-            fprintf(stderr, "  %-10s on the surfaces %.6g at the start, %.6g at the end (brought %.6g)\n",
-                    st->substance_names[k], l->initial_surface, l->final_surface, l->emitted);
+            printf("  %-10s on the surfaces %.6g at the start, %.6g at the end (brought %.6g)\n",
+                   st->substance_names[k], l->initial_surface, l->final_surface, l->emitted);
         }
     }
     if (!(phases & WX_PHASE_GATHER)) {
@@ -838,6 +851,8 @@ static void print_summary(const wx_scene *scene, const wx_run_def *opts, const w
     }
 }
 
+// Runs the phases in `phases` in order, in one process; a phase that is not run
+// reads what an earlier command left in the output folder.
 static int run_phases(const cli_args *args, unsigned phases)
 {
     double start = wx_now_s();
@@ -866,19 +881,7 @@ static int run_phases(const cli_args *args, unsigned phases)
         r = wx_write_stats(opts.stats_path, &run.stats, &run.times, opts.threads, opts.seed, &err);
     }
     if (r == WX_OK && !opts.quiet) {
-        const wx_sim_stats *st = &run.stats;
-        char flown[256] = "";
-        if ((phases & WX_PHASE_SIMULATE) && st->particles_emitted > 0) {
-            double n = (double)st->particles_emitted;
-            snprintf(flown, sizeof flown,
-                     " (%lld particles: %lld hits, %.1f%% escaped without a hit, %lld still "
-                     "flying)",
-                     (long long)st->particles_emitted, (long long)st->collisions,
-                     100.0 * (double)st->escaped_without_hit / n, (long long)st->alive);
-        }
-        fprintf(stderr, "weathering: %s done in %.2f s%s; outputs in %s\n", args->command,
-                run.times.total, flown, opts.out_dir);
-        print_summary(&scene, &opts, &run, phases);
+        print_summary(&scene, &opts, &run, args->command, phases);
     }
     wx_scene_free(&scene);
     return report(r, &err);
@@ -1022,12 +1025,11 @@ static int command_init(const cli_args *args)
         return r;
     }
     if (!args->quiet) {
-        fprintf(stderr,
-                "weathering: wrote %s (preset %s: %d cameras, %d emitter%s%s); run it with "
-                "`weathering run %s`\n",
-                scene_path, args->preset != NULL ? args->preset : "rain", scene.camera_count,
-                scene.emitter_count, scene.emitter_count == 1 ? "" : "s",
-                scene.texture_count > 0 ? ", a TextureMap" : "", scene_path);
+        printf("wrote %s (preset %s: %d cameras, %d emitter%s%s); run it with "
+               "`weathering run %s`\n",
+               scene_path, args->preset != NULL ? args->preset : "rain", scene.camera_count,
+               scene.emitter_count, scene.emitter_count == 1 ? "" : "s",
+               scene.texture_count > 0 ? ", a TextureMap" : "", scene_path);
     }
     wx_scene_free(&scene);
     return WX_OK;

@@ -405,6 +405,52 @@ TEST(info_pilot_predicts_the_particles_that_miss)
     ENSURE_NEAR(predicted, actual, 2.0);
 }
 
+// The summary (on stdout, issue 24) tells the particles that hit from those
+// that left or are still flying: the thesis box simulated for 0.2 s, its cloud
+// 4 m above the cube, hits nothing and ends with every particle in the air.
+// Diagnostics (the warning) go to stderr, the summary to stdout.
+TEST(summary_tells_hits_from_particles_still_flying)
+{
+    char maps[4200];
+    ENSURE(realpath(ensure_tests_dir(), maps) != NULL);
+    strcat(maps, "/../maps/");
+    char path[4300];
+    snprintf(path, sizeof path, "%s/../xml_scenes/thesis_box.xml", ensure_tests_dir());
+    char *xml = ensure_read_file(path);
+    ENSURE(xml != NULL);
+    char *solver = strstr(xml, "  </Solver>");
+    ENSURE(solver != NULL);
+    size_t cap = strlen(xml) * 2 + 8192;
+    char *scene = malloc(cap);
+    size_t n = (size_t)snprintf(scene, cap, "%.*s    <Simulation steps=\"20\"/>\n",
+                                (int)(solver - xml), xml);
+    for (const char *c = solver; *c != '\0' && n + 4200 < cap;) {
+        if (strncmp(c, "../maps/", 8) == 0) {
+            n += (size_t)snprintf(scene + n, cap - n, "%s", maps);
+            c += 8;
+        } else {
+            scene[n++] = *c++;
+        }
+    }
+    scene[n] = '\0';
+    free(xml);
+    const char *d = ensure_tmpdir();
+    ensure_write_file(d, "flying.xml", scene);
+    free(scene);
+    ENSURE(ensure_shell(out, sizeof out, "cd '%s' && '%s/weathering' run flying.xml --out fly "
+                        "2>/dev/null", d, build_dir()) == 0);
+    ENSURE(ensure_contains(out, "run done in"));
+    ENSURE(ensure_contains(out, "4000 emitted: 0.0% hit the model, 0.0% left without a hit, "
+                                "100.0% still flying without a hit; 0 hits; 4000 (100.0%) still "
+                                "flying at the end"));
+    ENSURE(strstr(out, "warning") == NULL);
+    ENSURE(ensure_shell(out, sizeof out, "cd '%s' && '%s/weathering' run flying.xml --out fly "
+                        ">/dev/null", d, build_dir()) == 0);
+    ENSURE(strstr(out, "done in") == NULL);
+    ENSURE(ensure_contains(out, "100% of the particles (4000 of 4000) are still flying when the "
+                                "simulation ends, 4000 of them before any hit"));
+}
+
 int main(void)
 {
     RUN(help_lists_commands_and_options);
@@ -421,5 +467,6 @@ int main(void)
     RUN(overlong_paths_are_refused);
     RUN(control_characters_from_files_are_escaped);
     RUN(info_pilot_predicts_the_particles_that_miss);
+    RUN(summary_tells_hits_from_particles_still_flying);
     return ensure_summary();
 }

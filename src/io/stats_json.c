@@ -49,6 +49,7 @@ wx_result wx_write_stats(const char *path, const wx_sim_stats *stats, const wx_p
         "  \"escaped\": %lld,\n"
         "  \"escaped_without_hit\": %lld,\n"
         "  \"alive\": %lld,\n"
+        "  \"alive_without_hit\": %lld,\n"
         "%s"
         "  \"iterations\": %lld,\n"
         "  \"substances\": {\n%s\n  },\n"
@@ -68,7 +69,9 @@ wx_result wx_write_stats(const char *path, const wx_sim_stats *stats, const wx_p
         (long long)stats->particles_emitted, (long long)stats->particle_steps,
         (long long)stats->collisions, (long long)stats->absorbed, (long long)stats->settled,
         (long long)stats->escaped, (long long)stats->escaped_without_hit,
-        (long long)stats->alive, dirt, (long long)stats->iterations, substances, times->load, times->bake, times->simulate, times->gather,
+        (long long)stats->alive, (long long)stats->alive_without_hit, dirt,
+        (long long)stats->iterations, substances, times->load, times->bake, times->simulate,
+        times->gather,
         times->total, times->simulate_detail.read, times->simulate_detail.setup,
         times->simulate_detail.compute, times->simulate_detail.write, times->gather_detail.read,
         times->gather_detail.compute, times->gather_detail.write, threads,

@@ -33,6 +33,7 @@ typedef struct wx_sim_stats {
     int64_t escaped;
     int64_t escaped_without_hit; ///< of the emitters' particles, those that never hit
     int64_t alive;
+    int64_t alive_without_hit; ///< of the emitters' particles still flying, those yet to hit
     /// Substance "dirt"'s ledger (docs/design.md section 6); zero when the
     /// scene declares substances without "dirt".
     double dirt_initial_surface;

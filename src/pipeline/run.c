@@ -154,6 +154,18 @@ wx_result wx_run_phases(wx_scene *scene, const wx_run_def *opts, unsigned phases
                     scene->path, 100.0 * (double)st->escaped_without_hit / (double)st->particles_emitted,
                     (long long)st->escaped_without_hit, (long long)st->particles_emitted);
         }
+        // Particles still flying at the end carry their load in flight, not
+        // onto the surfaces: a run that stops too early looks too clean.
+        if (r == WX_OK && st->particles_emitted > 0 && 20 * st->alive > st->particles_emitted) {
+            wx_warn(opts->quiet,
+                    "%s: %.0f%% of the particles (%lld of %lld) are still flying when the "
+                    "simulation ends, %lld of them before any hit: what they carry is in "
+                    "flight, not on the surfaces; give the simulation more steps or end the "
+                    "emitters earlier",
+                    scene->path, 100.0 * (double)st->alive / (double)st->particles_emitted,
+                    (long long)st->alive, (long long)st->particles_emitted,
+                    (long long)st->alive_without_hit);
+        }
         report->times.simulate = wx_now_s() - t0;
     }
     if (r == WX_OK && (phases & WX_PHASE_GATHER)) {

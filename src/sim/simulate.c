@@ -1103,6 +1103,14 @@ void wx_sim_get_stats(const wx_sim *sim, wx_sim_stats *stats)
 {
     *stats = sim->stats;
     stats->alive = sim->particles.count;
+    // Of the emitters' particles still flying, those that have hit nothing yet.
+    stats->alive_without_hit = 0;
+    for (int64_t i = 0; i < sim->particles.count; ++i) {
+        uint64_t e = sim->particles.id[i] >> 48;
+        stats->alive_without_hit += e < (uint64_t)sim->emitter_count &&
+                                    sim->particles.collisions_left[i] ==
+                                        (uint32_t)sim->emitters[e].max_collisions;
+    }
     stats->iterations = sim->iterations_done;
     int S = sim->substances;
     for (int s = 0; s < S; ++s) {
