@@ -196,7 +196,8 @@ tsan: | deps
 	    WX_TESTS=tests tests/run.sh $(TSAN_BUILD)/tsan-tests
 
 # make fuzz: libFuzzer targets (clang) in $(BUILD)/fuzz, seeded with the shipped
-# scenes and maps, each run for FUZZ_SECONDS. The library is rebuilt with clang
+# scenes and maps and given their dictionary (tests/fuzz/TARGET.dict: the scene
+# format's words, the EXR header's), each run for FUZZ_SECONDS. The library is rebuilt with clang
 # and the fuzzer's instrumentation in $(BUILD)/fuzz/lib.
 FUZZ_CC ?= clang
 FUZZ_SECONDS ?= 30
@@ -217,6 +218,7 @@ fuzz: $(FUZZ_TARGETS)
 	    sh tests/fuzz/seed.sh $$name $$corpus || exit 1; \
 	    echo "== $$name for $(FUZZ_SECONDS) s"; \
 	    $(FUZZ_ENV) $$t -max_total_time=$(FUZZ_SECONDS) -timeout=10 -rss_limit_mb=4096 \
+	        -dict=tests/fuzz/$$name.dict \
 	        -malloc_limit_mb=4096 -print_final_stats=1 -artifact_prefix=$(BUILD)/fuzz/ \
 	        $$corpus >$(BUILD)/fuzz/$$name.log 2>&1; status=$$?; \
 	    grep -E '^(INFO: seed corpus|#[0-9]+ +DONE|stat::number_of_executed_units|Done )' \

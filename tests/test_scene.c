@@ -1564,9 +1564,42 @@ TEST(schema_rejects_bad_values)
     ENSURE(failures == 0);
 }
 
+// The fuzzer's dictionary (tests/fuzz/fuzz_scene.dict) holds every element
+// and attribute the schema has, so that a new one cannot be left out of the
+// fuzzing: "<Name" and " name=\"" for each.
+TEST(fuzz_dictionary_knows_every_element_and_attribute)
+{
+    char path[4200];
+    snprintf(path, sizeof path, "%s/../xml_scenes/weathering.xsd", ensure_tests_dir());
+    char *xsd = ensure_read_file(path);
+    snprintf(path, sizeof path, "%s/fuzz/fuzz_scene.dict", ensure_tests_dir());
+    char *dict = ensure_read_file(path);
+    ENSURE(xsd != NULL && dict != NULL);
+    static const char *const kinds[2] = { "<xs:element name=\"", "<xs:attribute name=\"" };
+    int checked = 0, missing = 0;
+    for (int k = 0; k < 2; ++k) {
+        for (const char *c = strstr(xsd, kinds[k]); c != NULL; c = strstr(c + 1, kinds[k])) {
+            const char *name = c + strlen(kinds[k]);
+            int len = (int)strcspn(name, "\"");
+            char word[160];
+            snprintf(word, sizeof word, k == 0 ? "\"<%.*s\"" : "\" %.*s=\\\"\"", len, name);
+            if (strstr(dict, word) == NULL) {
+                fprintf(stderr, "        fuzz_scene.dict lacks %s\n", word);
+                missing++;
+            }
+            checked++;
+        }
+    }
+    free(xsd);
+    free(dict);
+    ENSURE(checked > 100);
+    ENSURE(missing == 0);
+}
+
 int main(void)
 {
     RUN(data_maps);
+    RUN(fuzz_dictionary_knows_every_element_and_attribute);
     RUN(thesis_minimal_defaults);
     RUN(element_defaults);
     RUN(full_scene);
