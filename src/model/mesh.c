@@ -1,6 +1,8 @@
 // mesh.c: the memory of a triangle mesh (mesh.h).
 #include "model/mesh.h"
 
+#include <math.h>
+
 #include <stdlib.h>
 #include <string.h>
 
@@ -26,4 +28,198 @@ void wx_mesh_data_free(wx_mesh_data *mesh)
     free(mesh->material_names);
     free(mesh->material_colored);
     memset(mesh, 0, sizeof *mesh);
+}
+
+void wx_mesh_phong_point(const wx_mesh_data *mesh, int64_t tri, const double w[3],
+                         double out[3])
+{
+    // The corners in ascending vertex index, so that a point of an edge comes
+    // out bit for bit the same from both triangles that share it (a weight of
+    // 0 adds an exact 0 wherever it stands).
+    const uint32_t *tri_idx = &mesh->indices[3 * (size_t)tri];
+    int order[3] = { 0, 1, 2 };
+    for (int a = 1; a < 3; ++a) {
+        for (int b = a; b > 0 && tri_idx[order[b - 1]] > tri_idx[order[b]]; --b) {
+            int swap = order[b];
+            order[b] = order[b - 1];
+            order[b - 1] = swap;
+        }
+    }
+    double flat[3] = { 0.0, 0.0, 0.0 };
+    for (int j = 0; j < 3; ++j) {
+        const float *pk = &mesh->positions[3 * (size_t)tri_idx[order[j]]];
+        for (int a = 0; a < 3; ++a) {
+            flat[a] += w[order[j]] * pk[a];
+        }
+    }
+    double q[3] = { 0.0, 0.0, 0.0 };
+    for (int j = 0; j < 3; ++j) {
+        int k = order[j];
+        const float *pk = &mesh->positions[3 * (size_t)tri_idx[k]];
+        const float *nk = &mesh->normals[3 * (size_t)tri_idx[k]];
+        double len = sqrt((double)nk[0] * nk[0] + (double)nk[1] * nk[1] + (double)nk[2] * nk[2]);
+        double n[3] = { 0.0, 0.0, 0.0 }, along = 0.0;
+        if (len > 1e-6) {
+            for (int a = 0; a < 3; ++a) {
+                n[a] = nk[a] / len;
+                along += (flat[a] - pk[a]) * n[a];
+            }
+        }
+        for (int a = 0; a < 3; ++a) {
+            q[a] += w[k] * (flat[a] - along * n[a]);
+        }
+    }
+    for (int a = 0; a < 3; ++a) {
+        q[a] = flat[a] + WX_PHONG_SHAPE * (q[a] - flat[a]);
+    }
+    memcpy(out, q, sizeof q);
+}
+
+// Whether the normals at the two ends of an edge differ: only then does the
+// smooth surface leave the flat triangle along it.
+static bool edge_curves(const wx_mesh_data *mesh, uint32_t a, uint32_t b)
+{
+    const float *na = &mesh->normals[3 * (size_t)a], *nb = &mesh->normals[3 * (size_t)b];
+    return na[0] != nb[0] || na[1] != nb[1] || na[2] != nb[2];
+}
+
+static bool triangle_curves(const wx_mesh_data *mesh, int64_t t)
+{
+    const uint32_t *idx = &mesh->indices[3 * t];
+    return edge_curves(mesh, idx[0], idx[1]) || edge_curves(mesh, idx[1], idx[2]) ||
+           edge_curves(mesh, idx[2], idx[0]);
+}
+
+double wx_mesh_longest_curved_edge(const wx_mesh_data *mesh)
+{
+    double longest = 0.0;
+    for (int64_t t = 0; t < mesh->triangle_count; ++t) {
+        const uint32_t *idx = &mesh->indices[3 * t];
+        for (int k = 0; k < 3; ++k) {
+            uint32_t a = idx[k], b = idx[(k + 1) % 3];
+            if (!edge_curves(mesh, a, b)) {
+                continue;
+            }
+            const float *pa = &mesh->positions[3 * (size_t)a];
+            const float *pb = &mesh->positions[3 * (size_t)b];
+            double dx = (double)pb[0] - pa[0], dy = (double)pb[1] - pa[1],
+                   dz = (double)pb[2] - pa[2];
+            double len = sqrt(dx * dx + dy * dy + dz * dz);
+            longest = len > longest ? len : longest;
+        }
+    }
+    return longest;
+}
+
+int64_t wx_mesh_curved_triangles(const wx_mesh_data *mesh)
+{
+    int64_t n = 0;
+    for (int64_t t = 0; t < mesh->triangle_count; ++t) {
+        n += triangle_curves(mesh, t);
+    }
+    return n;
+}
+
+wx_result wx_mesh_smooth_subdivide(wx_mesh_data *mesh, int level, wx_error *err)
+{
+    if (level <= 1 || mesh->triangle_count == 0) {
+        return WX_OK;
+    }
+    int64_t curved = wx_mesh_curved_triangles(mesh);
+    int64_t per_tri_v = (int64_t)(level + 1) * (level + 2) / 2;
+    int64_t per_tri_t = (int64_t)level * level;
+    int64_t flat = mesh->triangle_count - curved;
+    int64_t nv = mesh->vertex_count + curved * per_tri_v;
+    int64_t nt = flat + curved * per_tri_t;
+    if (nv > UINT32_MAX || nt * 3 > INT32_MAX) {
+        return wx_fail(err, WX_CAUSE_BAD_MESH, "the smooth surface of %lld triangles cut %d x %d "
+                       "is more than one draw takes", (long long)curved, level, level);
+    }
+    float *positions = malloc((size_t)nv * 3 * sizeof *positions);
+    float *normals = malloc((size_t)nv * 3 * sizeof *normals);
+    float *colors = mesh->colors != NULL ? malloc((size_t)nv * 4 * sizeof *colors) : NULL;
+    uint32_t *indices = malloc((size_t)nt * 3 * sizeof *indices);
+    uint16_t *materials = malloc((size_t)nt * sizeof *materials);
+    if (positions == NULL || normals == NULL || (mesh->colors != NULL && colors == NULL) ||
+        indices == NULL || materials == NULL) {
+        free(positions);
+        free(normals);
+        free(colors);
+        free(indices);
+        free(materials);
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY,
+                       "out of memory for the smooth surface (%lld triangles)", (long long)nt);
+    }
+    size_t old_v = (size_t)mesh->vertex_count;
+    memcpy(positions, mesh->positions, old_v * 3 * sizeof *positions);
+    memcpy(normals, mesh->normals, old_v * 3 * sizeof *normals);
+    if (colors != NULL) {
+        memcpy(colors, mesh->colors, old_v * 4 * sizeof *colors);
+    }
+    size_t v = old_v, t_out = 0;
+    for (int64_t t = 0; t < mesh->triangle_count; ++t) {
+        const uint32_t *idx = &mesh->indices[3 * t];
+        if (!triangle_curves(mesh, t)) {
+            memcpy(&indices[3 * t_out], idx, 3 * sizeof *idx);
+            materials[t_out++] = mesh->materials[t];
+            continue;
+        }
+        // Grid point (i, j), 0 <= i + j <= level: weights (level-i-j, i, j) / level.
+        size_t base = v;
+        for (int j = 0; j <= level; ++j) {
+            for (int i = 0; i + j <= level; ++i) {
+                double w[3] = { (double)(level - i - j) / level, (double)i / level,
+                                (double)j / level };
+                double p[3];
+                wx_mesh_phong_point(mesh, t, w, p);
+                for (int a = 0; a < 3; ++a) {
+                    positions[3 * v + (size_t)a] = (float)p[a];
+                    double n = 0.0;
+                    for (int k = 0; k < 3; ++k) {
+                        n += w[k] * mesh->normals[3 * (size_t)idx[k] + (size_t)a];
+                    }
+                    normals[3 * v + (size_t)a] = (float)n;
+                }
+                for (int a = 0; a < 4 && colors != NULL; ++a) {
+                    double c = 0.0;
+                    for (int k = 0; k < 3; ++k) {
+                        c += w[k] * mesh->colors[4 * (size_t)idx[k] + (size_t)a];
+                    }
+                    colors[4 * v + (size_t)a] = (float)c;
+                }
+                v++;
+            }
+        }
+        // Row j starts at base + j*(level+1) - j*(j-1)/2 and holds level+1-j points.
+        for (int j = 0; j < level; ++j) {
+            size_t row = base + (size_t)(j * (level + 1) - j * (j - 1) / 2);
+            size_t next = row + (size_t)(level + 1 - j);
+            for (int i = 0; i + j < level; ++i) {
+                uint32_t a = (uint32_t)(row + (size_t)i), b = a + 1, c = (uint32_t)(next + (size_t)i);
+                indices[3 * t_out] = a;
+                indices[3 * t_out + 1] = b;
+                indices[3 * t_out + 2] = c;
+                materials[t_out++] = mesh->materials[t];
+                if (i + j + 1 < level) {
+                    indices[3 * t_out] = b;
+                    indices[3 * t_out + 1] = c + 1;
+                    indices[3 * t_out + 2] = c;
+                    materials[t_out++] = mesh->materials[t];
+                }
+            }
+        }
+    }
+    free(mesh->positions);
+    free(mesh->normals);
+    free(mesh->colors);
+    free(mesh->indices);
+    free(mesh->materials);
+    mesh->positions = positions;
+    mesh->normals = normals;
+    mesh->colors = colors;
+    mesh->indices = indices;
+    mesh->materials = materials;
+    mesh->vertex_count = (int64_t)v;
+    mesh->triangle_count = (int64_t)t_out;
+    return WX_OK;
 }

@@ -44,4 +44,37 @@ void wx_mesh_data_release_arrays(wx_mesh_data *mesh);
 /// Frees everything; the struct is zeroed.
 void wx_mesh_data_free(wx_mesh_data *mesh);
 
+/// Phong tessellation's shape factor: 1/2 makes the curve along an edge leave
+/// each end in the tangent plane its vertex normal gives (for a circle's chord
+/// the exact quadratic; 3/4, the paper's choice for looks, leaves half the
+/// kink of the flat triangles between neighbours, 1 the whole kink turned
+/// over). docs/cameras.md.
+#define WX_PHONG_SHAPE 0.5
+
+/// The point of triangle `tri` at barycentric weights w (summing to 1) on the
+/// smooth surface its vertex normals describe, relative to mesh->origin: the
+/// flat point projected onto each corner's tangent plane, the projections
+/// blended by w and mixed with the flat point by WX_PHONG_SHAPE (Phong
+/// tessellation, Boubekeur and Alexa 2008). A corner without a normal keeps
+/// the flat point; a triangle whose three normals are equal stays flat, and so
+/// does an edge whose two normals are equal. A point of an edge is the same,
+/// bit for bit, from both triangles that share it.
+void wx_mesh_phong_point(const wx_mesh_data *mesh, int64_t tri, const double w[3],
+                         double out[3]);
+
+/// The longest edge whose two vertex normals differ (0 for a flat-shaded mesh):
+/// how far the smooth surface may stand off the triangles is at most this.
+double wx_mesh_longest_curved_edge(const wx_mesh_data *mesh);
+
+/// How many triangles have an edge whose vertex normals differ.
+int64_t wx_mesh_curved_triangles(const wx_mesh_data *mesh);
+
+/// Replaces every triangle that has an edge whose normals differ by level x
+/// level triangles on its smooth surface (wx_mesh_phong_point), normals and
+/// colours interpolated, so that a renderer draws the surface the normals
+/// describe; the other triangles stay. Shared edges are cut at the same points
+/// on both sides (no cracks). UVs are not carried (the bake does not read
+/// them). level <= 1 changes nothing.
+wx_result wx_mesh_smooth_subdivide(wx_mesh_data *mesh, int level, wx_error *err);
+
 #endif

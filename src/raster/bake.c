@@ -453,6 +453,45 @@ static void survey_vertices(baker *b, const wx_mesh *mesh, const wx_mesh_data *d
     }
 }
 
+// The smallest texel (world units) of the cameras this bake draws.
+static double finest_texel(const baker *b)
+{
+    double finest = INFINITY;
+    for (int c = 0; c < b->scene->camera_count; ++c) {
+        const wx_camera *cam = &b->scene->cameras[c].camera;
+        if (!b->cams[c].bake || cam->width <= 0 || cam->height <= 0) {
+            continue;
+        }
+        float w, h;
+        wx_camera_frame_size(cam, &w, &h);
+        finest = fmin(finest, fmin((double)w / cam->width, (double)h / cam->height));
+    }
+    return finest;
+}
+
+// How finely the triangles of a smooth-shaded mesh are cut so that the maps
+// record the smooth surface its normals describe (wx_mesh_smooth_subdivide,
+// docs/cameras.md): pieces of about SMOOTH_PIECE_TEXELS of the finest camera's
+// texels along the longest curved edge, at most SMOOTH_MAX_LEVEL, and at most
+// SMOOTH_MAX_TRIANGLES triangles in all.
+enum { SMOOTH_MAX_LEVEL = 16 };
+#define SMOOTH_PIECE_TEXELS 2.0
+#define SMOOTH_MAX_TRIANGLES 4000000.0
+
+static int smooth_level(const baker *b, const wx_mesh_data *data)
+{
+    double edge = wx_mesh_longest_curved_edge(data), texel = finest_texel(b);
+    if (!(edge > 0.0) || !isfinite(texel) || !(texel > 0.0)) {
+        return 1;
+    }
+    double level = fmin(ceil(edge / (SMOOTH_PIECE_TEXELS * texel)), SMOOTH_MAX_LEVEL);
+    double curved = (double)wx_mesh_curved_triangles(data);
+    while (level > 1.0 && curved * level * level > SMOOTH_MAX_TRIANGLES) {
+        level -= 1.0;
+    }
+    return level > 1.0 ? (int)level : 1;
+}
+
 // Uploads every mesh of the geometry (its arrays are released on the way).
 static wx_result load_meshes(baker *b, wx_geometry *geometry, wx_error *err)
 {
@@ -476,8 +515,11 @@ static wx_result load_meshes(baker *b, wx_geometry *geometry, wx_error *err)
             r = wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "bake: out of memory");
         } else {
             material_props(scene, i, g, props);
-            survey_vertices(b, mesh, data);
-            r = upload_mesh(b, data, props, &b->meshes[b->mesh_count], err);
+            r = wx_mesh_smooth_subdivide(data, smooth_level(b, data), err);
+            if (r == WX_OK) {
+                survey_vertices(b, mesh, data);
+                r = upload_mesh(b, data, props, &b->meshes[b->mesh_count], err);
+            }
             b->mesh_count++; // counted even when incomplete, so that it is deleted
             if (r != WX_OK) {
                 wx_error_prefix(err, "%s:%d: mesh '%s'", scene->path, mesh->line,

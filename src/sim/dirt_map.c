@@ -64,7 +64,19 @@ double wx_dirt_map_total(const wx_dirt_map *map, int s)
     return sum;
 }
 
-void wx_dirt_map_exchange(wx_dirt_map *map, uint32_t texel, double *load)
+// The share of a particle's weight an exchange at texel t spends: the texel's
+// strongest rate, deposit or erosion, over the substances.
+static float exchange_share(const wx_dirt_texel *t, int S)
+{
+    float f = 0.0f;
+    for (int s = 0; s < S; ++s) {
+        f = t[s].deposit > f ? t[s].deposit : f;
+        f = t[s].erosion > f ? t[s].erosion : f;
+    }
+    return f;
+}
+
+void wx_dirt_map_exchange(wx_dirt_map *map, uint32_t texel, double *load, float *weight)
 {
     int S = map->substances;
     wx_dirt_texel *t = &map->texels[(size_t)texel * (size_t)S];
@@ -74,10 +86,12 @@ void wx_dirt_map_exchange(wx_dirt_map *map, uint32_t texel, double *load)
         load[s] += ero - dep;
         t[s].dirt += dep - ero;
     }
-    t->hits += 1.0f;
+    float spent = exchange_share(t, S) * *weight;
+    t->hits += spent;
+    *weight -= spent;
 }
 
-void wx_dirt_map_deposit_all(wx_dirt_map *map, uint32_t texel, double *load)
+void wx_dirt_map_deposit_all(wx_dirt_map *map, uint32_t texel, double *load, float *weight)
 {
     int S = map->substances;
     wx_dirt_texel *t = &map->texels[(size_t)texel * (size_t)S];
@@ -85,6 +99,8 @@ void wx_dirt_map_deposit_all(wx_dirt_map *map, uint32_t texel, double *load)
         t[s].dirt += load[s];
         load[s] = 0.0;
     }
+    t->hits += *weight;
+    *weight = 0.0f;
 }
 
 // Bresenham's walk (thesis 3.5, Algorithm 1, generalised to every octant).
@@ -145,7 +161,8 @@ static bool has_surface(const wx_dirt_map *map, size_t texel)
     return map->depth == NULL || isfinite(map->depth[texel]);
 }
 
-void wx_dirt_map_exchange_line(wx_dirt_map *map, uint32_t from, uint32_t to, double *load)
+void wx_dirt_map_exchange_line(wx_dirt_map *map, uint32_t from, uint32_t to, double *load,
+                               float *weight)
 {
     int W = map->width;
     int x0 = (int)(from % (uint32_t)W), y0 = (int)(from / (uint32_t)W);
@@ -158,7 +175,7 @@ void wx_dirt_map_exchange_line(wx_dirt_map *map, uint32_t from, uint32_t to, dou
         n += has_surface(map, (size_t)w.y * (size_t)W + (size_t)w.x);
     }
     if (n == 0) {
-        wx_dirt_map_exchange(map, to, load);
+        wx_dirt_map_exchange(map, to, load, weight);
         return;
     }
     int S = map->substances;
@@ -168,7 +185,7 @@ void wx_dirt_map_exchange_line(wx_dirt_map *map, uint32_t from, uint32_t to, dou
         change[s] = 0.0;
     }
     double share = 1.0 / n;
-    float hit_share = 1.0f / (float)n;
+    float hit_share = *weight / (float)n, spent = 0.0f;
     line_begin(&w, x0, y0, x1, y1);
     for (line_next(&w); !w.done; line_next(&w)) {
         size_t texel = (size_t)w.y * (size_t)W + (size_t)w.x;
@@ -182,9 +199,12 @@ void wx_dirt_map_exchange_line(wx_dirt_map *map, uint32_t from, uint32_t to, dou
             t[s].dirt += dep - ero;
             change[s] += ero - dep;
         }
-        t->hits += hit_share;
+        float part = exchange_share(t, S) * hit_share;
+        t->hits += part;
+        spent += part;
     }
     for (int s = 0; s < S; ++s) {
         load[s] = p[s] + change[s];
     }
+    *weight -= spent;
 }

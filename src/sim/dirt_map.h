@@ -20,8 +20,10 @@ typedef struct wx_dirt_texel {
     double dirt;
     float deposit; ///< clamp(D * kd, 0, 1)
     float erosion; ///< clamp(E * ke, 0, 1)
-    /// Impacts that exchanged dirt here (a streak's share 1/n on each of its n
-    /// texels): what the gather's adaptive smoothing counts (docs/mask.md).
+    /// The particles that exchanged here, each counted by the share of itself
+    /// it spent here (its weight, wx_particles.weight: a particle counts once
+    /// over all its hits): what the gather's adaptive smoothing counts as its
+    /// independent samples (docs/mask.md).
     float hits;
 } wx_dirt_texel;
 
@@ -53,20 +55,25 @@ double wx_dirt_map_total(const wx_dirt_map *map, int s);
 
 /// One impact at `texel`, for every substance s with load[s]: dep =
 /// deposit*p, ero = erosion*s, then p += ero - dep, s += dep - ero (thesis
-/// 4.8.4.3, as pinned in docs/design.md section 4); the texel counts one hit.
-void wx_dirt_map_exchange(wx_dirt_map *map, uint32_t texel, double *load);
+/// 4.8.4.3, as pinned in docs/design.md section 4). The particle spends the
+/// share f of its weight (*weight, in [0, 1]) that the texel's strongest
+/// exchange rate gives (f = the largest deposit or erosion rate over the
+/// substances): the texel's hits grow by f * weight, and weight shrinks by as
+/// much.
+void wx_dirt_map_exchange(wx_dirt_map *map, uint32_t texel, double *load, float *weight);
 
 /// A slide that follows a slide: the same exchange spread evenly over the
 /// surface texels of the Bresenham line from `from` to `to`, without `from` (it
 /// took its share at the previous hit): each of the n texels exchanges with
 /// dep_k = deposit_k*p/n and ero_k = erosion_k*s_k/n, p being the load on
-/// arrival, for every substance; each counts 1/n of a hit. With no surface
-/// texel on the line, a plain exchange at `to`.
-void wx_dirt_map_exchange_line(wx_dirt_map *map, uint32_t from, uint32_t to, double *load);
+/// arrival, for every substance, and takes f_k * weight / n of the particle's
+/// weight. With no surface texel on the line, a plain exchange at `to`.
+void wx_dirt_map_exchange_line(wx_dirt_map *map, uint32_t from, uint32_t to, double *load,
+                               float *weight);
 
 /// Deposits all of every substance's load at `texel` (absorbed and settled
-/// particles).
-void wx_dirt_map_deposit_all(wx_dirt_map *map, uint32_t texel, double *load);
+/// particles), and the rest of the particle's weight.
+void wx_dirt_map_deposit_all(wx_dirt_map *map, uint32_t texel, double *load, float *weight);
 
 /// Bresenham's line from (x0, y0) to (x1, y1), both ends included (thesis 3.5):
 /// writes up to `max` texels as x, y pairs into `out` (may be NULL) and returns

@@ -64,25 +64,44 @@ void wx_uniform_cone(const float axis[3], float spread, float u1, float u2, floa
     }
 }
 
+// The Kronecker sequence R5 (Roberts 2018): alpha_k = 1 / phi^k, phi the root of
+// x^6 = x + 1. Its points n = 0, 1, 2, ... cover the unit cube evenly, and so
+// do the points of any run of consecutive n.
+static const double R5_ALPHA[WX_EMIT_DIMENSIONS] = { 0.8812714616335696, 0.7766393890897682,
+                                                     0.6844301295853426, 0.6031687406857283,
+                                                     0.5315553977157913 };
+
+void wx_emitter_uniforms(uint64_t seed, uint64_t id, double u[WX_EMIT_DIMENSIONS])
+{
+    uint64_t serial = id & ((UINT64_C(1) << 48) - 1), emitter = id >> 48;
+    for (int k = 0; k < WX_EMIT_DIMENSIONS; ++k) {
+        // One random shift of the whole sequence per seed, emitter and
+        // dimension (Cranley and Patterson 1976): a seed moves every point.
+        double shift = wx_particle_random(seed, wx_particle_id((uint32_t)emitter, WX_EMIT_SHIFT_SERIAL),
+                                          WX_RANDOM_EMIT_BOX + (uint64_t)k);
+        double x = shift + (double)serial * R5_ALPHA[k];
+        u[k] = x - floor(x);
+    }
+}
+
 void wx_emitter_sample(const wx_emitter *e, uint64_t seed, uint64_t id, float pos[3],
                        float vel[3])
 {
+    double u[WX_EMIT_DIMENSIONS];
+    wx_emitter_uniforms(seed, id, u);
     if (e->kind == WX_EMITTER_BOX) {
         float d[3];
         for (int k = 0; k < 3; ++k) {
-            float u = wx_particle_random(seed, id, WX_RANDOM_EMIT_BOX + (uint64_t)k);
-            pos[k] = e->box_min[k] + u * (e->box_max[k] - e->box_min[k]);
+            pos[k] = e->box_min[k] + (float)u[k] * (e->box_max[k] - e->box_min[k]);
         }
-        float u1 = wx_particle_random(seed, id, WX_RANDOM_EMIT_BOX + 3);
-        float u2 = wx_particle_random(seed, id, WX_RANDOM_EMIT_BOX + 4);
+        float u1 = (float)u[3], u2 = (float)u[4];
         wx_uniform_cone(e->dir, e->spread * 0.017453292519943295f, u1, u2, d);
         for (int k = 0; k < 3; ++k) {
             vel[k] = e->speed * d[k];
         }
         return;
     }
-    float u1 = wx_particle_random(seed, id, WX_RANDOM_EMIT_0);
-    float u2 = wx_particle_random(seed, id, WX_RANDOM_EMIT_1);
+    float u1 = (float)u[0], u2 = (float)u[1];
     float d[3];
     if (e->kind == WX_EMITTER_HEMISPHERE) {
         // thesis 4.8.2 samples a cube and rejects; the direct map is uniform too.

@@ -17,6 +17,7 @@ void wx_particles_free(wx_particles *p)
     free(p->id);
     free(p->collisions_left);
     free(p->last_slide);
+    free(p->weight);
     memset(p, 0, sizeof *p);
 }
 
@@ -60,7 +61,8 @@ bool wx_particles_reserve(wx_particles *p, int64_t needed)
               grow((void **)&p->load, old * S, capacity * S, sizeof *p->load) &&
               grow((void **)&p->id, old, capacity, sizeof *p->id) &&
               grow((void **)&p->collisions_left, old, capacity, sizeof *p->collisions_left) &&
-              grow((void **)&p->last_slide, old, capacity, sizeof *p->last_slide);
+              grow((void **)&p->last_slide, old, capacity, sizeof *p->last_slide) &&
+              grow((void **)&p->weight, old, capacity, sizeof *p->weight);
     if (!ok) {
         return false;
     }
@@ -116,6 +118,7 @@ int64_t wx_particles_push(wx_particles *p, const float pos[3], const float vel[3
     p->id[i] = id;
     p->collisions_left[i] = max_collisions;
     p->last_slide[i] = WX_NO_SLIDE;
+    p->weight[i] = 1.0f;
     return i;
 }
 
@@ -141,4 +144,5 @@ void wx_particles_remove(wx_particles *p, int64_t i)
     p->id[i] = p->id[last];
     p->collisions_left[i] = p->collisions_left[last];
     p->last_slide[i] = p->last_slide[last];
+    p->weight[i] = p->weight[last];
 }

@@ -42,11 +42,16 @@ typedef struct wx_particles {
     /// all input maps (the simulation numbers them), or WX_NO_SLIDE: the step
     /// loop resets it for every particle that does not collide.
     uint32_t *last_slide;
+    /// The share of the particle not yet left on a surface, 1 at emission: each
+    /// exchange leaves the share of the load it deposits (docs/mask.md: the
+    /// `hits` a gather counts are these shares, so a particle counts once
+    /// however often it hits).
+    float *weight;
 } wx_particles;
 
 /// Bytes stored per particle slot (all arrays), with a 1/mass array and one
 /// substance; each further substance adds one double.
-#define WX_PARTICLE_BYTES (7 * 4 + 8 + 8 + 4 + 4)
+#define WX_PARTICLE_BYTES (7 * 4 + 8 + 8 + 4 + 4 + 4)
 
 /// Bytes stored per particle slot now: WX_PARTICLE_BYTES less the 1/mass array
 /// while all particles share one mass, plus 8 per substance beyond the first.

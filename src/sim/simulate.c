@@ -470,13 +470,14 @@ static void apply_chunk(wx_sim *sim, const sim_chunk *ch)
         const sim_event *e = &ch->events[k];
         wx_dirt_map *map = &sim->dirt[e->camera];
         double *p = &load[e->index * S];
+        float *weight = &sim->particles.weight[e->index];
         if (e->flags & EVENT_LINE) {
-            wx_dirt_map_exchange_line(map, e->from, e->texel, p);
+            wx_dirt_map_exchange_line(map, e->from, e->texel, p, weight);
         } else {
-            wx_dirt_map_exchange(map, e->texel, p);
+            wx_dirt_map_exchange(map, e->texel, p, weight);
         }
         if (e->flags & EVENT_DIES) {
-            wx_dirt_map_deposit_all(map, e->texel, p);
+            wx_dirt_map_deposit_all(map, e->texel, p, weight);
             if ((e->flags & EVENT_KIND_MASK) == WX_IMPACT_ABSORB) {
                 sim->stats.absorbed++;
             } else {
