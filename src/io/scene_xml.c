@@ -85,6 +85,7 @@ typedef struct parser {
     const xmlNode *substances; ///< <Substances>, read before everything else (or NULL)
     /// The line of each declared <Substance> (a mask may not take its name).
     int substance_lines[WX_MAX_SUBSTANCES];
+    int output_map_line; ///< the output camera's <OutputMap>, 0 when it has none
 } parser;
 
 static int line_of(const xmlNode *node)
@@ -1701,6 +1702,9 @@ static wx_result parse_output_map(parser *p, const xmlNode *node, void *user)
     cam->normalize = out.normalize;
     cam->every = out.every;
     o->output_node = node;
+    if (cam->is_output) {
+        p->output_map_line = line_of(node);
+    }
     return WX_OK;
 }
 
@@ -2894,6 +2898,78 @@ static wx_result check_texture_names(parser *p)
     return WX_OK;
 }
 
+/// The longest name among the files an output writes, as pipeline/gather_phase.c
+/// and texture_phase.c name them (docs/design.md sections 10 and 11): the file,
+/// its previews (BASE.png, or BASE.preview.png for a file ending in .png, when
+/// the scene has neither <Substances> nor <Masks>; else BASE_NAME.png per
+/// substance and per mask) and its last frame BASE.NNNN.exr.
+static size_t longest_output_name(const wx_scene *s, const char *file, int every,
+                                  char longest[WX_OUTPUT_NAME_MAX])
+{
+    char name[WX_OUTPUT_NAME_MAX];
+    snprintf(longest, WX_OUTPUT_NAME_MAX, "%s", file);
+    int base = (int)output_base_length(file);
+    if (!s->substances_declared && s->mask_count == 0) {
+        const char *dot = strrchr(file, '.');
+        int stem = dot != NULL && dot != file ? (int)(dot - file) : (int)strlen(file);
+        bool png = dot != NULL && dot != file && strcmp(dot, ".png") == 0;
+        snprintf(name, sizeof name, "%.*s%s", stem, file, png ? ".preview.png" : ".png");
+        if (strlen(name) > strlen(longest)) {
+            memcpy(longest, name, sizeof name);
+        }
+    }
+    for (int k = 0; k < s->substance_count + s->mask_count && s->substances_declared +
+                                                                   s->mask_count > 0; ++k) {
+        const char *channel = k < s->substance_count ? s->substances[k]
+                                                      : s->masks[k - s->substance_count].name;
+        snprintf(name, sizeof name, "%.*s_%s.png", base, file, channel);
+        if (strlen(name) > strlen(longest)) {
+            memcpy(longest, name, sizeof name);
+        }
+    }
+    int last = every > 0 ? s->iterations / every * every : 0;
+    if (last > 0) {
+        snprintf(name, sizeof name, "%.*s.%04d.exr", base, file, last);
+        if (strlen(name) > strlen(longest)) {
+            memcpy(longest, name, sizeof name);
+        }
+    }
+    return strlen(longest);
+}
+
+/// Every file a run writes has a name its temporary ".NAME.tmpPID" can take
+/// (WX_OUTPUT_FILE_NAME_MAX): a longer one failed with "File name too long"
+/// after all the work (issue 24). Refused at the <OutputMap>'s or the
+/// <TextureMap>'s line. A camera's maps (<camera>_normal.exr) always fit.
+static wx_result check_output_name_lengths(parser *p)
+{
+    _Static_assert(sizeof(((wx_scene_camera *)0)->name) - 1 + sizeof "_normal.exr" - 1 <=
+                       WX_OUTPUT_FILE_NAME_MAX,
+                   "a camera's map names fit");
+    const wx_scene *s = p->scene;
+    int count = s->texture_count + (s->output_index >= 0 ? 1 : 0);
+    for (int k = 0; k < count; ++k) {
+        bool mask = k == s->texture_count;
+        const char *file = mask ? s->cameras[s->output_index].output_file : s->textures[k].file;
+        int every = mask ? s->cameras[s->output_index].every : s->textures[k].every;
+        int line = mask ? (p->output_map_line > 0 ? p->output_map_line
+                                                  : s->cameras[s->output_index].line)
+                        : s->textures[k].line;
+        char longest[WX_OUTPUT_NAME_MAX];
+        size_t len = longest_output_name(s, file, every, longest);
+        if (len > WX_OUTPUT_FILE_NAME_MAX) {
+            return fail_line(p, line, WX_CAUSE_PATH_TOO_LONG,
+                             "<%s> file=\"%.24s...\" (%zu characters) gives the output name "
+                             "'%.24s...%s' of %zu characters, over the %d a run can write (its "
+                             "temporary '.NAME.tmpPID' must fit the %d of a file name); shorten "
+                             "file",
+                             mask ? "OutputMap" : "TextureMap", file, strlen(file), longest,
+                             longest + len - 16, len, WX_OUTPUT_FILE_NAME_MAX, WX_FILE_NAME_MAX);
+        }
+    }
+    return WX_OK;
+}
+
 static wx_result parse_root(parser *p, const xmlNode *node)
 {
     if (node == NULL) {
@@ -2912,7 +2988,7 @@ static wx_result parse_root(parser *p, const xmlNode *node)
         return fail(p, node, WX_CAUSE_MISSING, "<Weathering> needs a <Collider> with the cameras");
     }
     if ((r = finish_emitters(p)) != WX_OK || (r = check_output_name(p)) != WX_OK ||
-        (r = check_texture_names(p)) != WX_OK) {
+        (r = check_texture_names(p)) != WX_OK || (r = check_output_name_lengths(p)) != WX_OK) {
         return r;
     }
     return check_surface_rules(p);

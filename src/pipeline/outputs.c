@@ -333,9 +333,18 @@ wx_result wx_output_path(const wx_scene *scene, const wx_run_def *opts, const ch
         strcmp(name, "..") == 0) {
         return wx_fail(err, WX_CAUSE_BAD_VALUE, "'%s' is not a plain file name", name);
     }
+    // The file is written as ".NAME.tmpPID" first: that name and its path must fit too.
+    if (strlen(name) > WX_OUTPUT_FILE_NAME_MAX) {
+        return wx_fail(err, WX_CAUSE_PATH_TOO_LONG,
+                       "'%.24s...%s': a name of %zu characters, over the %d a run can write "
+                       "(its temporary '.NAME.tmpPID' must fit the %d of a file name)",
+                       name, name + strlen(name) - 16, strlen(name), WX_OUTPUT_FILE_NAME_MAX,
+                       WX_FILE_NAME_MAX);
+    }
     int n = snprintf(path, WX_PATH_MAX, "%s/%s", opts->out_dir, name);
-    if (n < 0 || n >= WX_PATH_MAX) {
-        return wx_fail(err, WX_CAUSE_PATH_TOO_LONG, "%s/%s: path too long", opts->out_dir, name);
+    if (n < 0 || n + WX_TEMP_NAME_EXTRA >= WX_PATH_MAX) {
+        return wx_fail(err, WX_CAUSE_PATH_TOO_LONG, "%.200s.../%s: path too long",
+                       opts->out_dir, name);
     }
     struct stat st;
     if (stat(path, &st) == 0 && is_scene_input(scene, &st)) {
@@ -419,6 +428,14 @@ static wx_result check_stats_path(const wx_scene *scene, const wx_run_def *opts,
                                   const wx_output_names *outputs, wx_error *err)
 {
     const char *path = opts->stats_path;
+    const char *slash = strrchr(path, '/');
+    const char *base = slash != NULL ? slash + 1 : path;
+    if (strlen(base) > WX_OUTPUT_FILE_NAME_MAX || strlen(path) + WX_TEMP_NAME_EXTRA >= WX_PATH_MAX) {
+        return wx_fail(err, WX_CAUSE_PATH_TOO_LONG,
+                       "--stats %.24s...: a name of %zu characters, over the %d a run can "
+                       "write (its temporary '.NAME.tmpPID' must fit the %d of a file name)",
+                       base, strlen(base), WX_OUTPUT_FILE_NAME_MAX, WX_FILE_NAME_MAX);
+    }
     struct stat st;
     if (lstat(path, &st) == 0) {
         if (!S_ISREG(st.st_mode)) {
