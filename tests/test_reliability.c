@@ -3,6 +3,7 @@
 #define _XOPEN_SOURCE 700 // realpath
 #include <dirent.h>
 #include <errno.h>
+#include <float.h>
 #include <fcntl.h>
 #include <limits.h>
 #include <signal.h>
@@ -628,6 +629,66 @@ TEST(output_names_fit_the_file_system_with_their_temporaries)
 }
 
 
+// Issue 24: no output channel is ever written holding NaN or an infinity. The
+// scene's amounts are checked when it is read (tests/bad/*_overflows_float.xml);
+// what a map file brings is not: a dirt map holding FLT_MAX of two substances
+// and a rule moving all of one into the other overflows single precision (b's
+// amount and its record of the rules' result, 2 x 16 texels). The dirt map is
+// then not written, and the command fails (exit 1) saying why.
+TEST(no_output_is_written_non_finite)
+{
+    char dir[4200];
+    snprintf(dir, sizeof dir, "%s/nonfinite", ensure_tmpdir());
+    ENSURE(mkdir(dir, 0777) == 0);
+    static const char *const names[] = { "a.amount", "a.deposit", "a.erosion",
+                                         "b.amount", "b.deposit", "b.erosion" };
+    wx_image map;
+    ENSURE(wx_image_alloc(&map, 4, 4, 6, names, NULL) == WX_OK);
+    for (int t = 0; t < 16; ++t) {
+        map.channels[0][t] = FLT_MAX;
+        map.channels[3][t] = FLT_MAX;
+    }
+    char path[4400];
+    snprintf(path, sizeof path, "%s/front_dirt_in.exr", dir);
+    wx_error err;
+    wx_result r = wx_exr_write(path, &map, &err);
+    wx_image_free(&map);
+    ENSURE(r == WX_OK);
+    char maps[PATH_MAX];
+    ENSURE(realpath("tests/data/map4.exr", maps) != NULL);
+    char scene[16384];
+    snprintf(scene, sizeof scene,
+             "<Weathering>\n"
+             "  <Substances><Substance name=\"a\"/><Substance name=\"b\"/></Substances>\n"
+             "  <Ageing><Transfer from=\"a\" to=\"b\" rate=\"1\"/></Ageing>\n"
+             "  <Collider><ProjectedMaps><Ortho cameraName=\"front\">\n"
+             "    <WTCMatrix matrix=\"1 0 0 0  0 1 0 0  0 0 1 0  0 0 0 1\"/>\n"
+             "    <DepthMap file=\"%s\"/><NormalMap file=\"%s\"/><ImpactMap file=\"%s\"/>\n"
+             "    <DirtMap file=\"front_dirt_in.exr\"/>\n"
+             "  </Ortho></ProjectedMaps></Collider>\n"
+             "</Weathering>\n",
+             maps, maps, maps);
+    ensure_write_file(dir, "scene.xml", scene);
+    int status = ensure_shell(out, sizeof out,
+                              "%s/weathering simulate %s/scene.xml --out %s/out -q",
+                              ensure_build_dir(), dir, dir);
+    if (status != 1) {
+        fprintf(stderr, "        status %d: %s", status, out);
+    }
+    ENSURE(status == 1);
+    ENSURE(ensure_contains(out, "front_dirt.exr: not written: channel b.amount holds +inf at "
+                                "texel (0, 0), and 32 values in all are not finite numbers"));
+    snprintf(path, sizeof path, "%s/out/front_dirt.exr", dir);
+    struct stat st;
+    ENSURE(stat(path, &st) != 0);
+    snprintf(path, sizeof path, "%s/out", dir);
+    char *left[8];
+    int count = list_names(path, "", left, 8);
+    free_names(left, count);
+    ENSURE(count == 0); // no temporary either
+}
+
+
 // Out of memory in the bake (the framebuffer, the images) is exit status 1 with
 // "out of memory", never a bad input nor "framebuffer is incomplete" (issue 13).
 TEST(out_of_memory_in_the_bake_is_exit_1)
@@ -673,6 +734,7 @@ int main(void)
     RUN(interrupt_removes_only_unfinished_temporaries);
     RUN(an_input_is_never_overwritten);
     RUN(output_names_fit_the_file_system_with_their_temporaries);
+    RUN(no_output_is_written_non_finite);
     RUN(out_of_memory_in_the_bake_is_exit_1);
     RUN(sigint_stops_a_run_cleanly);
     RUN(sigkill_never_leaves_a_torn_file);

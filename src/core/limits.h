@@ -40,6 +40,12 @@
 /// What a temporary's name adds to its file's: "." and ".tmp" and the pid.
 #define WX_TEMP_NAME_EXTRA 12
 
+/// Largest amount per square metre (and per texel) the scene's amounts may put
+/// on one texel in the worst case (docs/reliability.md): maps and masks hold
+/// floats, and a sum over a whole map (2^28 texels) of values up to this stays
+/// below FLT_MAX (3.4e38).
+#define WX_AMOUNT_MAX 1e30
+
 /// Longest material name kept from a mesh file.
 #define WX_MATERIAL_NAME_MAX 128
 /// Most distinct material names one mesh file may use (per-triangle index is 16 bits).
