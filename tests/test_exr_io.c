@@ -937,6 +937,111 @@ TEST(image_alloc_checks_sizes)
     ENSURE(image.channels[0] == NULL && image.width == 0);
 }
 
+// ---------------------------------------------------------------------------
+// Long names (issue 24): OpenEXR refuses names over 31 characters unless told;
+// its refusal used to hang the writer (the error handler asked the library for
+// its user data while the library held its lock). SIGALRM ends the program if a
+// write hangs again: tests/run.sh then counts it as failed.
+
+enum { HANG_GUARD_S = 20 };
+
+// The file's version field (bytes 4-7): 2, plus 0x400 when it holds long names.
+static uint32_t version_field(const char *path)
+{
+    size_t size = 0;
+    unsigned char *bytes = read_bytes(path, &size);
+    uint32_t v = bytes != NULL && size >= 8 ? (uint32_t)bytes[4] | (uint32_t)bytes[5] << 8 |
+                                                  (uint32_t)bytes[6] << 16 |
+                                                  (uint32_t)bytes[7] << 24
+                                            : 0;
+    free(bytes);
+    return v;
+}
+
+TEST(long_channel_names_round_trip)
+{
+    // The longest names the program writes: a 32-character substance's
+    // channels, with a layer prefix (design.md section 14), and the longest
+    // name an image holds (WX_NAME_MAX - 1).
+    static const char *const names[] = {
+        "abcdefghijklmnopqrstuvwxyz012345.Y",                 // 34
+        "layer7.abcdefghijklmnopqrstuvwxyz012345.deposit",    // 47
+        "n23456789012345678901234567890123456789012345678901234567890123", // 63
+        "short",
+    };
+    ENSURE(strlen(names[2]) == WX_NAME_MAX - 1);
+    wx_image image;
+    ENSURE(make_image(&image, 9, 40, 4, names));
+    image.threads = 2;
+    wx_image_set_string(&image, "anAttributeNameOfMoreThan31Characters", "x");
+    const char *path = path_in("long_names.exr");
+    wx_error err = { 0 };
+    alarm(HANG_GUARD_S);
+    wx_result r = wx_exr_write(path, &image, &err);
+    alarm(0);
+    if (r != WX_OK) {
+        fprintf(stderr, "        %s\n", err.message);
+    }
+    ENSURE(r == WX_OK);
+    ENSURE(version_field(path) == (2u | 0x400u));
+
+    static const char *const wanted[] = {names[1], names[2], names[0]};
+    wx_image back;
+    ENSURE(wx_exr_read(path, wanted, 3, &back, &err) == WX_OK);
+    bool right = back.channel_count == 3 && strcmp(back.channel_names[1], names[2]) == 0 &&
+                 back.channels[0][39 * 9 + 8] == image.channels[1][39 * 9 + 8] &&
+                 back.channels[1][5] == image.channels[2][5] &&
+                 back.channels[2][9] == image.channels[0][9];
+    const wx_attr *a = wx_image_find_attr(&back, "anAttributeNameOfMoreThan31Characters");
+    right = right && a != NULL && strcmp(a->string, "x") == 0;
+    wx_image_free(&back);
+
+    // Names of 31 characters and less keep the flag off: the file reads in
+    // every OpenEXR, and the program's other files keep their bytes.
+    static const char *const short_names[] = {"n234567890123456789012345678901"};
+    wx_image small;
+    ENSURE(make_image(&small, 3, 3, 1, short_names));
+    const char *short_path = path_in("short_names.exr");
+    ENSURE(wx_exr_write(short_path, &small, &err) == WX_OK);
+    wx_image_free(&small);
+    ENSURE(version_field(short_path) == 2u);
+    wx_image_free(&image);
+    ENSURE(right);
+
+    // Other readers: oiiotool (Debian's openimageio-tools, the C++ OpenEXR that
+    // Blender uses too) lists the long names, when it is installed.
+    char log[4096];
+    if (ensure_shell(log, sizeof log, "command -v oiiotool >/dev/null") != 0) {
+        fprintf(stderr, "        note: oiiotool is not installed; not checked with it\n");
+        return;
+    }
+    ENSURE(ensure_shell(log, sizeof log, "oiiotool --info -v '%s' 2>&1", path) == 0);
+    ENSURE(ensure_contains(log, names[1]) && ensure_contains(log, names[2]));
+}
+
+TEST(library_error_inside_its_lock_is_reported)
+{
+    // Setting "compression" as a string makes OpenEXR report a type clash from
+    // inside its lock: the message must come back, not a hang.
+    static const char *const names[] = {"R"};
+    wx_image image;
+    ENSURE(make_image(&image, 4, 4, 1, names));
+    wx_image_set_string(&image, "compression", "zip");
+    const char *path = path_in("clash.exr");
+    wx_error err = { 0 };
+    alarm(HANG_GUARD_S);
+    wx_result r = wx_exr_write(path, &image, &err);
+    alarm(0);
+    wx_image_free(&image);
+    ENSURE(r == WX_FAIL);
+    ENSURE_CAUSE(err, IO);
+    ENSURE(ensure_contains(err.message, path));
+    ENSURE(ensure_contains(err.message, "compression"));
+    struct stat st;
+    ENSURE(stat(path, &st) != 0);
+    ENSURE(count_temporaries(ensure_tmpdir()) == 0);
+}
+
 int main(void)
 {
     RUN(float_round_trip_is_bit_exact);
@@ -962,5 +1067,7 @@ int main(void)
     RUN(write_replaces_existing_file_whole);
     RUN(write_failure_keeps_the_old_file);
     RUN(image_alloc_checks_sizes);
+    RUN(long_channel_names_round_trip);
+    RUN(library_error_inside_its_lock_is_reported);
     return ensure_summary();
 }

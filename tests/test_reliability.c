@@ -3,6 +3,7 @@
 #define _XOPEN_SOURCE 700 // realpath
 #include <dirent.h>
 #include <errno.h>
+#include <float.h>
 #include <fcntl.h>
 #include <limits.h>
 #include <signal.h>
@@ -560,6 +561,134 @@ TEST(an_input_is_never_overwritten)
 }
 
 
+// Issue 24: output names of 244 to 255 characters passed and failed after all
+// the work with "File name too long" (exit 1), the temporary ".NAME.tmpPID"
+// being 12 characters longer. 243 is the longest a run writes: a mask of 243
+// characters (its preview too: BASE.png) is written; 244 is refused before any
+// folder, and so is a --stats file of 244.
+TEST(output_names_fit_the_file_system_with_their_temporaries)
+{
+    const char *dir = ensure_tmpdir();
+    char name243[WX_OUTPUT_FILE_NAME_MAX + 1], name244[WX_OUTPUT_FILE_NAME_MAX + 2];
+    memset(name243, 'n', sizeof name243 - 5);
+    memcpy(name243 + sizeof name243 - 5, ".exr", 5);
+    memset(name244, 'n', sizeof name244 - 5);
+    memcpy(name244 + sizeof name244 - 5, ".exr", 5);
+    ENSURE(strlen(name243) == 243 && strlen(name244) == 244);
+    for (int k = 0; k < 2; ++k) {
+        const char *file = k == 0 ? name243 : name244;
+        int status = ensure_shell(
+            out, sizeof out,
+            "set -e; mkdir -p %s/names%d; sed -e \"s|\\.\\./maps/|$PWD/maps/|\" -e "
+            "'s|thesis_box_mask.exr|%s|' xml_scenes/thesis_box.xml > %s/names%d/scene.xml",
+            dir, k, file, dir, k);
+        ENSURE(status == 0);
+    }
+    // 243: written, with its preview and no temporary left.
+    int status = ensure_shell(out, sizeof out, "%s/weathering run %s/names0/scene.xml --out "
+                              "%s/names0/out -q",
+                              ensure_build_dir(), dir, dir);
+    if (status != 0) {
+        fprintf(stderr, "        %s", out);
+    }
+    ENSURE(status == 0);
+    char path[PATH_MAX + 512];
+    struct stat st;
+    snprintf(path, sizeof path, "%s/names0/out/%s", dir, name243);
+    ENSURE(stat(path, &st) == 0 && st.st_size > 0);
+    snprintf(path, sizeof path, "%s/names0/out/%.239s.png", dir, name243);
+    ENSURE(stat(path, &st) == 0 && st.st_size > 0);
+    // 244: refused at the <OutputMap>'s line, nothing made.
+    status = ensure_shell(out, sizeof out, "%s/weathering run %s/names1/scene.xml --out "
+                          "%s/names1/out -q",
+                          ensure_build_dir(), dir, dir);
+    ENSURE(status == 2);
+    ENSURE(ensure_contains(out, "names1/scene.xml:41: <OutputMap> file=\""));
+    ENSURE(ensure_contains(out, "of 244 characters, over the 243 a run can write"));
+    snprintf(path, sizeof path, "%s/names1/out", dir);
+    ENSURE(stat(path, &st) != 0);
+    // --stats of 244 characters: refused before any work; 243 written.
+    char stats[2][WX_OUTPUT_FILE_NAME_MAX + 2];
+    for (int k = 0; k < 2; ++k) {
+        memset(stats[k], 's', (size_t)(WX_OUTPUT_FILE_NAME_MAX + k - 5));
+        memcpy(stats[k] + WX_OUTPUT_FILE_NAME_MAX + k - 5, ".json", 6);
+    }
+    status = ensure_shell(out, sizeof out, "%s/weathering run %s/names0/scene.xml --out "
+                          "%s/names2 -q --stats %s/%s",
+                          ensure_build_dir(), dir, dir, dir, stats[1]);
+    ENSURE(status == 2);
+    ENSURE(ensure_contains(out, "a name of 244 characters, over the 243 a run can write"));
+    snprintf(path, sizeof path, "%s/names2", dir);
+    ENSURE(stat(path, &st) != 0);
+    status = ensure_shell(out, sizeof out, "%s/weathering simulate %s/names0/scene.xml --out "
+                          "%s/names2 -q --stats %s/%s",
+                          ensure_build_dir(), dir, dir, dir, stats[0]);
+    ENSURE(status == 0);
+    snprintf(path, sizeof path, "%s/%s", dir, stats[0]);
+    ENSURE(stat(path, &st) == 0 && st.st_size > 0);
+}
+
+
+// Issue 24: no output channel is ever written holding NaN or an infinity. The
+// scene's amounts are checked when it is read (tests/bad/*_overflows_float.xml);
+// what a map file brings is not: a dirt map holding FLT_MAX of two substances
+// and a rule moving all of one into the other overflows single precision (b's
+// amount and its record of the rules' result, 2 x 16 texels). The dirt map is
+// then not written, and the command fails (exit 1) saying why.
+TEST(no_output_is_written_non_finite)
+{
+    char dir[4200];
+    snprintf(dir, sizeof dir, "%s/nonfinite", ensure_tmpdir());
+    ENSURE(mkdir(dir, 0777) == 0);
+    static const char *const names[] = { "a.amount", "a.deposit", "a.erosion",
+                                         "b.amount", "b.deposit", "b.erosion" };
+    wx_image map;
+    ENSURE(wx_image_alloc(&map, 4, 4, 6, names, NULL) == WX_OK);
+    for (int t = 0; t < 16; ++t) {
+        map.channels[0][t] = FLT_MAX;
+        map.channels[3][t] = FLT_MAX;
+    }
+    char path[4400];
+    snprintf(path, sizeof path, "%s/front_dirt_in.exr", dir);
+    wx_error err;
+    wx_result r = wx_exr_write(path, &map, &err);
+    wx_image_free(&map);
+    ENSURE(r == WX_OK);
+    char maps[PATH_MAX];
+    ENSURE(realpath("tests/data/map4.exr", maps) != NULL);
+    char scene[16384];
+    snprintf(scene, sizeof scene,
+             "<Weathering>\n"
+             "  <Substances><Substance name=\"a\"/><Substance name=\"b\"/></Substances>\n"
+             "  <Ageing><Transfer from=\"a\" to=\"b\" rate=\"1\"/></Ageing>\n"
+             "  <Collider><ProjectedMaps><Ortho cameraName=\"front\">\n"
+             "    <WTCMatrix matrix=\"1 0 0 0  0 1 0 0  0 0 1 0  0 0 0 1\"/>\n"
+             "    <DepthMap file=\"%s\"/><NormalMap file=\"%s\"/><ImpactMap file=\"%s\"/>\n"
+             "    <DirtMap file=\"front_dirt_in.exr\"/>\n"
+             "  </Ortho></ProjectedMaps></Collider>\n"
+             "</Weathering>\n",
+             maps, maps, maps);
+    ensure_write_file(dir, "scene.xml", scene);
+    int status = ensure_shell(out, sizeof out,
+                              "%s/weathering simulate %s/scene.xml --out %s/out -q",
+                              ensure_build_dir(), dir, dir);
+    if (status != 1) {
+        fprintf(stderr, "        status %d: %s", status, out);
+    }
+    ENSURE(status == 1);
+    ENSURE(ensure_contains(out, "front_dirt.exr: not written: channel b.amount holds +inf at "
+                                "texel (0, 0), and 32 values in all are not finite numbers"));
+    snprintf(path, sizeof path, "%s/out/front_dirt.exr", dir);
+    struct stat st;
+    ENSURE(stat(path, &st) != 0);
+    snprintf(path, sizeof path, "%s/out", dir);
+    char *left[8];
+    int count = list_names(path, "", left, 8);
+    free_names(left, count);
+    ENSURE(count == 0); // no temporary either
+}
+
+
 // Out of memory in the bake (the framebuffer, the images) is exit status 1 with
 // "out of memory", never a bad input nor "framebuffer is incomplete" (issue 13).
 TEST(out_of_memory_in_the_bake_is_exit_1)
@@ -604,6 +733,8 @@ int main(void)
     RUN(stale_temporaries_of_dead_processes_are_removed);
     RUN(interrupt_removes_only_unfinished_temporaries);
     RUN(an_input_is_never_overwritten);
+    RUN(output_names_fit_the_file_system_with_their_temporaries);
+    RUN(no_output_is_written_non_finite);
     RUN(out_of_memory_in_the_bake_is_exit_1);
     RUN(sigint_stops_a_run_cleanly);
     RUN(sigkill_never_leaves_a_torn_file);

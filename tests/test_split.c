@@ -156,8 +156,8 @@ TEST(conflicts_are_refused_before_any_file)
     ENSURE(strstr(out, "f_b.exr: exists and is a folder") != NULL && !exists(dir, "f_a.exr"));
     // A name too long for the file system, with its temporary.
     char base[300];
-    memset(base, 'n', 236);
-    strcpy(base + 236, ".exr");
+    memset(base, 'n', 240); // BASE_a.exr: 246 characters, its temporary 258
+    strcpy(base + 240, ".exr");
     ENSURE(write_exr(dir, base, two, 2));
     char args[400];
     snprintf(args, sizeof args, "split %s", base);

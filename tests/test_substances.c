@@ -17,6 +17,7 @@
 #include <dirent.h>
 #include <sys/stat.h>
 
+#include "core/limits.h"
 #include "ensure.h"
 #include "io/exr.h"
 #include "model/image.h"
@@ -422,6 +423,113 @@ TEST(surfaces_beyond_a_thousand_keep_their_rules)
     free(img);
 }
 
+// Replaces every `from` in `text` by `to` (malloc'd; NULL when out of memory).
+static char *replace_all(const char *text, const char *from, const char *to)
+{
+    size_t nf = strlen(from), nt = strlen(to), count = 0;
+    for (const char *p = strstr(text, from); p != NULL; p = strstr(p + nf, from)) {
+        count++;
+    }
+    char *out = malloc(strlen(text) + count * (nt > nf ? nt - nf : 0) + 1);
+    if (out == NULL) {
+        return NULL;
+    }
+    char *o = out;
+    for (const char *p = text;;) {
+        const char *hit = strstr(p, from);
+        size_t keep = hit != NULL ? (size_t)(hit - p) : strlen(p);
+        memcpy(o, p, keep);
+        o += keep;
+        if (hit == NULL) {
+            break;
+        }
+        memcpy(o, to, nt);
+        o += nt;
+        p = hit + nf;
+    }
+    *o = '\0';
+    return out;
+}
+
+TEST(names_of_32_characters_run_to_the_end)
+{
+    // Issue 24: a substance name of 24+ characters or a mask name of 30+ made
+    // channel names over 31 characters, and the EXR writer hung for ever. The
+    // scene above with water renamed to a 32-character name and a Height mask
+    // of a 32-character name: the run finishes (timeout-guarded) and the renamed
+    // channel holds exactly what water.Y holds.
+    static const char LONG_SUBSTANCE[] = "water_water_water_water_water_32";
+    static const char LONG_MASK[] = "height_height_height_height_he32";
+    _Static_assert(sizeof LONG_SUBSTANCE - 1 == WX_SUBSTANCE_NAME_MAX, "32 characters");
+    _Static_assert(sizeof LONG_MASK - 1 == WX_SUBSTANCE_NAME_MAX, "32 characters");
+    char *renamed = replace_all(SCENE_XML, "\"water\"", "\"water_water_water_water_water_32\"");
+    char *xml = renamed != NULL ? replace_all(renamed, "  <Geometry>\n",
+                                              "  <Masks><Height name=\"height_height_height_"
+                                              "height_he32\"/></Masks>\n  <Geometry>\n")
+                                : NULL;
+    free(renamed);
+    ENSURE(xml != NULL);
+    char dir[4200];
+    snprintf(dir, sizeof dir, "%s/long_names", ensure_tmpdir());
+    mkdir(dir, 0777);
+    ensure_write_file(dir, "plane.obj", PLANE_OBJ);
+    ensure_write_file(dir, "plane.mtl", PLANE_MTL);
+    ensure_write_file(dir, "scene.xml", xml);
+    free(xml);
+    char log[8192];
+    int status = ensure_shell(log, sizeof log,
+                              "timeout 120 '%s/weathering' run '%s/scene.xml' --out '%s/out' -q",
+                              ensure_build_dir(), dir, dir);
+    if (status != 0) {
+        fprintf(stderr, "        weathering run: status %d (124: it hung)\n%s\n", status, log);
+    }
+    ENSURE(status == 0);
+
+    char path[4400], base_path[4400];
+    const char *channels[2] = { "water_water_water_water_water_32.Y",
+                                "height_height_height_height_he32.Y" };
+    static const char *const water[1] = { "water.Y" };
+    bool same = true;
+    for (int k = 1; k <= ITERATIONS + 1 && same; ++k) {
+        char name[64];
+        if (k <= ITERATIONS) {
+            snprintf(name, sizeof name, "mask.%04d.exr", k);
+        } else {
+            snprintf(name, sizeof name, "mask.exr");
+        }
+        snprintf(path, sizeof path, "%s/out/%s", dir, name);
+        snprintf(base_path, sizeof base_path, "%s/%s", run_dir(), name);
+        wx_image *img = calloc(1, sizeof *img), *base = calloc(1, sizeof *base);
+        wx_error err;
+        same = img != NULL && base != NULL &&
+               wx_exr_read(path, channels, 2, img, &err) == WX_OK &&
+               wx_exr_read(base_path, water, 1, base, &err) == WX_OK &&
+               memcmp(img->channels[0], base->channels[0],
+                      sizeof(float) * (size_t)(OUT_PX * OUT_PX)) == 0;
+        if (!same) {
+            fprintf(stderr, "        %s differs from the run with water (or is unreadable)\n",
+                    name);
+        }
+        wx_image_free(img);
+        wx_image_free(base);
+        free(img);
+        free(base);
+    }
+    ENSURE(same);
+    // The dirt maps hold the long substance channels; previews are named after them.
+    snprintf(path, sizeof path, "%s/out/top_dirt.exr", dir);
+    int w = 0, h = 0;
+    float *deposit = ensure_read_channel(path, "water_water_water_water_water_32.deposit", &w,
+                                         &h);
+    ENSURE(deposit != NULL);
+    free(deposit);
+    snprintf(path, sizeof path, "%s/out/mask_%s.png", dir, LONG_MASK);
+    struct stat st;
+    ENSURE(stat(path, &st) == 0 && st.st_size > 0);
+    snprintf(path, sizeof path, "%s/out/mask_%s.png", dir, LONG_SUBSTANCE);
+    ENSURE(stat(path, &st) == 0 && st.st_size > 0);
+}
+
 int main(void)
 {
     RUN(water_and_rust_follow_the_recurrence_in_every_frame);
@@ -431,5 +539,6 @@ int main(void)
     RUN(several_substances_give_the_same_bytes_for_any_thread_count);
     RUN(the_ledger_balances_on_every_shipped_scene);
     RUN(surfaces_beyond_a_thousand_keep_their_rules);
+    RUN(names_of_32_characters_run_to_the_end);
     return ensure_summary();
 }

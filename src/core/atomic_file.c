@@ -130,11 +130,6 @@ int wx_temp_remove_stale(const char *folder, bool (*is_ours)(const char *name, v
     return removed;
 }
 
-bool wx_temp_name_fits(const char *name)
-{
-    return strlen(name) <= WX_FILE_NAME_MAX - WX_TEMP_NAME_EXTRA;
-}
-
 void wx_temp_path(const char *path, char tmp[WX_PATH_MAX])
 {
     const char *slash = strrchr(path, '/');

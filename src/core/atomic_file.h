@@ -20,11 +20,6 @@
 /// remembered until wx_atomic_commit (or wx_temp_forget) for wx_temp_remove_all.
 void wx_temp_path(const char *path, char tmp[WX_PATH_MAX]);
 
-/// True when the file name `name` (no folder) and its temporary's
-/// ".NAME.tmpPID" both fit the file system's limit of WX_FILE_NAME_MAX bytes:
-/// at most WX_FILE_NAME_MAX - WX_TEMP_NAME_EXTRA bytes.
-bool wx_temp_name_fits(const char *name);
-
 /// Forgets a temporary name that was removed or never created.
 void wx_temp_forget(const char *tmp);
 

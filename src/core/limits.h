@@ -27,14 +27,24 @@
 #define WX_NAME_MAX 64
 #define WX_ATTR_STRING_MAX 1024
 
-/// Longest file name (one path component) the file systems take (NAME_MAX),
-/// and what a temporary ".NAME.tmpPID" adds to a name: '.', ".tmp" and a
-/// process id of up to 10 digits. So an output's name has at most 240 bytes.
-#define WX_FILE_NAME_MAX 255
-#define WX_TEMP_NAME_EXTRA 15
-
-/// Longest plain file name the program writes into an output folder.
+/// Size of the buffers that hold a plain file name the program writes into an
+/// output folder (a name of up to 255 characters and a suffix).
 #define WX_OUTPUT_NAME_MAX 320
+
+/// Longest file name a folder holds (NAME_MAX of Linux's file systems).
+#define WX_FILE_NAME_MAX 255
+/// Longest name of a file a run writes: its temporary ".NAME.tmpPID"
+/// (core/atomic_file.c) adds 5 characters and the pid's, at most 7 (Linux's
+/// pid_max is at most 2^22), and must fit WX_FILE_NAME_MAX too.
+#define WX_OUTPUT_FILE_NAME_MAX (WX_FILE_NAME_MAX - 5 - 7)
+/// What a temporary's name adds to its file's: "." and ".tmp" and the pid.
+#define WX_TEMP_NAME_EXTRA 12
+
+/// Largest amount per square metre (and per texel) the scene's amounts may put
+/// on one texel in the worst case (docs/reliability.md): maps and masks hold
+/// floats, and a sum over a whole map (2^28 texels) of values up to this stays
+/// below FLT_MAX (3.4e38).
+#define WX_AMOUNT_MAX 1e30
 
 /// Longest material name kept from a mesh file.
 #define WX_MATERIAL_NAME_MAX 128

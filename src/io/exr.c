@@ -50,13 +50,35 @@ static void stream_reset(exr_stream *s)
     s->message[0] = '\0';
 }
 
+// The stream of the file this thread is reading or writing, where the error
+// handler records the library's message. The handler must not ask the library
+// for it (exr_get_user_data): OpenEXR calls the handler while it holds the
+// context's lock, and asking again waits on that lock forever (a channel name
+// over 31 characters hung every run this way, issue 24). A worker thread of a
+// parallel decode or encode has none bound: its messages are dropped, and the
+// failure is reported with the library's default message for its code.
+static _Thread_local exr_stream *bound_stream;
+
+// Binds `s` to the calling thread; returns the stream bound before, for stream_unbind.
+static exr_stream *stream_bind(exr_stream *s)
+{
+    exr_stream *outer = bound_stream;
+    bound_stream = s;
+    return outer;
+}
+
+static void stream_unbind(exr_stream *outer)
+{
+    bound_stream = outer;
+}
+
 static void stream_on_error(exr_const_context_t ctxt, exr_result_t code, const char *msg)
 {
-    void *user = NULL;
-    if (ctxt == NULL || exr_get_user_data(ctxt, &user) != EXR_ERR_SUCCESS || user == NULL) {
+    (void)ctxt; // never call into the library from here (see bound_stream)
+    exr_stream *s = bound_stream;
+    if (s == NULL) {
         return;
     }
-    exr_stream *s = user;
     if (!s->quiet && s->message[0] == '\0') {
         snprintf(s->message, sizeof s->message, "%s",
                  msg != NULL ? msg : exr_get_default_error_message(code));
@@ -149,6 +171,8 @@ typedef struct exr_reader {
     int width;
     int height;
     int min_y; // data window origin: file scanline of row 0
+    bool bound;               // the stream is bound to this thread (stream_bind)
+    exr_stream *outer_stream; // what was bound before
 } exr_reader;
 
 static void reader_close(exr_reader *r)
@@ -157,6 +181,10 @@ static void reader_close(exr_reader *r)
     if (r->stream.fd >= 0) {
         close(r->stream.fd);
         r->stream.fd = -1;
+    }
+    if (r->bound) {
+        stream_unbind(r->outer_stream);
+        r->bound = false;
     }
 }
 
@@ -167,10 +195,13 @@ static const uint8_t exr_magic[4] = {0x76, 0x2f, 0x31, 0x01};
 static wx_result reader_open(exr_reader *r, const char *path, wx_error *err)
 {
     memset(r, 0, sizeof *r);
+    r->outer_stream = stream_bind(&r->stream);
+    r->bound = true;
     char why[WX_INPUT_WHY_MAX];
     wx_cause cause = WX_CAUSE_NONE;
     r->stream.fd = wx_open_regular(path, why, &cause); // a FIFO is refused, never waited on
     if (r->stream.fd < 0) {
+        reader_close(r);
         return wx_fail(err, cause, "%s: %s", path, why);
     }
     struct stat st;
@@ -945,6 +976,29 @@ static exr_result_t write_chunks(exr_context_t ctx, int part, int lines, const w
     return rv;
 }
 
+// Longest name a file without the "long names" flag may hold (OpenEXR before
+// 1.7 reads only those; the library refuses longer ones unless told).
+enum { EXR_SHORT_NAME_MAX = 31 };
+
+// True when a channel or attribute name of `image` is longer than 31 characters:
+// a substance channel such as layer7.NAME.deposit of a 32-character substance
+// (47 characters). Only such files carry the flag, so every other file keeps
+// its bytes and stays readable by the oldest readers.
+static bool needs_long_names(const wx_image *image)
+{
+    for (int c = 0; c < image->channel_count; c++) {
+        if (strlen(image->channel_names[c]) > EXR_SHORT_NAME_MAX) {
+            return true;
+        }
+    }
+    for (int a = 0; a < image->attr_count; a++) {
+        if (strlen(image->attrs[a].name) > EXR_SHORT_NAME_MAX) {
+            return true;
+        }
+    }
+    return false;
+}
+
 // Writes the whole file through the stream (the temporary file).
 static wx_result write_body(exr_stream *s, const char *path, const char *tmp_path,
                             const wx_image *image, wx_error *err)
@@ -956,6 +1010,9 @@ static wx_result write_body(exr_stream *s, const char *path, const char *tmp_pat
     exr_context_t ctx = NULL;
     stream_reset(s);
     exr_result_t rv = exr_start_write(&ctx, tmp_path, EXR_WRITE_FILE_DIRECTLY, &init);
+    if (rv == EXR_ERR_SUCCESS && needs_long_names(image)) {
+        rv = exr_set_longname_support(ctx, 1);
+    }
     int part = 0;
     if (rv == EXR_ERR_SUCCESS) {
         rv = exr_add_part(ctx, NULL, EXR_STORAGE_SCANLINE, &part);
@@ -1037,7 +1094,9 @@ wx_result wx_exr_write(const char *path, const wx_image *image, wx_error *err)
         return wx_fail(err, WX_CAUSE_IO, "%s: cannot create %s (%s)", path, tmp_path,
                             strerror(errno));
     }
+    exr_stream *outer = stream_bind(&s);
     result = write_body(&s, path, tmp_path, image, err);
+    stream_unbind(outer);
     if (close(s.fd) != 0 && result == WX_OK) {
         result = wx_fail(err, WX_CAUSE_IO, "%s: cannot write (%s)", path, strerror(errno));
     }

@@ -74,6 +74,15 @@ wx_result wx_preview_scale(const float *mask, size_t count, float *scale, wx_err
     return WX_OK;
 }
 
+// A mask within [0, 1] (a derived mask, a normalised one, little dirt per
+// square metre) shows its values as they are; only a larger one is stretched
+// to its 99th percentile. Stretching every mask made a constant one (0.144
+// everywhere) pure white, as if it were at its most (issue 24).
+float wx_preview_white(float p99)
+{
+    return p99 > 1.0f ? p99 : 1.0f;
+}
+
 typedef struct png_failure {
     jmp_buf jump;
     char message[256];
@@ -180,7 +189,7 @@ wx_result wx_preview_write_png(const char *path, const float *mask, const float 
     if (pixels == NULL) {
         return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "%s: out of memory", path);
     }
-    const float inv_scale = scale > 0.0f ? 1.0f / scale : 0.0f;
+    const float inv_scale = 1.0f / wx_preview_white(scale);
     for (size_t t = 0; t < texels; ++t) {
         float value = mask[t] * inv_scale;
         value = value > 0.0f ? (value < 1.0f ? powf(value, 1.0f / 2.2f) : 1.0f) : 0.0f;

@@ -85,7 +85,23 @@ typedef struct parser {
     const xmlNode *substances; ///< <Substances>, read before everything else (or NULL)
     /// The line of each declared <Substance> (a mask may not take its name).
     int substance_lines[WX_MAX_SUBSTANCES];
+    int output_map_line; ///< the output camera's <OutputMap>, 0 when it has none
+    /// Every load and initial amount the scene gives, for check_amounts.
+    struct amount_source *sources;
+    int64_t source_count, source_cap;
 } parser;
+
+/// Where an amount comes from: an emitter's load of a substance (<Load>, or the
+/// emitter's dirt=) or a surface's initial amount per square metre (<Exchange
+/// initial>, or the <Surface>'s dirt=); Grow's amounts are the rules'.
+typedef struct amount_source {
+    bool load;          ///< else an initial amount
+    int emitter;        ///< a load's emitter (index)
+    int substance;
+    double amount;
+    int line;
+    const char *element; ///< "<Load> amount", "<BoxEmitter> dirt", ...
+} amount_source;
 
 static int line_of(const xmlNode *node)
 {
@@ -131,6 +147,23 @@ static wx_result fail_line(parser *p, int line, wx_cause cause, const char *fmt,
 static wx_result out_of_memory(parser *p)
 {
     return wx_fail(p->err, WX_CAUSE_OUT_OF_MEMORY, "%s: out of memory", p->path);
+}
+
+/// Records an amount for check_amounts (0 needs no check).
+static wx_result add_amount(parser *p, bool load, int emitter, int substance, double amount,
+                            int line, const char *element)
+{
+    if (!(amount > 0.0)) {
+        return WX_OK;
+    }
+    if (!wx_array_reserve((void **)&p->sources, &p->source_cap, p->source_count + 1,
+                          sizeof *p->sources, 16)) {
+        return out_of_memory(p);
+    }
+    p->sources[p->source_count++] = (amount_source){ .load = load, .emitter = emitter,
+                                                     .substance = substance, .amount = amount,
+                                                     .line = line, .element = element };
+    return WX_OK;
 }
 
 /// Makes room for one more item at the end of a scene array of at most `max`
@@ -1442,7 +1475,8 @@ static wx_result parse_load(parser *p, const xmlNode *node, void *user)
     st->given |= 1u << k;
     st->lines[k] = line_of(node);
     st->e->load[k] = d.amount;
-    return WX_OK;
+    return add_amount(p, true, (int)(st->e - p->scene->emitters), k, d.amount, line_of(node),
+                      "<Load> amount");
 }
 
 static const child_spec load_children[] = {
@@ -1496,6 +1530,19 @@ static wx_result parse_emitter(parser *p, const xmlNode *node, wx_emitter_kind k
                         name_of(node), (double)d.dirt, line_of(p->substances));
         }
         e->load[s->dirt_substance] = d.dirt;
+    }
+    if (s->dirt_substance >= 0) {
+        // dirt=, or version 1's default load of 1.
+        static const char *const dirt_of[2][3] = {
+            { "<PointEmitter>'s default dirt", "<HemisphereEmitter>'s default dirt",
+              "<BoxEmitter>'s default dirt" },
+            { "<PointEmitter> dirt", "<HemisphereEmitter> dirt", "<BoxEmitter> dirt" },
+        };
+        r = add_amount(p, true, s->emitter_count - 1, s->dirt_substance,
+                       e->load[s->dirt_substance], e->line, dirt_of[dirt_attribute][kind]);
+        if (r != WX_OK) {
+            return r;
+        }
     }
     for (int i = 0; e->name[0] != '\0' && i < s->emitter_count - 1; ++i) {
         if (strcmp(s->emitters[i].name, e->name) == 0) {
@@ -1712,6 +1759,9 @@ static wx_result parse_output_map(parser *p, const xmlNode *node, void *user)
     cam->normalize = out.normalize;
     cam->every = out.every;
     o->output_node = node;
+    if (cam->is_output) {
+        p->output_map_line = line_of(node);
+    }
     return WX_OK;
 }
 
@@ -2111,7 +2161,7 @@ static wx_result parse_exchange(parser *p, const xmlNode *node, void *user)
     st->sf->initial[k] = d.initial;
     st->sf->deposit[k] = d.deposit;
     st->sf->erosion[k] = d.erosion;
-    return WX_OK;
+    return add_amount(p, false, -1, k, d.initial, line_of(node), "<Exchange> initial");
 }
 
 static const child_spec surface_children[] = {
@@ -2169,6 +2219,10 @@ static wx_result parse_surface(parser *p, const xmlNode *node, void *user)
         sf->initial[s->dirt_substance] = d.dirt;
         sf->deposit[s->dirt_substance] = d.deposit;
         sf->erosion[s->dirt_substance] = d.erosion;
+        r = add_amount(p, false, -1, s->dirt_substance, d.dirt, sf->line, "<Surface> dirt");
+        if (r != WX_OK) {
+            return r;
+        }
     }
     memcpy(sf->material, d.material, sizeof d.material);
     surface_state st = { .sf = sf };
@@ -2912,6 +2966,186 @@ static const attr_spec root_attrs[] = {
     { "name", T_NAME, offsetof(wx_scene, name), .size = sizeof(((wx_scene *)0)->name) },
 };
 
+/// The longest name among the files an output writes, as pipeline/gather_phase.c
+/// and texture_phase.c name them (docs/design.md sections 10 and 11): the file,
+/// its previews (BASE.png, or BASE.preview.png for a file ending in .png, when
+/// the scene has neither <Substances> nor <Masks>; else BASE_NAME.png per
+/// substance and per mask) and its last frame BASE.NNNN.exr.
+static size_t longest_output_name(const wx_scene *s, const char *file, int every,
+                                  char longest[WX_OUTPUT_NAME_MAX])
+{
+    char name[WX_OUTPUT_NAME_MAX];
+    snprintf(longest, WX_OUTPUT_NAME_MAX, "%s", file);
+    int base = (int)output_base_length(file);
+    if (!s->substances_declared && s->mask_count == 0) {
+        const char *dot = strrchr(file, '.');
+        int stem = dot != NULL && dot != file ? (int)(dot - file) : (int)strlen(file);
+        bool png = dot != NULL && dot != file && strcmp(dot, ".png") == 0;
+        snprintf(name, sizeof name, "%.*s%s", stem, file, png ? ".preview.png" : ".png");
+        if (strlen(name) > strlen(longest)) {
+            memcpy(longest, name, sizeof name);
+        }
+    }
+    for (int k = 0; k < s->substance_count + s->mask_count && s->substances_declared +
+                                                                   s->mask_count > 0; ++k) {
+        const char *channel = k < s->substance_count ? s->substances[k]
+                                                      : s->masks[k - s->substance_count].name;
+        snprintf(name, sizeof name, "%.*s_%s.png", base, file, channel);
+        if (strlen(name) > strlen(longest)) {
+            memcpy(longest, name, sizeof name);
+        }
+    }
+    int last = every > 0 ? s->iterations / every * every : 0;
+    if (last > 0) {
+        snprintf(name, sizeof name, "%.*s.%04d.exr", base, file, last);
+        if (strlen(name) > strlen(longest)) {
+            memcpy(longest, name, sizeof name);
+        }
+    }
+    return strlen(longest);
+}
+
+/// Every file a run writes has a name its temporary ".NAME.tmpPID" can take
+/// (WX_OUTPUT_FILE_NAME_MAX): a longer one failed with "File name too long"
+/// after all the work (issue 24). Refused at the <OutputMap>'s or the
+/// <TextureMap>'s line. A camera's maps (<camera>_normal.exr) always fit.
+static wx_result check_output_name_lengths(parser *p)
+{
+    _Static_assert(sizeof(((wx_scene_camera *)0)->name) - 1 + sizeof "_normal.exr" - 1 <=
+                       WX_OUTPUT_FILE_NAME_MAX,
+                   "a camera's map names fit");
+    const wx_scene *s = p->scene;
+    int count = s->texture_count + (s->output_index >= 0 ? 1 : 0);
+    for (int k = 0; k < count; ++k) {
+        bool mask = k == s->texture_count;
+        const char *file = mask ? s->cameras[s->output_index].output_file : s->textures[k].file;
+        int every = mask ? s->cameras[s->output_index].every : s->textures[k].every;
+        int line = mask ? (p->output_map_line > 0 ? p->output_map_line
+                                                  : s->cameras[s->output_index].line)
+                        : s->textures[k].line;
+        char longest[WX_OUTPUT_NAME_MAX];
+        size_t len = longest_output_name(s, file, every, longest);
+        if (len > WX_OUTPUT_FILE_NAME_MAX) {
+            return fail_line(p, line, WX_CAUSE_PATH_TOO_LONG,
+                             "<%s> file=\"%.24s...\" (%zu characters) gives the output name "
+                             "'%.24s...%s' of %zu characters, over the %d a run can write (its "
+                             "temporary '.NAME.tmpPID' must fit the %d of a file name); shorten "
+                             "file",
+                             mask ? "OutputMap" : "TextureMap", file, strlen(file), longest,
+                             longest + len - 16, len, WX_OUTPUT_FILE_NAME_MAX, WX_FILE_NAME_MAX);
+        }
+    }
+    return WX_OK;
+}
+
+/// One amount's share of the worst case, per square metre and per texel.
+typedef struct amount_share {
+    double per_m2, per_texel;
+    int line;
+    char what[160];
+} amount_share;
+
+static void keep_largest(amount_share *largest, const amount_share *share)
+{
+    if (fmax(share->per_m2, share->per_texel) > fmax(largest->per_m2, largest->per_texel) ||
+        largest->line == 0) {
+        *largest = *share;
+    }
+}
+
+/// The amounts' worst case fits single precision with room for sums over a map
+/// (WX_AMOUNT_MAX, docs/reliability.md "Amounts"): what one texel of an input
+/// camera can hold, per square metre and in all, if every particle of every
+/// emitter, over every iteration, left its whole load on the smallest texel,
+/// on top of every surface's initial amount and every Grow's amount over the
+/// iterations (a substance may be transferred into another, so all add up;
+/// a texel seen edge-on covers up to 1000 times its area, as the bake clamps
+/// |N.view| at 1e-3). A scene over it is refused at the line of the amount that
+/// gives the most: <Load amount="3e38"> wrote dirt maps holding +inf, <Grow
+/// amount="3e38"> a mask holding +inf, with exit 0 (issue 24).
+static wx_result check_amounts(parser *p)
+{
+    const wx_scene *s = p->scene;
+    double a_min = INFINITY, a_max = 0.0;
+    for (int c = 0; c < s->camera_count; ++c) {
+        const wx_scene_camera *cam = &s->cameras[c];
+        float fw = 0.0f, fh = 0.0f;
+        if (cam->is_output || cam->camera.width <= 0 || cam->camera.height <= 0) {
+            continue;
+        }
+        wx_camera_frame_size(&cam->camera, &fw, &fh);
+        double area = ((double)fw / cam->camera.width) * ((double)fh / cam->camera.height);
+        if (area > 0.0 && isfinite(area)) {
+            a_min = fmin(a_min, area);
+            a_max = fmax(a_max, area);
+        }
+    }
+    if (a_max <= 0.0) {
+        return WX_OK; // no input camera: refused elsewhere
+    }
+    const double edge_on = 1000.0; // 1 / the bake's smallest |N.view|
+    double iterations = s->iterations > 1 ? s->iterations : 1;
+    double per_m2 = 0.0, per_texel = 0.0;
+    amount_share largest = { .line = 0 }, share;
+    for (int64_t k = 0; k < p->source_count; ++k) {
+        const amount_source *src = &p->sources[k];
+        const char *substance = s->substances[src->substance];
+        if (src->load) {
+            const wx_emitter *e = &s->emitters[src->emitter];
+            double particles = fmax(0.0, e->rate * (e->end - e->start)) * iterations;
+            share.per_texel = particles * src->amount;
+            share.per_m2 = share.per_texel / a_min;
+            snprintf(share.what, sizeof share.what,
+                     "%s=\"%g\" of substance '%s' (%.3g particles over %g iteration%s)",
+                     src->element, src->amount, substance, particles, iterations,
+                     iterations == 1.0 ? "" : "s");
+        } else {
+            share.per_m2 = edge_on * src->amount;
+            share.per_texel = share.per_m2 * a_max;
+            snprintf(share.what, sizeof share.what, "%s=\"%g\" of substance '%s'",
+                     src->element, src->amount, substance);
+        }
+        share.line = src->line;
+        per_m2 += share.per_m2;
+        per_texel += share.per_texel;
+        keep_largest(&largest, &share);
+    }
+    for (int m = -1; m < s->mesh_count; ++m) {
+        for (int f = m < 0 ? -1 : 0; f < (m < 0 ? 0 : s->meshes[m].surface_count); ++f) {
+            const wx_rule *rules = m < 0 ? s->rules : s->meshes[m].surfaces[f].rules;
+            int count = m < 0 ? s->rule_count : s->meshes[m].surfaces[f].rule_count;
+            for (int r = 0; r < count; ++r) {
+                if (rules[r].kind != WX_RULE_GROW || !(rules[r].amount > 0.0f)) {
+                    continue;
+                }
+                share.per_m2 = edge_on * iterations * rules[r].amount;
+                share.per_texel = share.per_m2 * a_max;
+                share.line = rules[r].line;
+                snprintf(share.what, sizeof share.what,
+                         "<Grow> amount=\"%g\" of substance '%s' (over %g iteration%s)",
+                         (double)rules[r].amount, s->substances[rules[r].substance], iterations,
+                         iterations == 1.0 ? "" : "s");
+                per_m2 += share.per_m2;
+                per_texel += share.per_texel;
+                keep_largest(&largest, &share);
+            }
+        }
+    }
+    if (!(per_m2 > WX_AMOUNT_MAX || per_texel > WX_AMOUNT_MAX)) {
+        return WX_OK;
+    }
+    return fail_line(p, largest.line, WX_CAUSE_BAD_VALUE,
+                     "%s: in the worst case one texel would hold %.3g per square metre (%.3g "
+                     "in all), over the %.0e that single-precision maps and masks hold with room "
+                     "for their sums (every load on the smallest input texel, %.3g m^2, plus "
+                     "every initial and grown amount; see docs/reliability.md); this amount "
+                     "gives the most: lower it%s",
+                     largest.what, per_m2, per_texel, WX_AMOUNT_MAX, a_min,
+                     strstr(largest.what, "particles") != NULL
+                         ? ", or the emitter's rate or duration, or the iterations"
+                         : "");
+}
+
 static wx_result parse_root(parser *p, const xmlNode *node)
 {
     if (node == NULL) {
@@ -2931,7 +3165,8 @@ static wx_result parse_root(parser *p, const xmlNode *node)
         return fail(p, node, WX_CAUSE_MISSING, "<Weathering> needs a <Collider> with the cameras");
     }
     if ((r = finish_emitters(p)) != WX_OK || (r = check_output_name(p)) != WX_OK ||
-        (r = check_texture_names(p)) != WX_OK) {
+        (r = check_texture_names(p)) != WX_OK || (r = check_output_name_lengths(p)) != WX_OK ||
+        (r = check_amounts(p)) != WX_OK) {
         return r;
     }
     return check_surface_rules(p);
@@ -2997,6 +3232,7 @@ static wx_result scene_load(const char *path, const char *text, size_t size, wx_
         locale_t previous = c_locale != (locale_t)0 ? uselocale(c_locale) : (locale_t)0;
         parser p = { .path = path, .err = err, .scene = out };
         r = parse_root(&p, xmlDocGetRootElement(doc));
+        free(p.sources);
         if (c_locale != (locale_t)0) {
             uselocale(previous);
             freelocale(c_locale);

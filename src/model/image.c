@@ -2,6 +2,8 @@
 #include "model/image.h"
 
 #include <assert.h>
+#include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -94,4 +96,35 @@ void wx_image_free(wx_image *image)
         free(image->channels[c]);
     }
     memset(image, 0, sizeof *image);
+}
+
+wx_result wx_image_check_finite(const wx_image *image, const char *path, wx_error *err)
+{
+    size_t texels = (size_t)image->width * (size_t)image->height;
+    int64_t bad = 0;
+    int first_channel = -1;
+    size_t first_texel = 0;
+    for (int c = 0; c < image->channel_count; ++c) {
+        const float *plane = image->channels[c];
+        for (size_t t = 0; plane != NULL && t < texels; ++t) {
+            if (!isfinite(plane[t])) {
+                if (bad++ == 0) {
+                    first_channel = c;
+                    first_texel = t;
+                }
+            }
+        }
+    }
+    if (bad == 0) {
+        return WX_OK;
+    }
+    float v = image->channels[first_channel][first_texel];
+    return wx_fail(err, WX_CAUSE_INTERNAL,
+                   "%s: not written: channel %s holds %s at texel (%zu, %zu), and %lld values "
+                   "in all are not finite numbers (an amount overflowed single precision; "
+                   "lower the scene's amounts, see docs/reliability.md)",
+                   path, image->channel_names[first_channel],
+                   isnan(v) ? "NaN" : (v > 0.0f ? "+inf" : "-inf"),
+                   first_texel % (size_t)image->width, first_texel / (size_t)image->width,
+                   (long long)bad);
 }

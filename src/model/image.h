@@ -65,6 +65,13 @@ void wx_image_set_string(wx_image *image, const char *name, const char *value);
 /// Finds an attribute by name, or NULL.
 const wx_attr *wx_image_find_attr(const wx_image *image, const char *name);
 
+/// The last guard before an output is written (issue 24): WX_OK when every
+/// texel of every channel is a finite number; else WX_FAIL (WX_CAUSE_INTERNAL:
+/// the scene's checks should have refused what overflowed) with a message
+/// naming `path`, the first channel and texel and how many are not finite.
+/// Depth maps, whose +inf means "no surface", are not checked with it.
+wx_result wx_image_check_finite(const wx_image *image, const char *path, wx_error *err);
+
 /// Frees the planes; the struct is zeroed and may be reused.
 void wx_image_free(wx_image *image);
 

@@ -40,7 +40,11 @@ static void write_files(int64_t begin, int64_t end, int worker, void *context)
     bake_writer *w = context;
     for (int64_t k = begin; k < end; ++k) {
         map_file *f = &w->files[k];
-        f->result = wx_exr_write(f->path, f->image, &f->err);
+        // Every map but the depth (whose +inf means no surface) holds finite values.
+        f->result = k > 0 ? wx_image_check_finite(f->image, f->path, &f->err) : WX_OK;
+        if (f->result == WX_OK) {
+            f->result = wx_exr_write(f->path, f->image, &f->err);
+        }
     }
 }
 

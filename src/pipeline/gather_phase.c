@@ -278,6 +278,9 @@ static wx_result write_mask(const wx_scene *scene, const wx_run_def *opts, const
         wx_image_set_m44f(image, "CTWMatrix", out->camera.ctw);
         wx_image_set_string(image, "cameraName", out->name);
         image->threads = opts->threads; // the chunks compressed in parallel: the same bytes
+        result = wx_image_check_finite(image, mask_path, err);
+    }
+    if (result == WX_OK) {
         result = wx_exr_write(mask_path, image, err);
     }
     if (result == WX_OK && frame == 0 && channels == 1) {

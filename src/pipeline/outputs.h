@@ -8,16 +8,21 @@
 
 #include <stdbool.h>
 #include <stddef.h>
+#include <stdint.h>
 
 #include "core/error.h"
 #include "core/limits.h"
 #include "model/scene.h"
 #include "pipeline/pipeline.h"
 
-/// The plain names of the files a run writes into its output folder.
+/// The plain names of the files a run writes into its output folder, each
+/// once, with a hash set of them (a sequence may hold 100 000 frames).
 typedef struct wx_output_names {
     int count;
     char (*names)[WX_OUTPUT_NAME_MAX];
+    int64_t capacity;  ///< names allocated
+    int *slots;        ///< open addressing: index + 1 of a name, 0 = empty
+    int64_t slot_count; ///< a power of two, at least twice count
 } wx_output_names;
 
 /// What a path that is not a regular file is, for messages, from its
@@ -33,6 +38,9 @@ wx_result wx_output_names_list(const wx_scene *scene, unsigned phases, wx_output
 
 /// Frees the list; the struct is zeroed.
 void wx_output_names_free(wx_output_names *names);
+
+/// True when `name` is one of the list's names (constant time).
+bool wx_output_names_has(const wx_output_names *names, const char *name);
 
 /// The preview's name for a mask's: its extension replaced by .png ("mask.exr"
 /// -> "mask.png"; "mask" -> "mask.png"; "mask.png" -> "mask.preview.png").

@@ -159,7 +159,10 @@ static wx_result write_one(const wx_scene *scene, const wx_run_def *opts, const 
     }
     image->threads = opts->threads; // compresses chunks in parallel: same bytes
     image->zip_level = 1;           // the pipeline's own intermediate: the fastest zlib
-    r = wx_exr_write(path, image, err);
+    r = wx_image_check_finite(image, path, err); // a double beyond FLT_MAX became +inf
+    if (r == WX_OK) {
+        r = wx_exr_write(path, image, err);
+    }
     wx_image_free(image);
     return r;
 }

@@ -51,7 +51,7 @@ static wx_result check_files(const char *input, const char *dir, const wx_image 
         return wx_fail(err, WX_CAUSE_FILE_MISSING, "%s: not found", input);
     }
     for (int c = 0; c < in->channel_count; ++c) {
-        if (!wx_temp_name_fits(files[c])) {
+        if (strlen(files[c]) > WX_OUTPUT_FILE_NAME_MAX) { // with its temporary
             return wx_fail(err, WX_CAUSE_PATH_TOO_LONG,
                            "%s: channel '%s' would be written to a file name of %zu characters, "
                            "too long for the file system; nothing written",

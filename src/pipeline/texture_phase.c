@@ -315,6 +315,9 @@ static wx_result write_texture(const wx_scene *scene, const wx_run_def *opts,
         snprintf(uv, sizeof uv, "%d", def->uv);
         wx_image_set_string(image, "weatheringUVChannel", uv);
         image->threads = opts->threads;
+        r = wx_image_check_finite(image, path, err);
+    }
+    if (r == WX_OK) {
         r = wx_exr_write(path, image, err);
     }
     // Previews: transparent where no texel holds a value.

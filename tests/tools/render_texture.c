@@ -31,8 +31,9 @@
 //               headlight (0.25 + 0.75 |N.view|), clay (0.80 0.78 0.72) blending
 //               to dirt (0.25 0.20 0.15) by t = min(1, value / white), grey-blue
 //               (0.55 0.60 0.70) where seen < 0.5, on a dark grey background.
-//               white is --white, else the 99th percentile of the channel's
-//               positive values over the texels with seen > 0 (as the previews).
+//               white is --white, else the larger of 1 and the 99th percentile
+//               of the channel's positive values over the texels with seen > 0
+//               (as the previews: wx_preview_white).
 // Exit status 2 on bad arguments or unreadable files, 1 on other failures.
 #include <math.h>
 #include <stdint.h>
@@ -220,7 +221,8 @@ static float sample(const texture *tex, const float *plane, double u, double v)
     return (float)((1.0 - fy) * top + fy * bottom);
 }
 
-// The PNG's white point: the 99th percentile of the positive values seen.
+// The PNG's white point, as the previews': the larger of 1 and the 99th
+// percentile of the positive values seen.
 static wx_result white_point(const texture *tex, float *white, wx_error *err)
 {
     size_t texels = (size_t)tex->width * (size_t)tex->height, n = 0;
@@ -235,9 +237,7 @@ static wx_result white_point(const texture *tex, float *white, wx_error *err)
     }
     wx_result r = wx_preview_scale(values, n, white, err);
     free(values);
-    if (r == WX_OK && !(*white > 0.0f)) {
-        *white = 1.0f; // nothing positive: every value draws as clay
-    }
+    *white = wx_preview_white(*white); // 1 when nothing is positive: all clay
     return r;
 }
 
