@@ -16,6 +16,7 @@
 
 #include "core/limits.h"
 #include "gather/adaptive.h"
+#include "model/ownership.h"
 #include "gather/visibility.h"
 #include "core/matrix.h"
 #include "core/parallel.h"
@@ -29,6 +30,8 @@ enum {
 };
 
 #define NORMAL_EPSILON WX_VISIBILITY_NORMAL_EPSILON
+// The least share of a texel's surface its dirt is divided by (add_tap).
+#define OWNED_MIN (1.0f / 16.0f)
 
 // ---------------------------------------------------------------------------
 // The mask's header matrices (core/matrix.h: row vectors, composed in double).
@@ -91,6 +94,7 @@ typedef struct input_cam {
     // no simulation wrote) and the impacts (NULL: none).
     const float *initial;
     const float *hits;
+    const float *owned;  // the share of each texel's surface this camera owns
     float ray[3];        // unit projection direction (ctw row 2)
     float tol_world;     // WX_GATHER_DEPTH_TOL_TEXELS * the texel's larger side
     float inv_head_area; // 1 / area of a texel seen head-on
@@ -159,15 +163,21 @@ static float clean_dirt(float dirt)
     return dirt > 0.0f && dirt < INFINITY ? dirt : 0.0f; // negative or NaN counts as 0
 }
 
-// The sums of one camera's taps: the weights, and the weighted dirt, initial
-// dirt and impacts per unit area (the last two for the adaptive pass only).
+// The sums of the taps of every camera: the weights of the taps that see the
+// point (all) and of the share of them their cameras own (own), and the
+// weighted dirt, initial dirt and impacts per unit area (the last two for the
+// adaptive pass only).
 typedef struct tap_sums {
-    float den, dirt, initial, hits;
+    float all, own, dirt, initial, hits;
 } tap_sums;
 
 // One texel of an input camera: when it sees the surface point (at depth dp in
-// this camera, unit normal n), adds weight * agreement to den and that times
-// the texel's values per unit area to the sums.
+// this camera, unit normal n), adds w = weight * agreement to all, w times the
+// share of the texel its camera owns to own, and w times the texel's values
+// per unit area to the sums. Every deposit lies in the map of the camera that
+// owns its point, so a texel's values per unit of the area it owns are the
+// densities; divided by `own`, the taps of all cameras give one estimate, and
+// a border between two cameras' parts leaves no seam (model/ownership.h).
 static inline void add_tap(const input_cam *c, size_t t, float weight, float dp, const float n[3],
                            bool adaptive, tap_sums *s)
 {
@@ -178,21 +188,29 @@ static inline void add_tap(const input_cam *c, size_t t, float weight, float dp,
         return;
     }
     float w = weight * agree;
-    // Dirt per unit area: the texel covers head_area / |N.view| of surface.
+    // Dirt per unit of owned area: the texel covers head_area / |N.view| of
+    // surface, of which it owns the share f. A share under OWNED_MIN (less
+    // than one of the 16 points a border texel is cut into) counts as
+    // OWNED_MIN, so that a few deposits the collider gave a texel the rule
+    // barely gives it cannot make a spike.
+    float f = c->owned[t];
     float cos_area = cos_view > WX_GATHER_AREA_MIN_COS ? cos_view : WX_GATHER_AREA_MIN_COS;
-    float per_area = w * cos_area * c->inv_head_area;
+    float per_area = w * cos_area * c->inv_head_area * (f < OWNED_MIN ? f / OWNED_MIN : 1.0f);
     s->dirt += per_area * clean_dirt(c->dirt[t]);
     if (adaptive) {
         s->initial += per_area * clean_dirt(c->initial[t]);
         s->hits += c->hits != NULL ? per_area * clean_dirt(c->hits[t]) : 0.0f;
     }
-    s->den += w;
+    s->all += w;
+    s->own += w * f;
 }
 
-// Whether texel t of camera c holds anything to gather.
+// Whether texel t of camera c weighs in: it holds something to gather, or its
+// camera owns part of it (a texel that holds 0 there counts as 0).
 static inline bool holds_something(const input_cam *c, size_t t, bool adaptive)
 {
-    return c->dirt[t] > 0.0f || (adaptive && c->hits != NULL && c->hits[t] > 0.0f);
+    return c->owned[t] > 0.0f || c->dirt[t] > 0.0f ||
+           (adaptive && c->hits != NULL && c->hits[t] > 0.0f);
 }
 
 // The four texels around continuous texel coordinates (x, y), each tested.
@@ -230,10 +248,10 @@ static void sample_bilinear(const input_cam *c, double x, double y, float dp, co
     }
 }
 
-// What camera `c` holds per unit area (dirt, and for the adaptive pass the
-// initial dirt and the impacts) for the surface point seen by output texel
-// (i, j) at depth d with unit normal n, added to *out; nothing when the camera
-// does not see it.
+// The taps of camera `c` (dirt, and for the adaptive pass the initial dirt and
+// the impacts, per unit area) for the surface point seen by output texel (i, j)
+// at depth d with unit normal n, added to *out; nothing when the camera does
+// not see it.
 static void sample_camera(const input_cam *c, double i, double j, double d, const float n[3],
                           bool bilinear, bool adaptive, tap_sums *out)
 {
@@ -244,21 +262,14 @@ static void sample_camera(const input_cam *c, double i, double j, double d, cons
         return;
     }
     const float dp = (float)(c->cd[0] * i + c->cd[1] * j + c->cd[2] * d + c->cd[3]);
-    tap_sums s = { 0.0f, 0.0f, 0.0f, 0.0f };
     if (!bilinear) {
         // x + 0.5 >= 0: truncation is floor.
         size_t t = (size_t)(int)(y + 0.5) * (size_t)c->width + (size_t)(int)(x + 0.5);
-        if (!holds_something(c, t, adaptive)) {
-            return;
+        if (holds_something(c, t, adaptive)) {
+            add_tap(c, t, 1.0f, dp, n, adaptive, out);
         }
-        add_tap(c, t, 1.0f, dp, n, adaptive, &s);
     } else {
-        sample_bilinear(c, x, y, dp, n, adaptive, &s);
-    }
-    if (s.den > 0.0f) {
-        out->dirt += s.dirt / s.den;
-        out->initial += s.initial / s.den;
-        out->hits += s.hits / s.den;
+        sample_bilinear(c, x, y, dp, n, adaptive, out);
     }
 }
 // First pass over one TILE x TILE block of output texels (tiles keep the input
@@ -273,11 +284,19 @@ static void first_pass_tile(const gather_job *job, int tile)
             size_t q = (size_t)j * (size_t)job->width + (size_t)i;
             float d = job->depth[q];
             float n[3] = { 0.0f, 0.0f, 0.0f };
-            tap_sums sum = { 0.0f, 0.0f, 0.0f, 0.0f };
+            tap_sums sum = { 0.0f, 0.0f, 0.0f, 0.0f, 0.0f };
             if (!wx_depth_is_empty(d) && unit_normal(&job->normal[3 * q], n)) {
                 for (int k = 0; k < job->cam_count; ++k) {
-                    // Every deposit is in exactly one camera's map: add them up.
                     sample_camera(&job->cams[k], i, j, d, n, job->bilinear, job->adaptive, &sum);
+                }
+                // Per unit of owned area; where no camera owns what it sees
+                // (a point the rule gives to a camera that does not see it
+                // here), per unit of area seen.
+                float den = sum.own > 0.0f ? sum.own : sum.all;
+                if (den > 0.0f) {
+                    sum.dirt /= den;
+                    sum.initial /= den;
+                    sum.hits /= den;
                 }
             } else {
                 d = 0.0f; // no surface: normal 0 (weight 0), depth finite
@@ -494,6 +513,7 @@ static wx_result prepare_input(const wx_target *out, const double out_ctw[16],
     bool simulated = in->initial != NULL && in->hits != NULL;
     cam->initial = simulated ? in->initial : in->dirt;
     cam->hits = simulated ? in->hits : NULL;
+    cam->owned = in->owned;
 
     double head_area = 0.0;
     if (!wx_gather_view_frame(in, cam->ray, &cam->tol_world, &head_area)) {
@@ -659,6 +679,47 @@ wx_result wx_gather_check_radius(const wx_target *target, float radius, int *tex
     return r;
 }
 
+wx_result wx_gather_owned(const wx_gather_view *views, int count, int threads, float **owned,
+                          wx_error *err)
+{
+    *owned = NULL;
+    size_t total = 0;
+    for (int k = 0; k < count; ++k) {
+        total += views[k].owned == NULL ? (size_t)views[k].width * (size_t)views[k].height : 0;
+    }
+    if (total == 0) {
+        return WX_OK;
+    }
+    wx_owner_view *owners = malloc((size_t)count * sizeof *owners);
+    float *planes = malloc(total * sizeof *planes);
+    if (owners == NULL || planes == NULL) {
+        free(owners);
+        free(planes);
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "gather: out of memory (ownership)");
+    }
+    for (int k = 0; k < count; ++k) {
+        wx_owner_view_init(&owners[k], views[k].camera, views[k].depth, views[k].width,
+                           views[k].height);
+    }
+    wx_result r = WX_OK;
+    size_t at = 0;
+    for (int k = 0; k < count && r == WX_OK; ++k) {
+        if (views[k].owned != NULL) {
+            continue;
+        }
+        const float *n = views[k].normal;
+        r = wx_owned_fraction(owners, count, k, n, n + 1, n + 2, 3, threads, planes + at, err);
+        at += (size_t)views[k].width * (size_t)views[k].height;
+    }
+    free(owners);
+    if (r != WX_OK) {
+        free(planes);
+        return r;
+    }
+    *owned = planes;
+    return WX_OK;
+}
+
 wx_result wx_gather_compute(const wx_gather_def *def, float *mask_out, wx_gather_stats *stats,
                             wx_error *err)
 {
@@ -713,6 +774,16 @@ wx_result wx_gather_compute(const wx_gather_def *def, float *mask_out, wx_gather
     for (int k = 0; k < def->input_count && result == WX_OK; ++k) {
         result = prepare_input(out, out_ctw, &def->inputs[k], k, &cams[k], err);
     }
+    float *owned = NULL; // the shares the caller did not give
+    if (result == WX_OK) {
+        result = wx_gather_owned(def->inputs, def->input_count, def->threads, &owned, err);
+        for (int k = 0, at = 0; k < def->input_count && owned != NULL; ++k) {
+            if (def->inputs[k].owned == NULL) {
+                cams[k].owned = owned + at;
+                at += def->inputs[k].width * def->inputs[k].height;
+            }
+        }
+    }
     int pad_x = 0, pad_y = 0;
     size_t stride = 0, plane = 0;
     if (result == WX_OK && second) {
@@ -737,6 +808,7 @@ wx_result wx_gather_compute(const wx_gather_def *def, float *mask_out, wx_gather
         free(cams);
         free(offsets);
         free(adaptive_planes);
+        free(owned);
         return result;
     }
 
@@ -823,6 +895,7 @@ wx_result wx_gather_compute(const wx_gather_def *def, float *mask_out, wx_gather
             wx_progress_end(&progress);
             wx_pool_destroy(pool);
             free(cams);
+            free(owned);
             return result;
         }
     }
@@ -857,5 +930,6 @@ wx_result wx_gather_compute(const wx_gather_def *def, float *mask_out, wx_gather
     free(scratch);
     free(offsets);
     free(cams);
+    free(owned);
     return WX_OK;
 }

@@ -50,7 +50,17 @@ typedef struct wx_gather_view {
     /// started from and the impacts at each texel (maps.h).
     const float *initial;
     const float *hits;
+    /// The share of each texel's surface this camera owns (model/ownership.h),
+    /// input cameras only; NULL: wx_gather_compute works it out itself.
+    const float *owned;
 } wx_gather_view;
+
+/// The share of each texel's surface every input camera owns
+/// (wx_owned_fraction of model/ownership.h), for the views whose `owned` is
+/// NULL: one malloc'd block, the planes of those views one after the other in
+/// their order (*owned NULL when every view has its own). The caller frees it.
+wx_result wx_gather_owned(const wx_gather_view *views, int count, int threads, float **owned,
+                          wx_error *err);
 
 /// Everything the gather needs, in memory. Zero-initialise or start from
 /// wx_default_gather_def(), then fill the views.

@@ -246,18 +246,18 @@ bool wx_uv_raster_point(const wx_mesh_data *mesh, int uv, const wx_uv_raster *ra
     point2 c = { (double)(t % (size_t)raster->width), (double)(t / (size_t)raster->width) };
     double b[3] = { edge(p[1], p[2], c), edge(p[2], p[0], c), edge(p[0], p[1], c) };
     double sum = b[0] + b[1] + b[2];
-    double n[3] = { 0.0, 0.0, 0.0 };
-    for (int a = 0; a < 3; ++a) {
-        position[a] = mesh->origin[a];
-    }
+    double n[3] = { 0.0, 0.0, 0.0 }, w[3], local[3];
     for (int k = 0; k < 3; ++k) {
-        double w = b[k] / sum;
-        const float *pk = &mesh->positions[3 * (size_t)idx[k]];
+        w[k] = b[k] / sum;
         const float *nk = &mesh->normals[3 * (size_t)idx[k]];
         for (int a = 0; a < 3; ++a) {
-            position[a] += w * pk[a];
-            n[a] += w * nk[a];
+            n[a] += w[k] * nk[a];
         }
+    }
+    // On the smooth surface the bake draws (its depth maps hold this point).
+    wx_mesh_phong_point(mesh, tri, w, local);
+    for (int a = 0; a < 3; ++a) {
+        position[a] = mesh->origin[a] + local[a];
     }
     double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
     if (!(len > 1e-6)) {

@@ -17,6 +17,7 @@ void wx_maps_free(wx_maps *maps)
     free(maps->hits);
     free(maps->surface);
     free(maps->area);
+    free(maps->owned);
     free(maps->dirt_attrs);
     memset(maps, 0, sizeof *maps);
 }

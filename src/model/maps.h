@@ -39,6 +39,11 @@ typedef struct wx_maps {
     /// point most head-on, else 0), which Grow multiplies.
     float *surface; ///< width*height
     float *area;    ///< width*height
+    /// The share of each texel's surface this camera owns (model/ownership.h:
+    /// it sees it most head-on, so the deposits there are stored here): what
+    /// the gather divides by. Computed in memory once the maps are read
+    /// (pipeline/load.c), never written; NULL until then.
+    float *owned;   ///< width*height
     /// The dirt map file's header attributes (camera matrices, name), kept so
     /// that the simulated dirt map is written with them without reading the
     /// file again.

@@ -29,6 +29,7 @@
 #include "model/maps.h"
 #include "model/scene.h"
 #include "model/geometry.h"
+#include "model/ownership.h"
 #include "model/mesh.h"
 #include "core/matrix.h"
 #include "core/progress.h"
@@ -43,8 +44,6 @@ enum {
 
 /// Smallest |N.view| used when dividing by it (a surface seen edge-on).
 #define MIN_COSINE 1e-3f
-/// Cameras whose |N.view| differ by less than this are tied (first listed wins).
-#define TIE_COSINE 1e-4f
 
 typedef struct gpu_mesh {
     GLuint vao;
@@ -673,69 +672,12 @@ static wx_result take_given_depth(baker *b, int c, wx_error *err)
     return WX_OK;
 }
 
-typedef struct other_view {
-    int index;         // scene camera index (its order in the file)
-    const wx_camera *cam;
-    const float *depth;
-    int width, height;
-    float view[3];
-    float texel_ws;    // larger side of one texel, world units
-} other_view;
-
-// True when camera k sees world point p (on a surface with unit normal n) and
-// sees it more head-on than camera c (|n.view_c| = cos_c), ties going to the
-// camera listed first. Visibility: p projects into k's frame onto a texel whose
-// depth agrees with p's within 1.5 texels' worth of the surface's depth slope
-// in k (plus 0.1 texel and float rounding).
-static bool other_owns(const other_view *k, int c, const double p[3], const float n[3],
-                       float cos_c, bool slack)
-{
-    float cos_k = fabsf(n[0] * k->view[0] + n[1] * k->view[1] + n[2] * k->view[2]);
-    bool better = cos_k > cos_c + TIE_COSINE || (cos_k >= cos_c - TIE_COSINE && k->index < c);
-    if (!better) {
-        return false;
-    }
-    double uvd[3];
-    wx_matrix_apply_affine(k->cam->wtc, p, uvd);
-    int i, j;
-    if (!wx_map_texel(k->width, k->height, (float)uvd[0], (float)uvd[1], &i, &j)) {
-        return false;
-    }
-    float ck = cos_k > MIN_COSINE ? cos_k : MIN_COSINE;
-    float slope = sqrtf(fmaxf(0.0f, 1.0f - ck * ck)) / ck;
-    float stored = k->depth[(size_t)j * (size_t)k->width + (size_t)i];
-    if (isfinite(stored)) {
-        double tol = k->texel_ws * (1.5 * fmin(slope, 1e3) + 0.1) +
-                     4e-6 * (fabs(uvd[2]) + fabs(stored));
-        return fabs(uvd[2] - stored) <= tol;
-    }
-    if (!slack) {
-        return false;
-    }
-    // At a surface's outline k's texel may be empty while its neighbour holds
-    // the point: a neighbour that agrees (one texel more of tolerance) owns it,
-    // so that points along an outline are not counted by two cameras.
-    for (int dj = -1; dj <= 1; ++dj) {
-        for (int di = -1; di <= 1; ++di) {
-            int ni = i + di, nj = j + dj;
-            if (ni < 0 || nj < 0 || ni >= k->width || nj >= k->height) {
-                continue;
-            }
-            float s = k->depth[(size_t)nj * (size_t)k->width + (size_t)ni];
-            double tol = k->texel_ws * (2.5 * fmin(slope, 1e3) + 0.1) +
-                         4e-6 * (fabs(uvd[2]) + fabs(s));
-            if (isfinite(s) && fabs(uvd[2] - s) <= tol) {
-                return true;
-            }
-        }
-    }
-    return false;
-}
-
 // Turns the density planes of camera c (one per substance) into amounts:
-// density x texel area / |N.view| where c owns the patch, 0 elsewhere; `area`
-// (may be NULL) receives texel area / |N.view| where c owns the patch, 0
-// elsewhere (what Grow multiplies).
+// density x texel area / |N.view| x the share of the texel's surface c owns
+// (model/ownership.h: the camera that sees a point most head-on holds what
+// lies there, so every amount is stored once and a border between two
+// cameras' parts is shared as the gather reads it); `area` (may be NULL)
+// receives texel area / |N.view| x that share (what Grow multiplies).
 static wx_result compute_initial_dirt(baker *b, int c, const float *depth,
                                       const wx_image *normal, float *const *planes, int count,
                                       float *area, wx_error *err)
@@ -748,73 +690,48 @@ static wx_result compute_initial_dirt(baker *b, int c, const float *depth,
     wx_camera_frame_size(&sc->camera, &frame_w, &frame_h);
     float texel_area = (frame_w / (float)width) * (frame_h / (float)height);
 
-    other_view *others = malloc((size_t)scene->camera_count * sizeof *others);
-    if (others == NULL) {
+    size_t texels = (size_t)width * (size_t)height;
+    wx_owner_view *owners = malloc((size_t)scene->camera_count * sizeof *owners);
+    float *share = malloc((texels > 0 ? texels : 1) * sizeof *share);
+    if (owners == NULL || share == NULL) {
+        free(owners);
+        free(share);
         return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "bake: out of memory");
     }
-    int other_count = 0;
+    int count_views = 0, self = -1;
     for (int k = 0; k < scene->camera_count; ++k) {
         const cam_state *ks = &b->cams[k];
-        if (k == c || scene->cameras[k].is_output || ks->depth == NULL) {
+        if (scene->cameras[k].is_output || (k != c && ks->depth == NULL)) {
             continue;
         }
-        other_view *o = &others[other_count++];
-        o->index = k;
-        o->cam = &scene->cameras[k].camera;
-        o->depth = ks->depth;
-        o->width = ks->depth_width;
-        o->height = ks->depth_height;
-        wx_camera_view_dir(o->cam, o->view);
-        float fw, fh;
-        wx_camera_frame_size(o->cam, &fw, &fh);
-        o->texel_ws = fmaxf(fw / (float)o->width, fh / (float)o->height);
-    }
-
-    for (int j = 0; j < height; ++j) {
-        for (int i = 0; i < width; ++i) {
-            size_t t = (size_t)j * (size_t)width + (size_t)i;
-            bool any = area != NULL;
-            for (int s = 0; s < count; ++s) {
-                any = any || planes[s][t] != 0.0f;
-            }
-            float d = depth[t];
-            if (!any || !isfinite(d)) {
-                for (int s = 0; s < count; ++s) {
-                    planes[s][t] = 0.0f;
-                }
-                if (area != NULL) {
-                    area[t] = 0.0f;
-                }
-                continue;
-            }
-            float n[3] = { normal->channels[0][t], normal->channels[1][t],
-                           normal->channels[2][t] };
-            float cos_c = fabsf(n[0] * view[0] + n[1] * view[1] + n[2] * view[2]);
-            bool owner = true, area_owner = true;
-            if (other_count > 0) {
-                float u, v;
-                wx_map_texel_center(width, height, i, j, &u, &v);
-                double p[3];
-                const double uvd[3] = { u, v, d };
-                wx_matrix_apply_affine(sc->camera.ctw, uvd, p);
-                for (int k = 0; k < other_count && owner; ++k) {
-                    owner = !other_owns(&others[k], c, p, n, cos_c, false);
-                }
-                // Grow's area (new in version 2) takes outlines into account;
-                // initial amounts keep version 1's rule and bytes.
-                for (int k = 0; k < other_count && area_owner && area != NULL; ++k) {
-                    area_owner = !other_owns(&others[k], c, p, n, cos_c, true);
-                }
-            }
-            for (int s = 0; s < count; ++s) {
-                planes[s][t] = owner ? planes[s][t] * texel_area / fmaxf(cos_c, MIN_COSINE) : 0.0f;
-            }
-            if (area != NULL) {
-                area[t] = area_owner ? texel_area / fmaxf(cos_c, MIN_COSINE) : 0.0f;
-            }
+        if (k == c) {
+            self = count_views;
+            wx_owner_view_init(&owners[count_views++], &sc->camera, depth, width, height);
+        } else {
+            wx_owner_view_init(&owners[count_views++], &scene->cameras[k].camera, ks->depth,
+                               ks->depth_width, ks->depth_height);
         }
     }
-    free(others);
+    wx_result r = wx_owned_fraction(owners, count_views, self, normal->channels[0],
+                                    normal->channels[1], normal->channels[2], 1,
+                                    b->def->threads > 0 ? b->def->threads : 1, share, err);
+    free(owners);
+    if (r != WX_OK) {
+        free(share);
+        return r;
+    }
+    for (size_t t = 0; t < texels; ++t) {
+        float cos_c = fabsf(normal->channels[0][t] * view[0] + normal->channels[1][t] * view[1] +
+                            normal->channels[2][t] * view[2]);
+        float owned_area = share[t] * texel_area / fmaxf(cos_c, MIN_COSINE);
+        for (int s = 0; s < count; ++s) {
+            planes[s][t] = owned_area > 0.0f ? planes[s][t] * owned_area : 0.0f;
+        }
+        if (area != NULL) {
+            area[t] = owned_area;
+        }
+    }
+    free(share);
     return WX_OK;
 }
 

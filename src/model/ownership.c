@@ -1,0 +1,223 @@
+// ownership.c: which input camera a surface point belongs to (ownership.h).
+#include "model/ownership.h"
+
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/matrix.h"
+#include "core/parallel.h"
+#include "model/maps.h"
+
+// Ties between two views' |n . view| go to the view listed first.
+#define TIE_COSINE 1e-4f
+// Slopes steeper than this (|n . view|) count as this one (the collider's).
+#define MIN_SLOPE_COS 0.05f
+// Points a border texel is cut into, per side.
+enum { SUB = 4 };
+
+void wx_owner_view_init(wx_owner_view *view, const wx_camera *camera, const float *depth,
+                        int width, int height)
+{
+    view->camera = camera;
+    view->depth = depth;
+    view->width = width;
+    view->height = height;
+    wx_camera_view_dir(camera, view->view);
+    float w, h;
+    wx_camera_frame_size(camera, &w, &h);
+    view->texel_ws = fmaxf(w / (float)width, h / (float)height);
+}
+
+// Depth at continuous texel coordinates (x, y) (centres at integers): bilinear
+// when the four texels around hold a surface, else the texel's own; false when
+// the texel holding (x, y) has none.
+static bool depth_at(const float *depth, int width, int height, double x, double y, double *own,
+                     double *between)
+{
+    int i = (int)floor(x + 0.5), j = (int)floor(y + 0.5);
+    if (i < 0 || j < 0 || i >= width || j >= height) {
+        return false;
+    }
+    float d = depth[(size_t)j * (size_t)width + (size_t)i];
+    if (wx_depth_is_empty(d)) {
+        return false;
+    }
+    *own = d;
+    *between = d;
+    int i0 = (int)floor(x), j0 = (int)floor(y);
+    if (i0 < 0 || j0 < 0 || i0 + 1 >= width || j0 + 1 >= height) {
+        return true;
+    }
+    const float *row0 = depth + (size_t)j0 * (size_t)width + (size_t)i0;
+    const float *row1 = row0 + width;
+    if (wx_depth_is_empty(row0[0]) || wx_depth_is_empty(row0[1]) || wx_depth_is_empty(row1[0]) ||
+        wx_depth_is_empty(row1[1])) {
+        return true;
+    }
+    double fx = x - i0, fy = y - j0;
+    *between = (1.0 - fy) * ((1.0 - fx) * row0[0] + fx * row0[1]) +
+               fy * ((1.0 - fx) * row1[0] + fx * row1[1]);
+    return true;
+}
+
+bool wx_owner_sees(const wx_owner_view *view, const double p[3], const float n[3])
+{
+    double uvd[3];
+    wx_matrix_apply_affine(view->camera->wtc, p, uvd);
+    double x = uvd[0] * view->width - 0.5, y = (1.0 - uvd[1]) * view->height - 0.5;
+    double own, between;
+    if (!depth_at(view->depth, view->width, view->height, x, y, &own, &between)) {
+        return false;
+    }
+    float c = fabsf(n[0] * view->view[0] + n[1] * view->view[1] + n[2] * view->view[2]);
+    float cs = c > MIN_SLOPE_COS ? c : MIN_SLOPE_COS;
+    double tan_view = sqrt(fmax(0.0, 1.0 - (double)c * c)) / cs;
+    double precision = view->texel_ws * (0.5 + tan_view) + 4e-6 * (fabs(uvd[2]) + fabs(own));
+    return fabs(uvd[2] - own) <= precision && fabs(uvd[2] - between) <= precision;
+}
+
+int wx_owner_of(const wx_owner_view *views, int count, const double p[3], const float n[3],
+                int known)
+{
+    int best = -1;
+    float best_cos = -1.0f;
+    for (int k = 0; k < count; ++k) {
+        const wx_owner_view *v = &views[k];
+        float c = fabsf(n[0] * v->view[0] + n[1] * v->view[1] + n[2] * v->view[2]);
+        if (!(c > best_cos + TIE_COSINE)) {
+            continue; // cannot win: ties go to the view listed first
+        }
+        if (k == known || wx_owner_sees(v, p, n)) {
+            best = k;
+            best_cos = c;
+        }
+    }
+    return best;
+}
+
+typedef struct owned_job {
+    const wx_owner_view *views;
+    int count, c;
+    const float *nx, *ny, *nz;
+    size_t stride;
+    float *out;
+} owned_job;
+
+// World point of view c at continuous texel coordinates (x, y), depth d.
+static void world_point(const owned_job *job, double x, double y, double d, double p[3])
+{
+    const wx_owner_view *v = &job->views[job->c];
+    const double uvd[3] = { (x + 0.5) / v->width, 1.0 - (y + 0.5) / v->height, d };
+    wx_matrix_apply_affine(v->camera->ctw, uvd, p);
+}
+
+static bool texel_normal(const owned_job *job, size_t t, float n[3])
+{
+    n[0] = job->nx[t * job->stride];
+    n[1] = job->ny[t * job->stride];
+    n[2] = job->nz[t * job->stride];
+    float len = sqrtf(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    if (!(len > 1e-6f) || !isfinite(len)) {
+        return false;
+    }
+    for (int k = 0; k < 3; ++k) {
+        n[k] /= len;
+    }
+    return true;
+}
+
+// Pass 1: each texel's centre, 1 owned or 0 (also without a surface).
+static void centres(int64_t begin, int64_t end, int worker, void *context)
+{
+    (void)worker;
+    const owned_job *job = context;
+    const wx_owner_view *v = &job->views[job->c];
+    for (int64_t j = begin; j < end; ++j) {
+        for (int i = 0; i < v->width; ++i) {
+            size_t t = (size_t)j * (size_t)v->width + (size_t)i;
+            float d = v->depth[t], n[3];
+            job->out[t] = 0.0f;
+            if (wx_depth_is_empty(d) || !texel_normal(job, t, n)) {
+                continue;
+            }
+            double p[3];
+            world_point(job, i, (double)j, d, p);
+            job->out[t] = wx_owner_of(job->views, job->count, p, n, job->c) == job->c;
+        }
+    }
+}
+
+// Pass 2: texels whose surface neighbours were decided otherwise, cut into SUB x
+// SUB points. Reads the centres' verdicts (copied) and writes fractions.
+typedef struct border_job {
+    const owned_job *owned;
+    const float *centre; // pass 1's verdicts
+} border_job;
+
+static void borders(int64_t begin, int64_t end, int worker, void *context)
+{
+    (void)worker;
+    const border_job *b = context;
+    const owned_job *job = b->owned;
+    const wx_owner_view *v = &job->views[job->c];
+    const int W = v->width, H = v->height;
+    for (int64_t j = begin; j < end; ++j) {
+        for (int i = 0; i < W; ++i) {
+            size_t t = (size_t)j * (size_t)W + (size_t)i;
+            float d = v->depth[t], n[3];
+            if (wx_depth_is_empty(d) || !texel_normal(job, t, n)) {
+                continue;
+            }
+            bool mixed = false;
+            for (int dj = -1; dj <= 1 && !mixed; ++dj) {
+                for (int di = -1; di <= 1 && !mixed; ++di) {
+                    int ni = i + di, nj = (int)j + dj;
+                    if (ni < 0 || nj < 0 || ni >= W || nj >= H) {
+                        continue;
+                    }
+                    size_t u = (size_t)nj * (size_t)W + (size_t)ni;
+                    mixed = !wx_depth_is_empty(v->depth[u]) && b->centre[u] != b->centre[t];
+                }
+            }
+            if (!mixed) {
+                continue;
+            }
+            int owned = 0;
+            for (int sy = 0; sy < SUB; ++sy) {
+                for (int sx = 0; sx < SUB; ++sx) {
+                    double x = i + (sx + 0.5) / SUB - 0.5, y = (double)j + (sy + 0.5) / SUB - 0.5;
+                    double own, between, p[3];
+                    if (!depth_at(v->depth, W, H, x, y, &own, &between)) {
+                        between = d;
+                    }
+                    world_point(job, x, y, between, p);
+                    owned += wx_owner_of(job->views, job->count, p, n, job->c) == job->c;
+                }
+            }
+            job->out[t] = (float)owned / (float)(SUB * SUB);
+        }
+    }
+}
+
+wx_result wx_owned_fraction(const wx_owner_view *views, int count, int c, const float *nx,
+                            const float *ny, const float *nz, size_t stride, int threads,
+                            float *out, wx_error *err)
+{
+    const wx_owner_view *v = &views[c];
+    owned_job job = { .views = views, .count = count, .c = c, .nx = nx, .ny = ny, .nz = nz,
+                      .stride = stride, .out = out };
+    size_t n = (size_t)v->width * (size_t)v->height;
+    float *centre = malloc((n > 0 ? n : 1) * sizeof *centre);
+    if (centre == NULL) {
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (%d x %d ownership)",
+                       v->width, v->height);
+    }
+    wx_parallel_for(threads, v->height, 8, centres, &job);
+    memcpy(centre, out, n * sizeof *centre);
+    border_job b = { .owned = &job, .centre = centre };
+    wx_parallel_for(threads, v->height, 8, borders, &b);
+    free(centre);
+    return WX_OK;
+}
