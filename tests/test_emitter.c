@@ -287,7 +287,10 @@ TEST(box_emitter_puts_n_over_a_on_each_square_metre)
         ENSURE(outside == 0.0);
         double mean = inside / n_inside, var = sum_sq / n_inside - mean * mean;
         ENSURE_NEAR(mean, 62.5, 1e-9);
-        ENSURE_NEAR(var, 62.5 * (1 - 1.0 / 256), 62.5 * 0.3); // multinomial counts
+        // Low-discrepancy starts (wx_emitter_uniforms): the counts per texel
+        // spread far less than independent draws' multinomial counts
+        // (variance 62.3): a tenth of that at most.
+        ENSURE(var < 0.1 * 62.5 * (1 - 1.0 / 256));
     }
 }
 

@@ -1,6 +1,8 @@
-// test_mesh.c: Assimp import into flat arrays (src/io/mesh_import.c): the file system
+// test_mesh.c: the smooth surface of a smooth-shaded mesh (src/model/mesh.c), and
+// Assimp import into flat arrays (src/io/mesh_import.c): the file system
 // Assimp reads through (regular files inside the mesh's folder only), values
 // refused at import, out of memory inside Assimp, and the FBX unit.
+#include <math.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -671,8 +673,197 @@ TEST(formats_without_a_unit_are_left_as_they_are)
     wx_mesh_data_free(&m);
 }
 
+// --- the smooth surface of a smooth-shaded mesh (model/mesh.c) ---------------
+
+// A UV sphere of radius 1 in memory, `bands` latitude bands and 2*bands
+// segments, unit normals along the radius (smooth shading); its poles are
+// shared vertices.
+static bool uv_sphere(wx_mesh_data *m, int bands)
+{
+    memset(m, 0, sizeof *m);
+    int segs = 2 * bands;
+    int64_t nv = (int64_t)(bands + 1) * (segs + 1), nt = (int64_t)bands * segs * 2;
+    m->positions = malloc((size_t)nv * 3 * sizeof(float));
+    m->normals = malloc((size_t)nv * 3 * sizeof(float));
+    m->indices = malloc((size_t)nt * 3 * sizeof(uint32_t));
+    m->materials = calloc((size_t)nt, sizeof(uint16_t));
+    if (m->positions == NULL || m->normals == NULL || m->indices == NULL || m->materials == NULL) {
+        return false;
+    }
+    for (int j = 0; j <= bands; ++j) {
+        for (int i = 0; i <= segs; ++i) {
+            const double pi = 3.14159265358979323846;
+            double th = pi * j / bands, ph = 2.0 * pi * i / segs;
+            size_t v = (size_t)j * (size_t)(segs + 1) + (size_t)i;
+            float p[3] = { (float)(sin(th) * cos(ph)), (float)cos(th), (float)(sin(th) * sin(ph)) };
+            memcpy(&m->positions[3 * v], p, sizeof p);
+            memcpy(&m->normals[3 * v], p, sizeof p);
+        }
+    }
+    int64_t t = 0;
+    for (int j = 0; j < bands; ++j) {
+        for (int i = 0; i < segs; ++i) {
+            uint32_t a = (uint32_t)(j * (segs + 1) + i), b = a + 1, c = a + (uint32_t)segs + 1,
+                     d = c + 1;
+            uint32_t tri[6] = { a, c, b, b, c, d };
+            memcpy(&m->indices[3 * t], tri, sizeof tri);
+            t += 2;
+        }
+    }
+    m->vertex_count = nv;
+    m->triangle_count = nt;
+    m->material_count = 1;
+    return true;
+}
+
+// The largest |radius - 1| over the points of every triangle at weights
+// (i, j, k) / 8, of the mesh as it is (flat) or on its smooth surface.
+static double radial_error(const wx_mesh_data *m, bool smooth)
+{
+    double worst = 0.0;
+    for (int64_t t = 0; t < m->triangle_count; ++t) {
+        for (int i = 0; i <= 8; ++i) {
+            for (int j = 0; i + j <= 8; ++j) {
+                double w[3] = { (8 - i - j) / 8.0, i / 8.0, j / 8.0 }, p[3] = { 0, 0, 0 };
+                if (smooth) {
+                    wx_mesh_phong_point(m, t, w, p);
+                } else {
+                    for (int k = 0; k < 3; ++k) {
+                        const float *v = &m->positions[3 * (size_t)m->indices[3 * t + k]];
+                        for (int a = 0; a < 3; ++a) {
+                            p[a] += w[k] * v[a];
+                        }
+                    }
+                }
+                worst = fmax(worst, fabs(sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]) - 1.0));
+            }
+        }
+    }
+    return worst;
+}
+
+// The smooth surface of a coarse sphere is rounder than its triangles (the
+// banding of docs/physics.md came from particles sliding over their edges).
+TEST(smooth_surface_of_a_coarse_sphere_is_rounder)
+{
+    wx_mesh_data m;
+    ENSURE(uv_sphere(&m, 12));
+    double flat = radial_error(&m, false), smooth = radial_error(&m, true);
+    printf("        12 bands: flat triangles %.5f off the sphere, smooth surface %.5f\n", flat,
+           smooth);
+    ENSURE(smooth < flat / 3.0);
+    wx_mesh_data_free(&m);
+}
+
+// An icosahedron in memory, radius 1, normals along the radius; with
+// `seam`, the triangles around vertex 0 reach it through two vertices of the
+// same position and normal (as at a UV seam).
+static bool icosahedron(wx_mesh_data *m, bool seam)
+{
+    static const int faces[20][3] = { { 0, 11, 5 }, { 0, 5, 1 },  { 0, 1, 7 },   { 0, 7, 10 },
+                                      { 0, 10, 11 }, { 1, 5, 9 }, { 5, 11, 4 },  { 11, 10, 2 },
+                                      { 10, 7, 6 }, { 7, 1, 8 },  { 3, 9, 4 },   { 3, 4, 2 },
+                                      { 3, 2, 6 },  { 3, 6, 8 },  { 3, 8, 9 },   { 4, 9, 5 },
+                                      { 2, 4, 11 }, { 6, 2, 10 }, { 8, 6, 7 },   { 9, 8, 1 } };
+    const double t = (1.0 + sqrt(5.0)) / 2.0;
+    const double v[12][3] = { { -1, t, 0 }, { 1, t, 0 },  { -1, -t, 0 }, { 1, -t, 0 },
+                              { 0, -1, t }, { 0, 1, t },  { 0, -1, -t }, { 0, 1, -t },
+                              { t, 0, -1 }, { t, 0, 1 },  { -t, 0, -1 }, { -t, 0, 1 } };
+    memset(m, 0, sizeof *m);
+    m->vertex_count = seam ? 13 : 12;
+    m->triangle_count = 20;
+    m->positions = malloc(13 * 3 * sizeof(float));
+    m->normals = malloc(13 * 3 * sizeof(float));
+    m->indices = malloc(20 * 3 * sizeof(uint32_t));
+    m->materials = calloc(20, sizeof(uint16_t));
+    m->material_count = 1;
+    if (m->positions == NULL || m->normals == NULL || m->indices == NULL || m->materials == NULL) {
+        return false;
+    }
+    for (int k = 0; k < 13; ++k) {
+        const double *p = v[k < 12 ? k : 0];
+        double len = sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
+        for (int a = 0; a < 3; ++a) {
+            m->positions[3 * k + a] = m->normals[3 * k + a] = (float)(p[a] / len);
+        }
+    }
+    for (int f = 0; f < 20; ++f) {
+        for (int k = 0; k < 3; ++k) {
+            int idx = faces[f][k];
+            m->indices[3 * f + k] = (uint32_t)(seam && idx == 0 && f % 2 == 1 ? 12 : idx);
+        }
+    }
+    return true;
+}
+
+// Cut 4 x 4, the triangles that share an edge put its points at the same place
+// bit for bit (no crack for a renderer to fall through), also across a seam of
+// split vertices: every point made occurs twice or more but the 3 inside each
+// triangle.
+TEST(smooth_subdivision_leaves_no_crack)
+{
+    for (int seam = 0; seam < 2; ++seam) {
+        wx_mesh_data m;
+        ENSURE(icosahedron(&m, seam));
+        int64_t originals = m.vertex_count;
+        wx_error err;
+        ENSURE(wx_mesh_smooth_subdivide(&m, 4, &err) == WX_OK);
+        ENSURE(m.triangle_count == 20 * 16);
+        int64_t lonely = 0;
+        for (int64_t a = originals; a < m.vertex_count; ++a) {
+            int same = 0;
+            for (int64_t b = originals; b < m.vertex_count && same < 2; ++b) {
+                same += memcmp(&m.positions[3 * a], &m.positions[3 * b], 3 * sizeof(float)) == 0;
+            }
+            lonely += same < 2;
+        }
+        ENSURE(lonely == 20 * 3);
+        wx_mesh_data_free(&m);
+    }
+}
+
+// A flat-shaded mesh (every triangle's normals equal) is left as it is.
+TEST(flat_shading_is_not_cut)
+{
+    wx_mesh_data m;
+    ENSURE(uv_sphere(&m, 4));
+    // Every triangle gets vertices of its own, all with one normal.
+    float *positions = malloc((size_t)m.triangle_count * 9 * sizeof(float));
+    float *normals = malloc((size_t)m.triangle_count * 9 * sizeof(float));
+    ENSURE(positions != NULL && normals != NULL);
+    for (int64_t t = 0; t < m.triangle_count; ++t) {
+        float n[3] = { 0, 0, 0 };
+        for (int k = 0; k < 3; ++k) {
+            memcpy(&positions[9 * t + 3 * k], &m.positions[3 * m.indices[3 * t + k]],
+                   3 * sizeof(float));
+            for (int a = 0; a < 3; ++a) {
+                n[a] += m.normals[3 * m.indices[3 * t + k] + a];
+            }
+        }
+        for (int k = 0; k < 3; ++k) {
+            memcpy(&normals[9 * t + 3 * k], n, sizeof n);
+            m.indices[3 * t + k] = (uint32_t)(3 * t + k);
+        }
+    }
+    free(m.positions);
+    free(m.normals);
+    m.positions = positions;
+    m.normals = normals;
+    m.vertex_count = 3 * m.triangle_count;
+    int64_t before = m.triangle_count;
+    wx_error err;
+    ENSURE(wx_mesh_curved_triangles(&m) == 0);
+    ENSURE(wx_mesh_smooth_subdivide(&m, 8, &err) == WX_OK);
+    ENSURE(m.triangle_count == before);
+    ENSURE(radial_error(&m, true) == radial_error(&m, false));
+    wx_mesh_data_free(&m);
+}
+
 int main(void)
 {
+    RUN(smooth_surface_of_a_coarse_sphere_is_rounder);
+    RUN(smooth_subdivision_leaves_no_crack);
+    RUN(flat_shading_is_not_cut);
     RUN(two_materials_keep_their_names);
     RUN(box_gets_flat_generated_normals);
     RUN(ply_vertex_colours);

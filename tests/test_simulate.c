@@ -489,9 +489,9 @@ TEST(same_output_bytes_for_1_2_and_4_threads)
 // The dirt maps the two produce are the same bytes.
 TEST(pinned_determinism_hash)
 {
-    const uint64_t EXPECTED_FUSED = 0xd0e85ce59b54afb3ull;
-    const uint64_t EXPECTED_UNFUSED = 0xce8f5282c5239e08ull;
-    const uint64_t EXPECTED_DIRT_MAPS = 0x4baada439b27fab4ull; // hits channel, zlib level 1 (issue 15)
+    const uint64_t EXPECTED_FUSED = 0x41c42693bcf8770bull; // issue 25: low-discrepancy starts, weights
+    const uint64_t EXPECTED_UNFUSED = 0x9c5d1ffdeee59212ull;
+    const uint64_t EXPECTED_DIRT_MAPS = 0x6276ca858856e8faull; // hits as particle weights (issue 25)
     bool fused = wx_kernels_fuse_multiply_add();
     uint64_t files[2], state[2];
     wx_sim_stats st[2];

@@ -500,12 +500,59 @@ TEST(mesh_without_uvs_is_refused)
     ENSURE(ensure_shell(out, sizeof out, "test -e '%s'", folder) != 0);
 }
 
+// Dirt of 1 per square metre on every surface, no particle: the texture and
+// the mask hold 1 everywhere they see the sphere, also along the borders
+// between the five cameras' parts (each camera holds the dirt of the part it
+// sees most head-on; the gather divides by the share of each texel a camera
+// owns: model/ownership.h). Before that rule the borders showed as lines of
+// -20% to +20%.
+TEST(uniform_dirt_has_no_seam_between_cameras)
+{
+    char dir[PATH_MAX + 16];
+    snprintf(dir, sizeof dir, "%s/uniform", ensure_tmpdir());
+    ENSURE(ensure_shell(NULL, 0, "mkdir -p '%s'", dir) == 0);
+    char text[8192];
+    snprintf(text, sizeof text, sphere_scene, 0, data_file("uv_sphere.obj"));
+    char *at = strstr(text, "absorption=\"1\"");
+    ENSURE(at != NULL);
+    char scene[8300];
+    snprintf(scene, sizeof scene, "%.*sdirt=\"1\" %s", (int)(at - text), text, at);
+    ensure_write_file(dir, "uniform.xml", scene);
+    ENSURE(weathering_in(dir, "run uniform.xml --out out -q", true) == 0);
+    char path[PATH_MAX + 64];
+    const char *files[2] = { "sphere.exr", "mask.exr" };
+    for (int f = 0; f < 2; ++f) {
+        snprintf(path, sizeof path, "%s/out/%s", dir, files[f]);
+        int w = 0, h = 0;
+        float *y = ensure_read_channel(path, "Y", &w, &h);
+        float *seen = f == 0 ? ensure_read_channel(path, "seen", &w, &h) : NULL;
+        ENSURE(y != NULL);
+        int64_t count = 0, off = 0;
+        double worst = 0.0;
+        for (int64_t t = 0; t < (int64_t)w * h; ++t) {
+            if ((seen != NULL && seen[t] < 0.5f) || (seen == NULL && y[t] == 0.0f)) {
+                continue;
+            }
+            count++;
+            off += fabs(y[t] - 1.0) > 0.01;
+            worst = fmax(worst, fabs(y[t] - 1.0));
+        }
+        printf("        %s: %lld texels, %lld more than 1%% off 1, worst %.4f\n", files[f],
+               (long long)count, (long long)off, worst);
+        free(y);
+        free(seen);
+        ENSURE(count > 100000);
+        ENSURE(off <= count / 1000);
+    }
+}
+
 int main(void)
 {
     RUN(uv_raster_counts_ties_overlaps_and_padding);
     RUN(cube_atlas_under_vertical_rain);
     RUN(cube_texture_frames);
     RUN(uv_sphere_follows_the_flux_without_a_seam);
+    RUN(uniform_dirt_has_no_seam_between_cameras);
     RUN(texture_through_the_output_camera_equals_the_mask);
     RUN(mesh_without_uvs_is_refused);
     return ensure_summary();

@@ -30,16 +30,33 @@ void wx_mesh_data_free(wx_mesh_data *mesh)
     memset(mesh, 0, sizeof *mesh);
 }
 
+// Whether vertex a comes after vertex b: by position, then normal.
+static bool corner_after(const wx_mesh_data *mesh, uint32_t a, uint32_t b)
+{
+    const float *pa = &mesh->positions[3 * (size_t)a], *pb = &mesh->positions[3 * (size_t)b];
+    const float *na = &mesh->normals[3 * (size_t)a], *nb = &mesh->normals[3 * (size_t)b];
+    const float ka[6] = { pa[0], pa[1], pa[2], na[0], na[1], na[2] };
+    const float kb[6] = { pb[0], pb[1], pb[2], nb[0], nb[1], nb[2] };
+    for (int k = 0; k < 6; ++k) {
+        if (ka[k] != kb[k]) {
+            return ka[k] > kb[k];
+        }
+    }
+    return false;
+}
+
 void wx_mesh_phong_point(const wx_mesh_data *mesh, int64_t tri, const double w[3],
                          double out[3])
 {
-    // The corners in ascending vertex index, so that a point of an edge comes
-    // out bit for bit the same from both triangles that share it (a weight of
-    // 0 adds an exact 0 wherever it stands).
+    // The corners in a canonical order (by position, then normal), so that a
+    // point of an edge comes out bit for bit the same from both triangles that
+    // share it, also where they reach it through different vertices of the
+    // same position and normal (a UV seam); a weight of 0 adds an exact 0
+    // wherever it stands.
     const uint32_t *tri_idx = &mesh->indices[3 * (size_t)tri];
     int order[3] = { 0, 1, 2 };
     for (int a = 1; a < 3; ++a) {
-        for (int b = a; b > 0 && tri_idx[order[b - 1]] > tri_idx[order[b]]; --b) {
+        for (int b = a; b > 0 && corner_after(mesh, tri_idx[order[b - 1]], tri_idx[order[b]]); --b) {
             int swap = order[b];
             order[b] = order[b - 1];
             order[b - 1] = swap;
@@ -90,8 +107,17 @@ static bool triangle_curves(const wx_mesh_data *mesh, int64_t t)
            edge_curves(mesh, idx[2], idx[0]);
 }
 
-double wx_mesh_longest_curved_edge(const wx_mesh_data *mesh)
+static int compare_doubles(const void *a, const void *b)
 {
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+double wx_mesh_curved_edge_length(const wx_mesh_data *mesh, double quantile)
+{
+    size_t count = 0;
+    double *lengths = malloc((size_t)(mesh->triangle_count > 0 ? mesh->triangle_count : 1) * 3 *
+                             sizeof *lengths);
     double longest = 0.0;
     for (int64_t t = 0; t < mesh->triangle_count; ++t) {
         const uint32_t *idx = &mesh->indices[3 * t];
@@ -106,9 +132,19 @@ double wx_mesh_longest_curved_edge(const wx_mesh_data *mesh)
                    dz = (double)pb[2] - pa[2];
             double len = sqrt(dx * dx + dy * dy + dz * dz);
             longest = len > longest ? len : longest;
+            if (lengths != NULL) {
+                lengths[count++] = len;
+            }
         }
     }
-    return longest;
+    if (lengths == NULL || count == 0 || quantile >= 1.0) {
+        free(lengths);
+        return longest; // out of memory: the longest, found on the way
+    }
+    qsort(lengths, count, sizeof *lengths, compare_doubles);
+    double q = lengths[(size_t)(quantile * (double)(count - 1))];
+    free(lengths);
+    return q;
 }
 
 int64_t wx_mesh_curved_triangles(const wx_mesh_data *mesh)

@@ -62,12 +62,16 @@ void wx_mesh_data_free(wx_mesh_data *mesh);
 void wx_mesh_phong_point(const wx_mesh_data *mesh, int64_t tri, const double w[3],
                          double out[3]);
 
-/// The longest edge whose two vertex normals differ (0 for a flat-shaded mesh):
-/// how far the smooth surface may stand off the triangles is at most this.
-double wx_mesh_longest_curved_edge(const wx_mesh_data *mesh);
+/// The length of the edges whose two vertex normals differ at `quantile`
+/// (0.9: nine in ten are shorter; 1: the longest); 0 for a flat-shaded mesh.
+double wx_mesh_curved_edge_length(const wx_mesh_data *mesh, double quantile);
 
 /// How many triangles have an edge whose vertex normals differ.
 int64_t wx_mesh_curved_triangles(const wx_mesh_data *mesh);
+
+/// The most triangles the bake cuts a mesh's smooth surface into
+/// (raster/bake.c; pipeline/memory.c counts them).
+#define WX_SMOOTH_MAX_TRIANGLES 1000000.0
 
 /// Replaces every triangle that has an edge whose normals differ by level x
 /// level triangles on its smooth surface (wx_mesh_phong_point), normals and

@@ -14,6 +14,9 @@
 #define TIE_COSINE 1e-4f
 // Slopes steeper than this (|n . view|) count as this one (the collider's).
 #define MIN_SLOPE_COS 0.05f
+// A surface seen exactly edge-on (n . view = 0, up to rounding) still counts as
+// facing the view.
+#define FACING_SLACK 1e-4f
 // Points a border texel is cut into, per side.
 enum { SUB = 4 };
 
@@ -64,6 +67,11 @@ static bool depth_at(const float *depth, int width, int height, double x, double
 
 bool wx_owner_sees(const wx_owner_view *view, const double p[3], const float n[3])
 {
+    // The surface must face the view (a normal map's normals face its camera).
+    float facing = n[0] * view->view[0] + n[1] * view->view[1] + n[2] * view->view[2];
+    if (!(facing < FACING_SLACK)) {
+        return false;
+    }
     double uvd[3];
     wx_matrix_apply_affine(view->camera->wtc, p, uvd);
     double x = uvd[0] * view->width - 0.5, y = (1.0 - uvd[1]) * view->height - 0.5;

@@ -32,8 +32,9 @@ typedef struct wx_owner_view {
 void wx_owner_view_init(wx_owner_view *view, const wx_camera *camera, const float *depth,
                         int width, int height);
 
-/// Whether `view` sees the world point p of a surface with unit normal n: p
-/// projects into its frame onto a texel with a surface, and both that texel's
+/// Whether `view` sees the world point p of a surface with unit normal n: the
+/// surface faces the view (n . view <= 0), p projects into its frame onto a
+/// texel with a surface, and both that texel's
 /// depth and the depth between texel centres (bilinear where the four texels
 /// around p hold a surface) agree with p's within half a texel plus one
 /// texel's worth of the surface's slope in this view (the collider's rule).

@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include "model/maps.h"
+#include "model/mesh.h"
 #include "pipeline/masks_phase.h"
 #include "pipeline/outputs.h"
 #include "pipeline/texture_phase.h"
@@ -68,6 +69,10 @@ void wx_memory_estimate(const wx_scene *scene, unsigned phases, wx_memory_need *
             struct stat st;
             double bytes = stat(scene->meshes[m].path, &st) == 0 ? (double)st.st_size : 0.0;
             need->mesh_bytes += WX_MESH_BYTES_PER_FILE_BYTE * bytes;
+            // Its smooth surface (raster/bake.c): at most WX_SMOOTH_MAX_TRIANGLES,
+            // and at most 64 times the triangles a file of that size holds.
+            need->mesh_bytes += WX_SMOOTH_BYTES_PER_TRIANGLE *
+                                fmin(WX_SMOOTH_MAX_TRIANGLES, 64.0 * bytes / 16.0);
             if (bytes > largest_file) {
                 largest_file = bytes;
                 need->mesh_line = scene->meshes[m].line;

@@ -51,6 +51,11 @@ typedef struct wx_memory_need {
 /// Bytes per byte of mesh file while Assimp imports it (measured: about 18 for
 /// OBJ; binary formats hold fewer bytes per triangle).
 #define WX_MESH_BYTES_PER_FILE_BYTE 32.0
+/// Bytes per triangle of a mesh's smooth surface in the bake (model/mesh.h:
+/// vertices, normals, colours, indices, materials, and the renderer's copy);
+/// a mesh file holds a triangle per 16 bytes at the most.
+#define WX_SMOOTH_BYTES_PER_TRIANGLE 100.0
+
 /// Bytes per texel of the bake's float framebuffer (RGBA32F x 2, R32F, depth).
 #define WX_BAKE_FRAMEBUFFER_BYTES_PER_TEXEL 40.0
 /// Bytes per texel of the images of one baked camera (depth 1, normal 3, impact

@@ -471,21 +471,21 @@ static double finest_texel(const baker *b)
 // How finely the triangles of a smooth-shaded mesh are cut so that the maps
 // record the smooth surface its normals describe (wx_mesh_smooth_subdivide,
 // docs/cameras.md): pieces of about SMOOTH_PIECE_TEXELS of the finest camera's
-// texels along the longest curved edge, at most SMOOTH_MAX_LEVEL, and at most
-// SMOOTH_MAX_TRIANGLES triangles in all.
-enum { SMOOTH_MAX_LEVEL = 16 };
-#define SMOOTH_PIECE_TEXELS 2.0
-#define SMOOTH_MAX_TRIANGLES 4000000.0
+// texels along the longest curved edges (the 90th percentile: a few long
+// edges do not cut every triangle), at most SMOOTH_MAX_LEVEL, and at most
+// WX_SMOOTH_MAX_TRIANGLES triangles in all (a dense scan stays as it is).
+enum { SMOOTH_MAX_LEVEL = 8 };
+#define SMOOTH_PIECE_TEXELS 4.0
 
 static int smooth_level(const baker *b, const wx_mesh_data *data)
 {
-    double edge = wx_mesh_longest_curved_edge(data), texel = finest_texel(b);
+    double edge = wx_mesh_curved_edge_length(data, 0.9), texel = finest_texel(b);
     if (!(edge > 0.0) || !isfinite(texel) || !(texel > 0.0)) {
         return 1;
     }
     double level = fmin(ceil(edge / (SMOOTH_PIECE_TEXELS * texel)), SMOOTH_MAX_LEVEL);
     double curved = (double)wx_mesh_curved_triangles(data);
-    while (level > 1.0 && curved * level * level > SMOOTH_MAX_TRIANGLES) {
+    while (level > 1.0 && curved * level * level > WX_SMOOTH_MAX_TRIANGLES) {
         level -= 1.0;
     }
     return level > 1.0 ? (int)level : 1;
@@ -508,6 +508,9 @@ static wx_result load_meshes(baker *b, wx_geometry *geometry, wx_error *err)
             continue;
         }
         double t1 = wx_now_s();
+        // The mesh as the file has it (the smooth surface may cut it finer).
+        b->stats->triangles += data->triangle_count;
+        b->stats->vertices += data->vertex_count;
         float *props = malloc((size_t)data->material_count * 8 * sizeof(float));
         wx_result r = WX_OK;
         if (props == NULL) {
@@ -525,8 +528,6 @@ static wx_result load_meshes(baker *b, wx_geometry *geometry, wx_error *err)
                                 wx_mesh_display_name(scene, mesh));
             }
         }
-        b->stats->triangles += data->triangle_count;
-        b->stats->vertices += data->vertex_count;
         free(props);
         wx_mesh_data_release_arrays(data);
         b->stats->setup_s += wx_now_s() - t1;
