@@ -1018,7 +1018,8 @@ static int generate(const cli_args *args, bool as_given, const char *scene_name,
                         .preset = args->preset,
                         .resolution = args->resolution,
                         .unit_m = args->units != NULL ? wx_unit_metres(args->units) : 1.0,
-                        .scene_name = scene_name };
+                        .scene_name = scene_name,
+                        .quiet = args->quiet };
     wx_error err;
     wx_result r = wx_scene_generate(&def, text, &err);
     if (r != WX_OK) {
