@@ -931,7 +931,17 @@ static void print_summary(const wx_scene *scene, const wx_run_def *opts, const w
         print_output(opts, scene->cameras[scene->output_index].output_file);
     }
     for (int t = 0; t < scene->texture_count; ++t) {
-        print_output(opts, scene->textures[t].file);
+        const wx_texture_map *tm = &scene->textures[t];
+        // One file, or one per UDIM tile.
+        for (int f = 0; f < wx_texture_file_count(tm); ++f) {
+            char name[WX_OUTPUT_NAME_MAX];
+            if (tm->tiles == WX_TILES_UDIM) {
+                wx_tile_name(tm->file, wx_texture_file_tile(tm, f), name, sizeof name);
+            } else {
+                snprintf(name, sizeof name, "%s", tm->file);
+            }
+            print_output(opts, name);
+        }
     }
 }
 
