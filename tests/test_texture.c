@@ -301,8 +301,8 @@ TEST(uv_raster_leaves_out_what_no_renderer_can_read)
 }
 
 // Rain straight down on quads lying in y = 0 (x, z in [-0.8, 0.8]) seen from
-// above: `iterations`, then the TextureMap's attributes. The mesh is quad.obj
-// in the scene's folder.
+// above: `iterations`, the TextureMap's attributes, then <Masks> or "". The
+// mesh is quad.obj in the scene's folder.
 static const char *quad_scene =
     "<Weathering>\n"
     "  <Solver><BoundingBox size=\"4\" centerY=\"1\"/>\n"
@@ -323,7 +323,16 @@ static const char *quad_scene =
     "      <TextureMap file=\"quad.exr\" resolution=\"32\" padding=\"2\"%s/>\n"
     "    </Mesh>\n"
     "  </Geometry>\n"
+    "%s"
     "</Weathering>\n";
+
+// Derived masks for quad_scene: each a channel evaluated at a texture's points.
+static const char *quad_masks =
+    "  <Masks>\n"
+    "    <Accessibility name=\"ao\" rays=\"16\" distance=\"0.5\"/>\n"
+    "    <Height name=\"h\" min=\"-1\" max=\"1\"/>\n"
+    "    <Combine name=\"c\"><Term mask=\"ao\"/><Term substance=\"dirt\" weight=\"0.001\"/></Combine>\n"
+    "  </Masks>\n";
 
 // A quad over x, z in [-0.8, 0.8] at y = 0 facing up, its corners' UVs from
 // (u0, v0) to (u1, v1); with `split`, two quads meeting at x = 0, the second's
@@ -360,10 +369,10 @@ TEST(quad_in_tile_2_wraps_onto_the_texture_byte_for_byte)
     snprintf(a, sizeof a, "%s/unit", dir);
     snprintf(b, sizeof b, "%s/tile2", dir);
     ENSURE(ensure_shell(NULL, 0, "mkdir -p '%s' '%s'", a, b) == 0);
-    snprintf(text, sizeof text, quad_scene, 1, "");
+    snprintf(text, sizeof text, quad_scene, 1, "", "");
     ensure_write_file(a, "scene.xml", text);
     ensure_write_file(b, "scene.xml", text);
-    snprintf(text, sizeof text, quad_scene, 1, " tiles=\"clip\"");
+    snprintf(text, sizeof text, quad_scene, 1, " tiles=\"clip\"", "");
     ensure_write_file(b, "clip.xml", text);
     write_quads(a, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, false);
     write_quads(b, 2.0, 3.0, 0.0, 0.0, 0.0, 1.0, false);
@@ -397,11 +406,12 @@ TEST(quad_in_tile_2_wraps_onto_the_texture_byte_for_byte)
 }
 
 // tiles="udim": two quads side by side, the left's UVs in [0, 0.5] x [0, 1]
-// (tile 1001), the right's in [1.5, 2] x [0, 1] (tile 1002). The run writes
-// exactly quad.1001.exr and quad.1002.exr with their previews and frames, and
-// each tile's texels hold what the same mesh with the right quad's UVs moved
-// to [0.5, 1] (one tile, REPEAT) holds there, bit for bit; the rest of a tile
-// is padding or empty.
+// (tile 1001), the right's in [1.5, 2] x [0, 1] (tile 1002), with derived
+// masks. The run writes exactly quad.1001.exr and quad.1002.exr with their
+// previews and frames, and each tile's texels hold what the same mesh with the
+// right quad's UVs moved to [0.5, 1] (one tile, REPEAT) holds there, every
+// channel bit for bit (the masks too, kept per tile over the frames); the
+// rest of a tile is padding or empty.
 TEST(udim_layout_writes_one_file_per_tile)
 {
     const char *dir = ensure_tmpdir();
@@ -409,9 +419,9 @@ TEST(udim_layout_writes_one_file_per_tile)
     snprintf(a, sizeof a, "%s/udim", dir);
     snprintf(b, sizeof b, "%s/one", dir);
     ENSURE(ensure_shell(NULL, 0, "mkdir -p '%s' '%s'", a, b) == 0);
-    snprintf(text, sizeof text, quad_scene, 2, " tiles=\"udim\" every=\"1\"");
+    snprintf(text, sizeof text, quad_scene, 2, " tiles=\"udim\" every=\"1\"", quad_masks);
     ensure_write_file(a, "scene.xml", text);
-    snprintf(text, sizeof text, quad_scene, 2, "");
+    snprintf(text, sizeof text, quad_scene, 2, "", quad_masks);
     ensure_write_file(b, "scene.xml", text);
     write_quads(a, 0.0, 0.5, 1.5, 2.0, 0.0, 1.0, true);
     write_quads(b, 0.0, 0.5, 0.5, 1.0, 0.0, 1.0, true);
@@ -422,31 +432,36 @@ TEST(udim_layout_writes_one_file_per_tile)
     ENSURE(weathering_in(a, "run scene.xml --out out -q", true) == 0);
     ENSURE(weathering_in(b, "run scene.xml --out out -q", true) == 0);
     ENSURE(ensure_shell(out, sizeof out, "cd '%s/out' && LC_ALL=C ls quad*", a) == 0);
-    ENSURE(strcmp(out, "quad.1001.0001.exr\nquad.1001.0002.exr\nquad.1001.exr\nquad.1001.png\n"
-                       "quad.1002.0001.exr\nquad.1002.0002.exr\nquad.1002.exr\nquad.1002.png\n") ==
+    ENSURE(strcmp(out, "quad.1001.0001.exr\nquad.1001.0002.exr\nquad.1001.exr\n"
+                       "quad.1001_ao.png\nquad.1001_c.png\nquad.1001_dirt.png\nquad.1001_h.png\n"
+                       "quad.1002.0001.exr\nquad.1002.0002.exr\nquad.1002.exr\n"
+                       "quad.1002_ao.png\nquad.1002_c.png\nquad.1002_dirt.png\nquad.1002_h.png\n") ==
            0);
     // The last frame is the final file; a tile's header names its tile.
     ENSURE(ensure_shell(out, sizeof out, "cd '%s/out' && cmp quad.1002.0002.exr quad.1002.exr",
                         a) == 0);
-    static const char *const names[] = { "Y", "seen" };
+    static const char *const names[] = { "dirt.Y", "seen", "ao.Y", "h.Y", "c.Y" };
     wx_image tiles[2], one;
     char path[2 * PATH_MAX];
     snprintf(path, sizeof path, "%s/out/quad.1001.exr", a);
-    ENSURE(read_channels(path, names, 2, &tiles[0]));
+    ENSURE(read_channels(path, names, 5, &tiles[0]));
     const wx_attr *tile = wx_image_find_attr(&tiles[0], "weatheringUDIMTile");
     ENSURE(tile != NULL && strcmp(tile->string, "1001") == 0);
     snprintf(path, sizeof path, "%s/out/quad.1002.exr", a);
-    ENSURE(read_channels(path, names, 2, &tiles[1]));
+    ENSURE(read_channels(path, names, 5, &tiles[1]));
     snprintf(path, sizeof path, "%s/out/quad.exr", b);
-    ENSURE(read_channels(path, names, 2, &one));
+    ENSURE(read_channels(path, names, 5, &one));
     int64_t same = 0, padded = 0, empty = 0;
     for (int j = 0; j < 32; ++j) {
         for (int i = 0; i < 32; ++i) {
             size_t t = (size_t)j * 32 + (size_t)i;
             int mine = i < 16 ? 0 : 1; // the tile whose quad covers column i in `one`
             const wx_image *m = &tiles[mine], *o = &tiles[1 - mine];
-            same += m->channels[0][t] == one.channels[0][t] &&
-                    m->channels[1][t] == one.channels[1][t];
+            bool all = true;
+            for (int c = 0; c < 5; ++c) {
+                all = all && m->channels[c][t] == one.channels[c][t];
+            }
+            same += all;
             // In the other tile: two columns of padding, then nothing.
             bool pad = i < 16 ? i >= 14 : i <= 17;
             padded += pad && o->channels[1][t] == 1.0f;
