@@ -553,20 +553,56 @@ static void print_texture(const wx_scene *scene, const wx_texture_map *t, const 
         printf(", adaptive smoothing (noise %g, maxRadius %g texels of each input camera)",
                (double)t->noise, (double)WX_DEFAULT_MAX_RADIUS_TEXELS);
     }
-    printf("\n");
+    printf("%s\n", t->tiles == WX_TILES_UDIM  ? ", one file per UDIM tile (tiles=\"udim\")"
+                   : t->tiles == WX_TILES_CLIP ? ", the [0,1] tile only (tiles=\"clip\")"
+                                               : "");
     double scale = fmin(1.0, 1024.0 / (double)(t->width > t->height ? t->width : t->height));
     int w = (int)fmax(1.0, round(t->width * scale)), h = (int)fmax(1.0, round(t->height * scale));
-    wx_uv_raster r;
-    wx_error err;
-    if (wx_uv_raster_build(mesh, t->uv, w, h, (int)ceil(t->padding * scale), &r, &err) != WX_OK) {
-        printf("    coverage: not estimated (%s)\n", err.message);
-    } else {
+    const int files = wx_texture_file_count(t);
+    if (t->tiles == WX_TILES_UDIM) {
+        char first[WX_OUTPUT_NAME_MAX] = "", last[WX_OUTPUT_NAME_MAX] = "";
+        if (files > 0) {
+            wx_tile_name(t->file, wx_texture_file_tile(t, 0), first, sizeof first);
+            wx_tile_name(t->file, wx_texture_file_tile(t, files - 1), last, sizeof last);
+        }
+        printf("    UDIM tiles: %d (where a texel centre lies inside a triangle)%s%s%s%s\n", files,
+               files > 0 ? ": " : "", first, files > 1 ? (files > 2 ? " ... " : ", ") : "",
+               files > 1 ? last : "");
+    }
+    wx_uv_raster_def rd = { .mesh = mesh, .uv = t->uv, .tiles = t->tiles, .width = w,
+                            .height = h, .padding = (int)ceil(t->padding * scale) };
+    for (int f = 0; f < (files > 0 ? files : 1); ++f) {
+        wx_uv_raster r;
+        wx_error err;
+        rd.udim = files > 0 ? wx_texture_file_tile(t, f) : 0;
+        if (wx_uv_raster_build(&rd, &r, &err) != WX_OK) {
+            printf("    coverage: not estimated (%s)\n", err.message);
+            break;
+        }
         double n = (double)w * (double)h;
-        printf("    coverage: about %.1f%% of the texels covered, %.2f%% overlapping, %.1f%% "
-               "padding (on %d x %d); %lld of %lld triangles reach outside the [0,1] tile\n",
-               100.0 * (double)r.covered / n, 100.0 * (double)r.overlapping / n,
-               100.0 * (double)r.padded / n, w, h, (long long)r.triangles_outside,
-               (long long)mesh->triangle_count);
+        char tile[32] = "";
+        if (t->tiles == WX_TILES_UDIM) {
+            snprintf(tile, sizeof tile, " of tile %d", WX_UDIM_FIRST + rd.udim);
+        }
+        if (files > 0 || t->tiles != WX_TILES_UDIM) {
+            printf("    coverage%s: about %.1f%% of the texels covered, %.2f%% overlapping, %.1f%% "
+                   "padding (on %d x %d)",
+                   tile, 100.0 * (double)r.covered / n, 100.0 * (double)r.overlapping / n,
+                   100.0 * (double)r.padded / n, w, h);
+        }
+        if (f == 0) {
+            // The triangles (exact, the same for every tile).
+            printf("%s%lld of %lld triangles reach outside %s", files > 0 || t->tiles != WX_TILES_UDIM ? "; " : "    ",
+                   (long long)r.triangles_outside, (long long)mesh->triangle_count,
+                   t->tiles == WX_TILES_UDIM   ? "the UDIM tiles 1001 to 2000 (not written)"
+                   : t->tiles == WX_TILES_CLIP ? "the [0,1] tile (not written)"
+                                               : "the [0,1] tile (they wrap, as REPEAT reads them)");
+            if (r.triangles_unusable > 0) {
+                printf("; %lld left out (a UV not finite%s)", (long long)r.triangles_unusable,
+                       t->tiles == WX_TILES_CLIP ? "" : " or over 64 UV tiles");
+            }
+        }
+        printf("\n");
         wx_uv_raster_free(&r);
     }
     int64_t input_texels = 0;
@@ -575,8 +611,9 @@ static void print_texture(const wx_scene *scene, const wx_texture_map *t, const 
             input_texels += (int64_t)scene->cameras[c].camera.width * scene->cameras[c].camera.height;
         }
     }
-    printf("    writing it needs about %.0f MiB\n",
-           (double)wx_texture_bytes(scene, t, input_texels) / (1024.0 * 1024.0));
+    printf("    writing it needs about %.0f MiB%s\n",
+           (double)wx_texture_bytes(scene, t, input_texels) / (1024.0 * 1024.0),
+           files > 1 ? " a tile, one tile at a time" : "");
     if (frames > 0) {
         char names[WX_IMAGE_MAX_CHANNELS][WX_NAME_MAX];
         print_sequence_cost(scene, frames, wx_texture_channels(scene, names), t->width,
@@ -600,11 +637,15 @@ static int command_info(const cli_args *args)
     bool imported = wx_scene_needs_bake(&scene) || scene.texture_count > 0;
     wx_error err;
     wx_result r = wx_gather_check(&scene, &err);
-    if (r == WX_OK) {
-        r = wx_check_outputs(&scene, &opts, WX_PHASE_ALL, &err);
-    }
     if (r == WX_OK && imported) {
         r = wx_geometry_load(&scene, args->quiet, &geometry, &err);
+    }
+    // A tiles="udim" texture's files are its mesh's tiles: known from here on.
+    if (r == WX_OK && imported) {
+        wx_textures_find_tiles(&scene, &geometry);
+    }
+    if (r == WX_OK) {
+        r = wx_check_outputs(&scene, &opts, WX_PHASE_ALL, &err);
     }
     if (r != WX_OK) {
         fprintf(stderr, "weathering: %s\n", err.message);
@@ -890,7 +931,17 @@ static void print_summary(const wx_scene *scene, const wx_run_def *opts, const w
         print_output(opts, scene->cameras[scene->output_index].output_file);
     }
     for (int t = 0; t < scene->texture_count; ++t) {
-        print_output(opts, scene->textures[t].file);
+        const wx_texture_map *tm = &scene->textures[t];
+        // One file, or one per UDIM tile.
+        for (int f = 0; f < wx_texture_file_count(tm); ++f) {
+            char name[WX_OUTPUT_NAME_MAX];
+            if (tm->tiles == WX_TILES_UDIM) {
+                wx_tile_name(tm->file, wx_texture_file_tile(tm, f), name, sizeof name);
+            } else {
+                snprintf(name, sizeof name, "%s", tm->file);
+            }
+            print_output(opts, name);
+        }
     }
 }
 
@@ -977,7 +1028,8 @@ static int generate(const cli_args *args, bool as_given, const char *scene_name,
                         .preset = args->preset,
                         .resolution = args->resolution,
                         .unit_m = args->units != NULL ? wx_unit_metres(args->units) : 1.0,
-                        .scene_name = scene_name };
+                        .scene_name = scene_name,
+                        .quiet = args->quiet };
     wx_error err;
     wx_result r = wx_scene_generate(&def, text, &err);
     if (r != WX_OK) {

@@ -178,6 +178,74 @@ TEST(run_a_mesh_and_split_its_texture)
     free(y2);
 }
 
+// Two quads side by side (x in [-0.8, 0] and [0, 0.8], y = 0, facing up), the
+// first's UVs from (u[0], v[0]) to (u[1], v[1]), the second's from (u[2], v[2])
+// to (u[3], v[3]), written as dir/name.
+static void write_two_quads(const char *dir, const char *name, const double u[4],
+                            const double v[4])
+{
+    char text[1024];
+    snprintf(text, sizeof text,
+             "v -0.8 0 0.8\nv 0 0 0.8\nv 0 0 -0.8\nv -0.8 0 -0.8\nv 0.8 0 0.8\nv 0.8 0 -0.8\n"
+             "vt %g %g\nvt %g %g\nvt %g %g\nvt %g %g\nvt %g %g\nvt %g %g\nvt %g %g\nvt %g %g\n"
+             "vn 0 1 0\nf 1/1/1 2/2/1 3/3/1\nf 1/1/1 3/3/1 4/4/1\n"
+             "f 2/5/1 5/6/1 6/7/1\nf 2/5/1 6/7/1 3/8/1\n",
+             u[0], v[0], u[1], v[0], u[1], v[1], u[0], v[1], u[2], v[2], u[3], v[2], u[3], v[3],
+             u[2], v[3]);
+    ensure_write_file(dir, name, text);
+}
+
+// init reads the UV layout (docs/presets.md): UVs in UDIM tiles 1001 and 1002
+// give tiles="udim"; a layout in [0,1] that overshoots by a hair, and one
+// spread over -7.6 .. 8.5, the default REPEAT (with a comment saying how far
+// they reach); a layout without area no TextureMap, with a note in the scene
+// and on stderr. Every scene validates and `info` reads it.
+TEST(init_reads_the_uv_layout)
+{
+    const char *dir = ensure_tmpdir();
+    static const struct {
+        const char *name;
+        double u[4], v[4];
+        const char *want, *not_want;
+    } layouts[] = {
+        { "udim", { 0, 0.5, 1.5, 2 }, { 0, 1, 0, 1 },
+          "<TextureMap file=\"udim_texture.exr\" resolution=\"64\" tiles=\"udim\"/>",
+          "covers no texel" },
+        { "over", { -0.01, 0.5, 0.5, 1.01 }, { 0, 1, 0, 1.001 },
+          "<TextureMap file=\"over_texture.exr\" resolution=\"64\"/>", "tiles=" },
+        { "spread", { -7.6, -7.1, 8, 8.5 }, { -3, -2, 3, 4 },
+          "They reach from (-7.6, -3) to (8.5, 4): outside [0,1] they wrap", "tiles=" },
+        { "flat", { 0.5, 0.5, 0.5, 0.5 }, { 0.5, 0.5, 0.5, 0.5 },
+          "covers no texel at 64 x 64:\n           of its 4 triangles, 4 have no area in UV",
+          "<TextureMap file" },
+    };
+    for (size_t k = 0; k < sizeof layouts / sizeof layouts[0]; ++k) {
+        char mesh[64], scene[64], path[PATH_MAX + 64];
+        snprintf(mesh, sizeof mesh, "%s.obj", layouts[k].name);
+        snprintf(scene, sizeof scene, "%s.xml", layouts[k].name);
+        write_two_quads(dir, mesh, layouts[k].u, layouts[k].v);
+        ENSURE(run_in(dir, "init %s --resolution 64 -o %s", mesh, scene) == 0);
+        bool noted = strstr(out, "weathering: note: flat.obj: the mesh's UV layout covers no "
+                                 "texel at 64 x 64") != NULL;
+        ENSURE(noted == (k == 3));
+        snprintf(path, sizeof path, "%s/%s", dir, scene);
+        char *text = ensure_read_file(path);
+        ENSURE(text != NULL);
+        bool ok = strstr(text, layouts[k].want) != NULL && strstr(text, layouts[k].not_want) == NULL;
+        if (!ok) {
+            fprintf(stderr, "        %s:\n%s\n", scene, text);
+        }
+        free(text);
+        ENSURE(ok);
+        ENSURE(schema_accepts(path));
+        ENSURE(run_in(dir, "info %s%s", scene, "") == 0);
+    }
+    // info names the UDIM files.
+    ENSURE(run_in(dir, "info %s%s", "udim.xml", "") == 0);
+    ENSURE(strstr(out, "UDIM tiles: 2 (where a texel centre lies inside a triangle): "
+                       "udim_texture.1001.exr, udim_texture.1002.exr") != NULL);
+}
+
 // Bad input: exit 2 with one message; an existing scene is never replaced
 // without --force.
 TEST(bad_input_is_exit_2)
@@ -313,6 +381,7 @@ int main(void)
     RUN(presets_make_valid_scenes_and_rain_dirties_the_top);
     RUN(sizes_scale_with_the_mesh);
     RUN(run_a_mesh_and_split_its_texture);
+    RUN(init_reads_the_uv_layout);
     RUN(bad_input_is_exit_2);
     RUN(run_mesh_folder_is_plain_and_named_after_the_mesh);
     RUN(run_mesh_keeps_a_users_scene_and_leaves_nothing_on_refusal);

@@ -910,11 +910,12 @@ static void texture_scene(char *text, size_t cap)
              "    </Mesh>\n"                                                        // 6
              "    <Mesh file=\"%s\">\n"                                             // 7
              "      <TextureMap file=\"house_weathering.exr\" resolution=\"2048\"\n"  // 8
-             "                  width=\"512\" padding=\"0\" uv=\"7\" every=\"5\"\n"  // 9
+             "                  width=\"512\" padding=\"0\" uv=\"7\" every=\"5\" tiles=\" udim \"\n" // 9
              "                  radius=\"0.25\"/>\n"                                // 10
              "      <TextureMap file=\"tall.EXR\" resolution=\"64\" height=\"300\"\n" // 11
-             "                  padding=\"1024\" uv=\"1\" noise=\"0.1\" maxRadius=\"2\"/>\n" // 12
-             "    </Mesh>\n"                                                        // 13
+             "                  padding=\"1024\" uv=\"1\" noise=\"0.1\" maxRadius=\"2\"\n" // 12
+             "                  tiles=\"clip\"/>\n"                                 // 13
+             "    </Mesh>\n"                                                        // 14
              "  </Geometry>\n" VIEW_COLLIDER "</Weathering>\n",
              abs_data_path("box.obj"), abs_data_path("box.obj"));
 }
@@ -956,7 +957,13 @@ TEST(texture_maps)
     ENSURE(texture_is(&s.textures[1], 1, "house_weathering.exr", 512, 2048, 0, 7, 5, false,
                       0.25f, WX_DEFAULT_NOISE, 0.0f, 10));
     ENSURE(texture_is(&s.textures[2], 1, "tall.EXR", 64, 300, 1024, 1, 0, true, 0.0f, 0.1f,
-                      2.0f, 12));
+                      2.0f, 13));
+    // tiles: repeat by default (UVs outside [0,1] wrap), the keywords trimmed;
+    // a UDIM texture's tiles are known only once its mesh is read.
+    ENSURE(s.textures[0].tiles == WX_TILES_REPEAT && s.textures[1].tiles == WX_TILES_UDIM &&
+           s.textures[2].tiles == WX_TILES_CLIP);
+    ENSURE(!s.textures[1].udim_known && wx_texture_file_count(&s.textures[1]) == 0 &&
+           wx_texture_file_count(&s.textures[0]) == 1);
     // The output camera is unchanged by them.
     ENSURE(s.output_index == 1 && strcmp(s.cameras[1].output_file, "mask.exr") == 0);
     wx_scene_free(&s);
@@ -1540,7 +1547,7 @@ TEST(schema_rejects_bad_values)
         // docs/design.md section 11.
         "texture_map_not_exr", "texture_map_uv_too_large", "texture_map_padding_negative",
         "texture_map_zero_resolution", "texture_map_width_too_large", "texture_map_without_file",
-        "texture_map_same_file_twice", "texture_map_outside_mesh",
+        "texture_map_same_file_twice", "texture_map_outside_mesh", "texture_map_tiles_unknown",
         // docs/design.md section 12 (issue 18).
         "term_unknown_mask", "accessibility_rays_zero", "accessibility_rays_too_many",
         "accessibility_distance_zero", "exposure_elevation_above_90",

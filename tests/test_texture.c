@@ -71,7 +71,11 @@ TEST(uv_raster_counts_ties_overlaps_and_padding)
     wx_uv_raster r;
     wx_error err;
     square_mesh(&mesh, positions, normals, uvs, indices, false);
-    ENSURE(wx_uv_raster_build(&mesh, 0, 16, 16, 2, &r, &err) == WX_OK);
+    wx_uv_raster_def rd = wx_default_uv_raster_def();
+    rd.mesh = &mesh;
+    rd.width = rd.height = 16;
+    rd.padding = 2;
+    ENSURE(wx_uv_raster_build(&rd, &r, &err) == WX_OK);
     ENSURE(r.covered == 64 && r.overlapping == 0 && r.triangles_outside == 0);
     int64_t padded = 0, nearest_ok = 0;
     for (int j = 0; j < 16; ++j) {
@@ -112,7 +116,8 @@ TEST(uv_raster_counts_ties_overlaps_and_padding)
     wx_uv_raster_free(&r);
 
     square_mesh(&mesh, positions, normals, uvs, indices, true);
-    ENSURE(wx_uv_raster_build(&mesh, 0, 16, 16, 0, &r, &err) == WX_OK);
+    rd.padding = 0;
+    ENSURE(wx_uv_raster_build(&rd, &r, &err) == WX_OK);
     ENSURE(r.covered == 64 && r.overlapping == 64 && r.padded == 0);
     bool first_wins = true;
     for (size_t k = 0; k < 256; ++k) {
@@ -120,6 +125,360 @@ TEST(uv_raster_counts_ties_overlaps_and_padding)
     }
     ENSURE(first_wins);
     wx_uv_raster_free(&r);
+}
+
+// ---------------------------------------------------------------------------
+// UVs outside [0,1] (docs/texture.md "UVs outside [0,1]").
+
+// One triangle whose UVs straddle u = 1, positions equal to (u, v, 0).
+static const float straddle_uv[3][2] = { { 0.8f, 0.2f }, { 1.3f, 0.35f }, { 0.9f, 0.85f } };
+
+static void one_triangle(wx_mesh_data *m, float *positions, float *normals, float *uvs,
+                         uint32_t *indices, const float corners[3][2])
+{
+    memset(m, 0, sizeof *m);
+    for (int k = 0; k < 3; ++k) {
+        positions[3 * k] = corners[k][0];
+        positions[3 * k + 1] = corners[k][1];
+        positions[3 * k + 2] = 0.0f;
+        normals[3 * k] = normals[3 * k + 1] = 0.0f;
+        normals[3 * k + 2] = 1.0f;
+        uvs[2 * k] = corners[k][0];
+        uvs[2 * k + 1] = corners[k][1];
+        indices[k] = (uint32_t)k;
+    }
+    m->vertex_count = 3;
+    m->triangle_count = 1;
+    m->positions = positions;
+    m->normals = normals;
+    m->indices = indices;
+    m->uvs[0] = uvs;
+}
+
+// Brute force: the sign of point (u, v) against the triangle's three edges
+// (+1 inside, -1 outside, 0 on an edge), in UV.
+static int side_of(const float tri[3][2], double u, double v)
+{
+    int pos = 0, neg = 0;
+    for (int k = 0; k < 3; ++k) {
+        const float *a = tri[k], *b = tri[(k + 1) % 3];
+        double e = ((double)b[0] - a[0]) * (v - a[1]) - ((double)b[1] - a[1]) * (u - a[0]);
+        pos += e > 0.0;
+        neg += e < 0.0;
+    }
+    return pos == 3 || neg == 3 ? 1 : pos + neg == 3 ? -1 : 0;
+}
+
+// REPEAT covers a texel when its centre lies in the triangle or in the
+// triangle moved one tile to the left: the part of the triangle beyond u = 1
+// lands on the texture's left edge, the rest stays on its right. CLIP keeps
+// only the right part, and UDIM gives each part its own tile (1001, 1002).
+// Texel values: the surface point of a wrapped texel is the point at u + 1.
+TEST(uv_raster_wraps_a_triangle_across_u_1)
+{
+    float positions[9], normals[9], uvs[6];
+    uint32_t indices[3];
+    wx_mesh_data mesh;
+    one_triangle(&mesh, positions, normals, uvs, indices, straddle_uv);
+    const int W = 32, H = 32;
+    // The expected texels, and no centre on an edge (no tie decides anything).
+    bool right[32 * 32], left[32 * 32];
+    int64_t n_right = 0, n_left = 0, on_edge = 0;
+    for (int j = 0; j < H; ++j) {
+        for (int i = 0; i < W; ++i) {
+            double u = (i + 0.5) / W, v = 1.0 - (j + 0.5) / H;
+            int a = side_of(straddle_uv, u, v), b = side_of(straddle_uv, u + 1.0, v);
+            right[j * W + i] = a > 0;
+            left[j * W + i] = b > 0;
+            n_right += a > 0;
+            n_left += b > 0;
+            on_edge += a == 0 || b == 0;
+        }
+    }
+    printf("        %lld texels right of the border, %lld wrapped to the left\n",
+           (long long)n_right, (long long)n_left);
+    ENSURE(on_edge == 0 && n_right > 20 && n_left > 20);
+
+    wx_uv_raster_def rd = wx_default_uv_raster_def();
+    rd.mesh = &mesh;
+    rd.width = W;
+    rd.height = H;
+    static const wx_uv_tiles modes[4] = { WX_TILES_REPEAT, WX_TILES_CLIP, WX_TILES_UDIM,
+                                          WX_TILES_UDIM };
+    for (int m = 0; m < 4; ++m) {
+        rd.tiles = modes[m];
+        rd.udim = m == 3 ? 1 : 0; // tiles 1001 and 1002
+        wx_uv_raster r;
+        wx_error err;
+        ENSURE(wx_uv_raster_build(&rd, &r, &err) == WX_OK);
+        int64_t wrong = 0;
+        for (int t = 0; t < W * H; ++t) {
+            bool want = m == 0 ? right[t] || left[t] : m == 3 ? left[t] : right[t];
+            wrong += want != (r.triangle[t] == 0);
+        }
+        int64_t want_covered = m == 0 ? n_right + n_left : m == 3 ? n_left : n_right;
+        ENSURE(wrong == 0 && r.covered == want_covered && r.overlapping == 0);
+        ENSURE(r.triangles_outside == (m < 2 ? 1 : 0) && r.triangles_unusable == 0);
+        // A texel on the left edge stands for the point at u + 1.
+        for (int t = 0; t < W * H && m != 1 && m != 2; ++t) {
+            if (!left[t]) {
+                continue;
+            }
+            double p[3];
+            float n[3];
+            ENSURE(wx_uv_raster_point(&mesh, 0, &r, (size_t)t, p, n));
+            ENSURE_NEAR(p[0], (t % W + 0.5) / W + 1.0, 1e-6);
+            ENSURE_NEAR(p[1], 1.0 - (t / W + 0.5) / H, 1e-6);
+        }
+        wx_uv_raster_free(&r);
+    }
+    // The survey finds both tiles, and both sides covered.
+    wx_uv_survey s;
+    wx_error err;
+    ENSURE(wx_uv_survey_build(&mesh, 0, W, H, &s, &err) == WX_OK);
+    ENSURE(s.covers && s.udim_count == 2 && (s.udim[0] & 3u) == 3u);
+    ENSURE(s.triangles_outside_unit == 1 && s.triangles_outside_udim == 0 &&
+           s.triangles_in_other_tiles == 0);
+}
+
+// UVs that no float arithmetic should walk: 1e30 apart, NaN, infinity, the
+// largest float; a triangle spanning 8 x 8 tiles is drawn (64 copies, every
+// texel many times over) and one spanning 65 is left out. Nothing hangs or
+// overflows: every loop is bounded by the tiles a triangle spans.
+TEST(uv_raster_leaves_out_what_no_renderer_can_read)
+{
+    static const float corners[6][3][2] = {
+        { { 1e30f, 0.1f }, { -1e30f, 0.2f }, { 0.5f, 0.9f } }, // spans 2e30 tiles
+        { { NAN, 0.1f }, { 0.5f, 0.2f }, { 0.5f, 0.9f } },
+        { { INFINITY, 0.1f }, { 0.5f, 0.2f }, { 0.5f, 0.9f } },
+        { { 3e38f, 0.1f }, { 3e38f, 0.9f }, { 3e38f, 0.5f } }, // no area once read
+        { { 0.0f, 0.0f }, { 8.0f, 0.0f }, { 0.0f, 8.0f } },    // 64 tiles: drawn
+        { { 0.0f, 0.0f }, { 65.0f, 0.0f }, { 0.0f, 1.0f } },   // 65 tiles: left out
+    };
+    float positions[54], normals[54], uvs[36];
+    uint32_t indices[18];
+    for (int k = 0; k < 54; ++k) {
+        positions[k] = (float)(k % 5);
+        normals[k] = k % 3 == 2 ? 1.0f : 0.0f;
+    }
+    for (int t = 0; t < 6; ++t) {
+        for (int k = 0; k < 3; ++k) {
+            uvs[2 * (3 * t + k)] = corners[t][k][0];
+            uvs[2 * (3 * t + k) + 1] = corners[t][k][1];
+            indices[3 * t + k] = (uint32_t)(3 * t + k);
+        }
+    }
+    wx_mesh_data mesh = { .vertex_count = 18, .triangle_count = 6, .positions = positions,
+                          .normals = normals, .indices = indices };
+    mesh.uvs[0] = uvs;
+    wx_uv_raster_def rd = wx_default_uv_raster_def();
+    rd.mesh = &mesh;
+    rd.width = rd.height = 64;
+    rd.padding = 4;
+    wx_uv_raster r;
+    wx_error err;
+    ENSURE(wx_uv_raster_build(&rd, &r, &err) == WX_OK);
+    ENSURE(r.triangles_unusable == 4 && r.triangles_degenerate == 1);
+    ENSURE(r.covered == 64 * 64 && r.overlapping == 64 * 64);
+    wx_uv_raster_free(&r);
+    // CLIP draws one copy at most: only the non-finite UVs are unusable, and
+    // the giant triangles are clipped to the tile.
+    rd.tiles = WX_TILES_CLIP;
+    ENSURE(wx_uv_raster_build(&rd, &r, &err) == WX_OK);
+    ENSURE(r.triangles_unusable == 2 && r.triangles_degenerate == 1 && r.covered > 0);
+    wx_uv_raster_free(&r);
+    // UDIM: tile 1011 (u 0..1, v 1..2) holds a part of the 8 x 8 triangle.
+    rd.tiles = WX_TILES_UDIM;
+    rd.udim = 10;
+    ENSURE(wx_uv_raster_build(&rd, &r, &err) == WX_OK);
+    ENSURE(r.triangles_unusable == 4 && r.covered == 64 * 64 && r.overlapping == 0);
+    wx_uv_raster_free(&r);
+    wx_uv_survey s;
+    ENSURE(wx_uv_survey_build(&mesh, 0, 64, 64, &s, &err) == WX_OK);
+    // The 8 x 8 triangle covers the 36 tiles with u + v <= 7 (on u + v = 7 half of it).
+    ENSURE(s.triangles_unusable == 4 && s.triangles_degenerate == 1 && s.covers &&
+           s.udim_count == 36);
+}
+
+// Rain straight down on quads lying in y = 0 (x, z in [-0.8, 0.8]) seen from
+// above: `iterations`, the TextureMap's attributes, then <Masks> or "". The
+// mesh is quad.obj in the scene's folder.
+static const char *quad_scene =
+    "<Weathering>\n"
+    "  <Solver><BoundingBox size=\"4\" centerY=\"1\"/>\n"
+    "    <Simulation timeStep=\"0.02\" steps=\"40\" seed=\"5\" iterations=\"%d\"/></Solver>\n"
+    "  <Emitters>\n"
+    "    <BoxEmitter minX=\"-0.8\" minY=\"2\" minZ=\"-0.8\" maxX=\"0.8\" maxY=\"2\" maxZ=\"0.8\"\n"
+    "                rate=\"60000\" end=\"0.5\" speed=\"10\"/>\n"
+    "  </Emitters>\n"
+    "  <Collider>\n"
+    "    <ProjectedMaps>\n"
+    "      <Ortho cameraName=\"top\"><View eye=\"0 5 0\" target=\"0 0 0\" up=\"0 0 -1\"\n"
+    "        width=\"1.7\" height=\"1.7\" resolution=\"96\"/></Ortho>\n"
+    "    </ProjectedMaps>\n"
+    "  </Collider>\n"
+    "  <Geometry>\n"
+    "    <Mesh file=\"quad.obj\">\n"
+    "      <Surface material=\"*\" absorption=\"1\"/>\n"
+    "      <TextureMap file=\"quad.exr\" resolution=\"32\" padding=\"2\"%s/>\n"
+    "    </Mesh>\n"
+    "  </Geometry>\n"
+    "%s"
+    "</Weathering>\n";
+
+// Derived masks for quad_scene: each a channel evaluated at a texture's points.
+static const char *quad_masks =
+    "  <Masks>\n"
+    "    <Accessibility name=\"ao\" rays=\"16\" distance=\"0.5\"/>\n"
+    "    <Height name=\"h\" min=\"-1\" max=\"1\"/>\n"
+    "    <Combine name=\"c\"><Term mask=\"ao\"/><Term substance=\"dirt\" weight=\"0.001\"/></Combine>\n"
+    "  </Masks>\n";
+
+// A quad over x, z in [-0.8, 0.8] at y = 0 facing up, its corners' UVs from
+// (u0, v0) to (u1, v1); with `split`, two quads meeting at x = 0, the second's
+// UVs from (u2, v0) to (u3, v1).
+static void write_quads(const char *dir, double u0, double u1, double u2, double u3, double v0,
+                        double v1, bool split)
+{
+    char text[2048];
+    if (!split) {
+        snprintf(text, sizeof text,
+                 "v -0.8 0 0.8\nv 0.8 0 0.8\nv 0.8 0 -0.8\nv -0.8 0 -0.8\n"
+                 "vt %.9g %.9g\nvt %.9g %.9g\nvt %.9g %.9g\nvt %.9g %.9g\nvn 0 1 0\n"
+                 "f 1/1/1 2/2/1 3/3/1\nf 1/1/1 3/3/1 4/4/1\n",
+                 u0, v0, u1, v0, u1, v1, u0, v1);
+    } else {
+        snprintf(text, sizeof text,
+                 "v -0.8 0 0.8\nv 0 0 0.8\nv 0 0 -0.8\nv -0.8 0 -0.8\nv 0.8 0 0.8\nv 0.8 0 -0.8\n"
+                 "vt %.9g %.9g\nvt %.9g %.9g\nvt %.9g %.9g\nvt %.9g %.9g\n"
+                 "vt %.9g %.9g\nvt %.9g %.9g\nvt %.9g %.9g\nvt %.9g %.9g\nvn 0 1 0\n"
+                 "f 1/1/1 2/2/1 3/3/1\nf 1/1/1 3/3/1 4/4/1\n"
+                 "f 2/5/1 5/6/1 6/7/1\nf 2/5/1 6/7/1 3/8/1\n",
+                 u0, v0, u1, v0, u1, v1, u0, v1, u2, v0, u3, v0, u3, v1, u2, v1);
+    }
+    ensure_write_file(dir, "quad.obj", text);
+}
+
+// A quad whose UVs fill the tile [2,3] x [0,1] gives, read with REPEAT (the
+// default), the texture of the same quad with UVs [0,1]^2, byte for byte (the
+// EXR and its preview); read with CLIP it covers nothing.
+TEST(quad_in_tile_2_wraps_onto_the_texture_byte_for_byte)
+{
+    const char *dir = ensure_tmpdir();
+    char a[PATH_MAX], b[PATH_MAX], text[4096];
+    snprintf(a, sizeof a, "%s/unit", dir);
+    snprintf(b, sizeof b, "%s/tile2", dir);
+    ENSURE(ensure_shell(NULL, 0, "mkdir -p '%s' '%s'", a, b) == 0);
+    snprintf(text, sizeof text, quad_scene, 1, "", "");
+    ensure_write_file(a, "scene.xml", text);
+    ensure_write_file(b, "scene.xml", text);
+    snprintf(text, sizeof text, quad_scene, 1, " tiles=\"clip\"", "");
+    ensure_write_file(b, "clip.xml", text);
+    write_quads(a, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, false);
+    write_quads(b, 2.0, 3.0, 0.0, 0.0, 0.0, 1.0, false);
+    ENSURE(weathering_in(a, "run scene.xml --out out -q", true) == 0);
+    ENSURE(weathering_in(b, "run scene.xml --out out -q", true) == 0);
+    ENSURE(ensure_shell(out, sizeof out, "cmp '%s/out/quad.exr' '%s/out/quad.exr' && cmp "
+                                         "'%s/out/quad.png' '%s/out/quad.png'",
+                        a, b, a, b) == 0);
+    char path[2 * PATH_MAX];
+    snprintf(path, sizeof path, "%s/out/quad.exr", b);
+    static const char *const names[] = { "Y", "seen" };
+    wx_image img;
+    ENSURE(read_channels(path, names, 2, &img));
+    double sum = 0.0;
+    for (int t = 0; t < 32 * 32; ++t) {
+        sum += img.channels[0][t];
+    }
+    wx_image_free(&img);
+    ENSURE(sum > 0.0);
+    // CLIP: the tile [0,1]^2 holds no triangle; said on stderr, all zero.
+    ENSURE(weathering_in(b, "run clip.xml --out clip", true) == 0);
+    ENSURE(ensure_contains(out, "no texel centre lies inside a triangle"));
+    snprintf(path, sizeof path, "%s/clip/quad.exr", b);
+    ENSURE(read_channels(path, names, 2, &img));
+    sum = 0.0;
+    for (int t = 0; t < 32 * 32; ++t) {
+        sum += img.channels[0][t] + img.channels[1][t];
+    }
+    wx_image_free(&img);
+    ENSURE(sum == 0.0);
+}
+
+// tiles="udim": two quads side by side, the left's UVs in [0, 0.5] x [0, 1]
+// (tile 1001), the right's in [1.5, 2] x [0, 1] (tile 1002), with derived
+// masks. The run writes exactly quad.1001.exr and quad.1002.exr with their
+// previews and frames, and each tile's texels hold what the same mesh with the
+// right quad's UVs moved to [0.5, 1] (one tile, REPEAT) holds there, every
+// channel bit for bit (the masks too, kept per tile over the frames); the
+// rest of a tile is padding or empty.
+TEST(udim_layout_writes_one_file_per_tile)
+{
+    const char *dir = ensure_tmpdir();
+    char a[PATH_MAX], b[PATH_MAX], text[4096];
+    snprintf(a, sizeof a, "%s/udim", dir);
+    snprintf(b, sizeof b, "%s/one", dir);
+    ENSURE(ensure_shell(NULL, 0, "mkdir -p '%s' '%s'", a, b) == 0);
+    snprintf(text, sizeof text, quad_scene, 2, " tiles=\"udim\" every=\"1\"", quad_masks);
+    ensure_write_file(a, "scene.xml", text);
+    snprintf(text, sizeof text, quad_scene, 2, "", quad_masks);
+    ensure_write_file(b, "scene.xml", text);
+    write_quads(a, 0.0, 0.5, 1.5, 2.0, 0.0, 1.0, true);
+    write_quads(b, 0.0, 0.5, 0.5, 1.0, 0.0, 1.0, true);
+    // info knows the files before any work.
+    ENSURE(weathering_in(a, "info scene.xml", true) == 0);
+    ENSURE(ensure_contains(out, "UDIM tiles: 2 (where a texel centre lies inside a triangle): "
+                                "quad.1001.exr, quad.1002.exr"));
+    ENSURE(weathering_in(a, "run scene.xml --out out -q", true) == 0);
+    ENSURE(weathering_in(b, "run scene.xml --out out -q", true) == 0);
+    ENSURE(ensure_shell(out, sizeof out, "cd '%s/out' && LC_ALL=C ls quad*", a) == 0);
+    ENSURE(strcmp(out, "quad.1001.0001.exr\nquad.1001.0002.exr\nquad.1001.exr\n"
+                       "quad.1001_ao.png\nquad.1001_c.png\nquad.1001_dirt.png\nquad.1001_h.png\n"
+                       "quad.1002.0001.exr\nquad.1002.0002.exr\nquad.1002.exr\n"
+                       "quad.1002_ao.png\nquad.1002_c.png\nquad.1002_dirt.png\nquad.1002_h.png\n") ==
+           0);
+    // The last frame is the final file; a tile's header names its tile.
+    ENSURE(ensure_shell(out, sizeof out, "cd '%s/out' && cmp quad.1002.0002.exr quad.1002.exr",
+                        a) == 0);
+    static const char *const names[] = { "dirt.Y", "seen", "ao.Y", "h.Y", "c.Y" };
+    wx_image tiles[2], one;
+    char path[2 * PATH_MAX];
+    snprintf(path, sizeof path, "%s/out/quad.1001.exr", a);
+    ENSURE(read_channels(path, names, 5, &tiles[0]));
+    const wx_attr *tile = wx_image_find_attr(&tiles[0], "weatheringUDIMTile");
+    ENSURE(tile != NULL && strcmp(tile->string, "1001") == 0);
+    snprintf(path, sizeof path, "%s/out/quad.1002.exr", a);
+    ENSURE(read_channels(path, names, 5, &tiles[1]));
+    snprintf(path, sizeof path, "%s/out/quad.exr", b);
+    ENSURE(read_channels(path, names, 5, &one));
+    int64_t same = 0, padded = 0, empty = 0;
+    for (int j = 0; j < 32; ++j) {
+        for (int i = 0; i < 32; ++i) {
+            size_t t = (size_t)j * 32 + (size_t)i;
+            int mine = i < 16 ? 0 : 1; // the tile whose quad covers column i in `one`
+            const wx_image *m = &tiles[mine], *o = &tiles[1 - mine];
+            bool all = true;
+            for (int c = 0; c < 5; ++c) {
+                all = all && m->channels[c][t] == one.channels[c][t];
+            }
+            same += all;
+            // In the other tile: two columns of padding, then nothing.
+            bool pad = i < 16 ? i >= 14 : i <= 17;
+            padded += pad && o->channels[1][t] == 1.0f;
+            empty += !pad && o->channels[0][t] == 0.0f && o->channels[1][t] == 0.0f;
+        }
+    }
+    double sum = 0.0;
+    for (int t = 0; t < 32 * 32; ++t) {
+        sum += one.channels[0][t];
+    }
+    printf("        %lld of 1024 texels equal the one-tile texture's, %lld padding, %lld "
+           "empty\n",
+           (long long)same, (long long)padded, (long long)empty);
+    ENSURE(sum > 0.0 && same == 1024 && padded == 2 * 32 * 2 && empty == 2 * 32 * 14);
+    wx_image_free(&tiles[0]);
+    wx_image_free(&tiles[1]);
+    wx_image_free(&one);
 }
 
 // ---------------------------------------------------------------------------
@@ -549,6 +908,10 @@ TEST(uniform_dirt_has_no_seam_between_cameras)
 int main(void)
 {
     RUN(uv_raster_counts_ties_overlaps_and_padding);
+    RUN(uv_raster_wraps_a_triangle_across_u_1);
+    RUN(uv_raster_leaves_out_what_no_renderer_can_read);
+    RUN(quad_in_tile_2_wraps_onto_the_texture_byte_for_byte);
+    RUN(udim_layout_writes_one_file_per_tile);
     RUN(cube_atlas_under_vertical_rain);
     RUN(cube_texture_frames);
     RUN(uv_sphere_follows_the_flux_without_a_seam);

@@ -13,6 +13,7 @@ import contextlib
 import io
 import math
 import os
+import re
 import tempfile
 import time
 
@@ -177,6 +178,39 @@ def _units(scene):
     return []
 
 
+def _tile_file(texture):
+    """A pattern matching the tiles tiles="udim" writes for `texture`
+    (BASE.1001.exr ...), the tile number its group 1."""
+    base = texture[:-4] if texture.endswith(".exr") else texture
+    return re.compile(re.escape(base) + r"\.(1[0-9]{3}|2000)\.exr$")
+
+
+def udim_tiles(folder, texture):
+    """[(tile number, path)] of the UDIM tiles of `texture` in `folder`, by
+    tile number (BASE.1001.exr ...; frames BASE.1001.0003.exr are not tiles)."""
+    pattern = _tile_file(texture)
+    found = []
+    for name in os.listdir(folder) if os.path.isdir(folder) else []:
+        m = pattern.match(name)
+        if m and 1001 <= int(m.group(1)) <= 2000:
+            found.append((int(m.group(1)), os.path.join(folder, name)))
+    return sorted(found)
+
+
+def remove_tiles(folder, texture):
+    """Removes an earlier run's UDIM files of `texture` (the tiles, their
+    previews, frames and split channels: BASE.TTTT*), so that Blender, which
+    finds a tiled image's tiles on disk, sees only this run's."""
+    base = texture[:-4] if texture.endswith(".exr") else texture
+    pattern = re.compile(re.escape(base) + r"\.[0-9]{4}[._]")
+    for name in os.listdir(folder) if os.path.isdir(folder) else []:
+        if pattern.match(name):
+            try:
+                os.remove(os.path.join(folder, name))
+            except OSError:
+                pass
+
+
 def split(program, path):
     """`weathering split FILE`: {channel: path of its single-channel EXR}."""
     folder = os.path.dirname(path)
@@ -244,10 +278,23 @@ class Job:
             export_obj(context, [obj], os.path.join(self.folder, rel))
             uv = obj.data.uv_layers.active
             texture = name + "_texture.exr" if uv is not None and obj.data.polygons else None
+            attrs = None
             if texture is None:
                 self.notes.append(("INFO", "%s has no UV map: it gets the camera mask only" % obj.name))
-            self.objects.append((obj.name, rel, texture, uv.name if uv is not None else None))
-            meshes.append((rel, texture))
+            else:
+                # How `init` reads this object's UVs alone: tiles="udim" for a
+                # UDIM layout, no TextureMap when the layout covers no texel.
+                attrs = self.texture_layout(context, rel)
+                if attrs is None:
+                    self.notes.append(("WARNING", "%s's UV map covers no texel (its faces have no "
+                                                  "area in UV): it gets the camera mask only"
+                                       % obj.name))
+                    texture = None
+                remove_tiles(self.out, name + "_texture.exr")
+            tiles = attrs.get("tiles", "repeat").strip() if attrs else None
+            self.objects.append((obj.name, rel, texture, uv.name if uv is not None else None,
+                                 tiles))
+            meshes.append((rel, texture, attrs))
 
         args = [self.program, "init", "mesh.obj", "--preset", self.preset, "-o", "scene.xml",
                 "--force", "--resolution", str(self.resolution)] + _units(context.scene)
@@ -278,6 +325,22 @@ class Job:
                        "Edited by Blender's weathering add-on: one <Mesh> per object, %s, "
                        "about %d particles." % (where, round(self.particles)))
 
+    def texture_layout(self, context, rel):
+        """The <TextureMap> attributes `weathering init` writes for the mesh
+        `rel` alone (resolution, tiles), or None when it writes none."""
+        layout = rel[:-4] + ".layout.xml"
+        args = [self.program, "init", rel, "--preset", self.preset, "-o", layout, "--force",
+                "--resolution", str(self.resolution), "-q"] + _units(context.scene)
+        cli.run(args, cwd=self.folder)
+        path = os.path.join(self.folder, layout)
+        try:
+            return scene_xml.texture_map_attributes(scene_xml.load(path))
+        finally:
+            try:
+                os.remove(path)
+            except OSError:
+                pass
+
     # --- the run -------------------------------------------------------------
 
     def start(self, progress):
@@ -303,7 +366,7 @@ class Job:
         # A material two weathered objects share gets a copy per object (their
         # textures differ).
         owners = {}
-        for name, _, _, _ in self.objects:
+        for name, _, _, _, _ in self.objects:
             obj = bpy.data.objects.get(name)
             if obj is None:
                 self.notes.append(("WARNING", "%s disappeared during the run" % name))
@@ -321,12 +384,15 @@ class Job:
                     slot.material = copy
                 owners.setdefault(slot.material.name, obj.name)
 
-        for name, _, texture, uv_map in self.objects:
+        for name, _, texture, uv_map, tiles in self.objects:
             obj = bpy.data.objects.get(name)
             if obj is None:
                 continue
             channels = []
-            if texture is not None:
+            numbers = []
+            if texture is not None and tiles == "udim":
+                channels, numbers = self.load_udim(texture)
+            elif texture is not None:
                 path = os.path.join(self.out, texture)
                 if not os.path.isfile(path):
                     raise CommandError("weathering run wrote no %s" % path)
@@ -347,8 +413,32 @@ class Job:
                 done.add(slot.material.name)
                 shading.weather(slot.material, uv_map, channels, main, mask, colour, full)
             self.weathered.append({"object": name, "texture": texture, "channels":
-                                   [c for c, _ in channels], "main": main, "full": full})
+                                   [c for c, _ in channels], "main": main, "full": full,
+                                   "tiles": numbers})
         self.notes.append(("INFO", "weathered %d object(s) with %s (%d particles) in %.1f s; "
                                    "files in %s" % (len(self.weathered), self.preset,
                                                     round(self.particles),
                                                     time.time() - self.started, self.folder)))
+
+    def load_udim(self, texture):
+        """A tiles="udim" texture: each tile split (BASE.1001_Y.exr ...), each
+        channel's tiles one tiled image read through Blender's <UDIM> token
+        (BASE.<UDIM>_Y.exr). Returns ([(channel, image)], [tile numbers])."""
+        tiles = udim_tiles(self.out, texture)
+        if not tiles:
+            raise CommandError("weathering run wrote no tile of %s (%s.1001.exr ...) in %s"
+                               % (texture, texture[:-4], self.out))
+        numbers = [n for n, _ in tiles]
+        patterns = {}
+        for number, path in tiles:
+            for channel, written in split(self.program, path).items():
+                folder, base = os.path.split(written)
+                tile = ".%d" % number
+                at = base.rfind(tile + "_")
+                if at < 0:
+                    raise CommandError("weathering split %s wrote %s, not a tile's file"
+                                       % (path, written))
+                patterns[channel] = os.path.join(
+                    folder, base[:at] + "." + shading.UDIM + base[at + len(tile):])
+        channels = [(c, shading.load_tiles(p, numbers)) for c, p in sorted(patterns.items())]
+        return channels, numbers

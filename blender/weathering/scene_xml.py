@@ -148,12 +148,23 @@ def set_particles(tree, count):
     scale_particles(tree, count / now)
 
 
+def texture_map_attributes(tree):
+    """The attributes of the scene's first <TextureMap> (a dict), or None when
+    it has none (`weathering init` leaves it out for a mesh without UVs, or
+    whose UV layout covers no texel)."""
+    for tex in tree.getroot().iter("TextureMap"):
+        return dict(tex.attrib)
+    return None
+
+
 def set_meshes(tree, meshes, resolution=1024):
     """Replaces the <Mesh> of the generated scene by one per object:
-    meshes = [(file relative to the scene, TextureMap file or None)]. Each
-    keeps the generated <Surface>s; a TextureMap keeps the generated one's
-    attributes (resolution, padding) with its own file, or `resolution` when
-    the generated scene has none (the combined mesh lacked UVs somewhere)."""
+    meshes = [(file relative to the scene, TextureMap file or None[,
+    TextureMap attributes or None])]. Each keeps the generated <Surface>s; a
+    TextureMap takes the attributes given for it (what `init` chose for that
+    object alone: its resolution, tiles="udim"...), else the generated one's
+    (resolution, padding), or `resolution` when the generated scene has none
+    (the combined mesh lacked UVs somewhere), with its own file."""
     geometry = tree.getroot().find("Geometry")
     template = geometry.find("Mesh") if geometry is not None else None
     if template is None:
@@ -164,12 +175,14 @@ def set_meshes(tree, meshes, resolution=1024):
     index = list(geometry).index(template)
     for old in [c for c in geometry if c.tag == "Mesh"]:
         geometry.remove(old)
-    for k, (file, texture_file) in enumerate(meshes):
+    for k, entry in enumerate(meshes):
+        file, texture_file = entry[0], entry[1]
+        own = entry[2] if len(entry) > 2 else None
         mesh = ET.Element("Mesh", {"file": file})
         for s in surfaces:
             mesh.append(copy.deepcopy(s))
         if texture_file:
-            attrs = dict(texture_attrs)
+            attrs = dict(own if own is not None else texture_attrs)
             attrs["file"] = texture_file
             ET.SubElement(mesh, "TextureMap", attrs)
         geometry.insert(index + k, mesh)

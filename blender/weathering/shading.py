@@ -37,15 +37,58 @@ def load_image(path):
     return image
 
 
-def fully_dirty(image, percentile=0.95):
-    """The amount the mix calls fully dirty: the `percentile` of the image's
-    positive values (every 7th texel), or 1 when none is positive."""
+UDIM = "<UDIM>"
+
+
+def load_tiles(pattern, numbers):
+    """A UDIM set as one tiled Non-Color image (Blender 3.4: source 'TILED',
+    the <UDIM> token in its filepath): `pattern` is the files' path with <UDIM>
+    where the tile number stands, `numbers` the tiles (1001, 1002, ...). An
+    image of an earlier run with the same pattern is reused and reloaded."""
+    image = None
+    for im in bpy.data.images:
+        if im.source == "TILED" and bpy.path.abspath(im.filepath) == pattern:
+            image = im
+            break
+    if image is None:
+        image = bpy.data.images.load(pattern.replace(UDIM, str(numbers[0])), check_existing=False)
+        image.source = "TILED"
+        image.filepath = pattern
+        image.name = bpy.path.basename(pattern)
+    have = {t.number for t in image.tiles}
+    for n in numbers:
+        if n not in have:
+            image.tiles.new(tile_number=n)
+    image.reload()                      # every tile's file, found through the token
+    image.colorspace_settings.name = "Non-Color"
+    return image
+
+
+def _image_values(image, step=7):
     w, h = image.size
     if w * h == 0:
-        return 1.0
+        return []
     pixels = array.array("f", bytes(4 * 4 * w * h))
     image.pixels.foreach_get(pixels)
-    values = sorted(v for v in pixels[0::28] if v > 0.0)
+    return [v for v in pixels[0::4 * step] if v > 0.0]
+
+
+def fully_dirty(image, percentile=0.95):
+    """The amount the mix calls fully dirty: the `percentile` of the image's
+    positive values (every 7th texel; of every tile of a UDIM image), or 1
+    when none is positive."""
+    if image.source == "TILED":
+        # Blender's pixels are the first tile's: read each tile's file alone.
+        values = []
+        pattern = bpy.path.abspath(image.filepath)
+        for tile in image.tiles:
+            one = bpy.data.images.load(pattern.replace(UDIM, str(tile.number)),
+                                       check_existing=False)
+            values += _image_values(one)
+            bpy.data.images.remove(one)
+    else:
+        values = _image_values(image)
+    values.sort()
     if not values:
         return 1.0
     return max(values[int(percentile * (len(values) - 1))], 1e-12)

@@ -44,60 +44,185 @@ static bool inside(double e, point2 a, point2 b)
     return e > 0.0 || (e == 0.0 && owns_edge(a, b));
 }
 
-// Texel coordinates of a UV: centres at integers, row 0 at v = 1.
-static point2 texel_of(const float *uv, int width, int height)
+// A triangle's UVs and the box of whole UV tiles they span (tile (a, b)
+// holds [a, a + 1] x [b, b + 1]; a triangle touching a tile's border from
+// outside does not span it). In double, and finite whatever the floats: a
+// box of 1e30 tiles is counted, never walked.
+typedef struct tri_uv {
+    const float *uv[3];
+    double tu0, tu1, tv0, tv1; // first and last tile along u and v
+    double tiles;              // (tu1 - tu0 + 1) * (tv1 - tv0 + 1)
+} tri_uv;
+
+// Reads triangle tri's UVs; false when one of them is not finite.
+static bool triangle_uvs(const wx_mesh_data *mesh, const float *uvs, int64_t tri, tri_uv *t)
 {
-    point2 p = { (double)uv[0] * width - 0.5, (1.0 - (double)uv[1]) * height - 0.5 };
+    const uint32_t *idx = &mesh->indices[3 * (size_t)tri];
+    double lo[2] = { INFINITY, INFINITY }, hi[2] = { -INFINITY, -INFINITY };
+    for (int k = 0; k < 3; ++k) {
+        const float *uv = &uvs[2 * (size_t)idx[k]];
+        t->uv[k] = uv;
+        if (!isfinite(uv[0]) || !isfinite(uv[1])) {
+            return false;
+        }
+        for (int a = 0; a < 2; ++a) {
+            lo[a] = fmin(lo[a], (double)uv[a]);
+            hi[a] = fmax(hi[a], (double)uv[a]);
+        }
+    }
+    t->tu0 = floor(lo[0]);
+    t->tu1 = fmax(t->tu0, ceil(hi[0]) - 1.0);
+    t->tv0 = floor(lo[1]);
+    t->tv1 = fmax(t->tv0, ceil(hi[1]) - 1.0);
+    t->tiles = (t->tu1 - t->tu0 + 1.0) * (t->tv1 - t->tv0 + 1.0);
+    return true;
+}
+
+static bool spans_tile(const tri_uv *t, double tu, double tv)
+{
+    return tu >= t->tu0 && tu <= t->tu1 && tv >= t->tv0 && tv <= t->tv1;
+}
+
+// Texel coordinates of a UV read in tile (tu, tv): centres at integers, row 0
+// at v = tv + 1. The offset is taken off exactly (both are whole or the float
+// is), so a triangle in tile (2, 0) lands on the texels of its copy in (0, 0).
+static point2 texel_in_tile(const float *uv, double tu, double tv, int width, int height)
+{
+    point2 p = { ((double)uv[0] - tu) * width - 0.5,
+                 (1.0 - ((double)uv[1] - tv)) * height - 0.5 };
     return p;
 }
 
-static bool in_tile(const float *uv)
+// The copy of a triangle in tile (tu, tv), positively oriented in q; false
+// when it has no area (or the numbers overflow).
+static bool oriented_copy(const tri_uv *t, double tu, double tv, int width, int height,
+                          point2 q[3])
 {
-    return uv[0] >= 0.0f && uv[0] <= 1.0f && uv[1] >= 0.0f && uv[1] <= 1.0f;
-}
-
-static void raster_triangle(const wx_mesh_data *mesh, const float *uvs, int32_t tri,
-                            wx_uv_raster *r, unsigned char *count)
-{
-    const uint32_t *idx = &mesh->indices[3 * (size_t)tri];
-    point2 p[3];
-    bool outside = false;
     for (int k = 0; k < 3; ++k) {
-        const float *uv = &uvs[2 * (size_t)idx[k]];
-        p[k] = texel_of(uv, r->width, r->height);
-        outside = outside || !in_tile(uv);
+        q[k] = texel_in_tile(t->uv[k], tu, tv, width, height);
     }
-    r->triangles_outside += outside;
-    double area = edge(p[0], p[1], p[2]);
+    double area = edge(q[0], q[1], q[2]);
     if (!(area != 0.0) || !isfinite(area)) {
-        r->triangles_degenerate++;
-        return;
+        return false;
     }
     if (area < 0.0) {
-        point2 t = p[1];
-        p[1] = p[2];
-        p[2] = t;
+        point2 s = q[1];
+        q[1] = q[2];
+        q[2] = s;
     }
-    double x0 = fmin(p[0].x, fmin(p[1].x, p[2].x)), x1 = fmax(p[0].x, fmax(p[1].x, p[2].x));
-    double y0 = fmin(p[0].y, fmin(p[1].y, p[2].y)), y1 = fmax(p[0].y, fmax(p[1].y, p[2].y));
-    int i0 = (int)fmax(0.0, ceil(x0)), i1 = (int)fmin(r->width - 1.0, floor(x1));
-    int j0 = (int)fmax(0.0, ceil(y0)), j1 = (int)fmin(r->height - 1.0, floor(y1));
+    return true;
+}
+
+// Whether texel centre c lies inside the positively oriented triangle q (edges
+// shared by two triangles going to exactly one of them). Not inlined: the
+// raster and wx_uv_raster_point must decide every centre alike.
+static __attribute__((noinline)) bool covers_centre(const point2 q[3], point2 c)
+{
+    return inside(edge(q[1], q[2], c), q[1], q[2]) && inside(edge(q[2], q[0], c), q[2], q[0]) &&
+           inside(edge(q[0], q[1], c), q[0], q[1]);
+}
+
+// The texels a copy's bounding box reaches, clamped to the raster before any
+// conversion to int (an empty range when it lies off the raster).
+static void copy_box(const point2 q[3], int width, int height, int *i0, int *i1, int *j0, int *j1)
+{
+    double x0 = fmin(q[0].x, fmin(q[1].x, q[2].x)), x1 = fmax(q[0].x, fmax(q[1].x, q[2].x));
+    double y0 = fmin(q[0].y, fmin(q[1].y, q[2].y)), y1 = fmax(q[0].y, fmax(q[1].y, q[2].y));
+    *i0 = (int)fmin((double)width, fmax(0.0, ceil(x0)));
+    *i1 = (int)fmax(-1.0, fmin(width - 1.0, floor(x1)));
+    *j0 = (int)fmin((double)height, fmax(0.0, ceil(y0)));
+    *j1 = (int)fmax(-1.0, fmin(height - 1.0, floor(y1)));
+}
+
+// Whether the copy q covers any texel centre of a width x height tile.
+static bool copy_covers_any(const point2 q[3], int width, int height)
+{
+    int i0, i1, j0, j1;
+    copy_box(q, width, height, &i0, &i1, &j0, &j1);
     for (int j = j0; j <= j1; ++j) {
         for (int i = i0; i <= i1; ++i) {
-            point2 c = { i, j };
-            if (!inside(edge(p[1], p[2], c), p[1], p[2]) ||
-                !inside(edge(p[2], p[0], c), p[2], p[0]) ||
-                !inside(edge(p[0], p[1], c), p[0], p[1])) {
+            if (covers_centre(q, (point2){ i, j })) {
+                return true;
+            }
+        }
+    }
+    return false;
+}
+
+static void draw_copy(const point2 q[3], int32_t tri, wx_uv_raster *r, unsigned char *count)
+{
+    int i0, i1, j0, j1;
+    copy_box(q, r->width, r->height, &i0, &i1, &j0, &j1);
+    for (int j = j0; j <= j1; ++j) {
+        for (int i = i0; i <= i1; ++i) {
+            if (!covers_centre(q, (point2){ i, j })) {
                 continue;
             }
             size_t t = (size_t)j * (size_t)r->width + (size_t)i;
             if (count[t] == 0) {
-                r->triangle[t] = tri; // the lowest index wins an overlap
+                r->triangle[t] = tri; // the lowest index (its first copy) wins an overlap
                 r->covered++;
             } else if (count[t] == 1) {
                 r->overlapping++;
             }
             count[t] = count[t] < 2 ? count[t] + 1 : 2;
+        }
+    }
+}
+
+static bool outside_box(const tri_uv *t, double u_max, double v_max)
+{
+    bool out = false;
+    for (int k = 0; k < 3; ++k) {
+        out = out || t->uv[k][0] < 0.0f || t->uv[k][0] > u_max || t->uv[k][1] < 0.0f ||
+              t->uv[k][1] > v_max;
+    }
+    return out;
+}
+
+// The tile of a raster's copies when it has one: CLIP (0, 0), UDIM its tile.
+static bool fixed_tile(const wx_uv_raster *r, double *tu, double *tv)
+{
+    if (r->tiles == WX_TILES_REPEAT) {
+        return false;
+    }
+    *tu = r->tiles == WX_TILES_UDIM ? (double)(r->udim % WX_UDIM_COLUMNS) : 0.0;
+    *tv = r->tiles == WX_TILES_UDIM ? (double)(r->udim / WX_UDIM_COLUMNS) : 0.0;
+    return true;
+}
+
+static void raster_triangle(const wx_mesh_data *mesh, const float *uvs, int32_t tri,
+                            wx_uv_raster *r, unsigned char *count)
+{
+    tri_uv t;
+    if (!triangle_uvs(mesh, uvs, tri, &t) ||
+        (r->tiles != WX_TILES_CLIP && t.tiles > WX_UV_MAX_TILES_PER_TRIANGLE)) {
+        r->triangles_unusable++;
+        return;
+    }
+    r->triangles_outside += r->tiles == WX_TILES_UDIM
+                                ? outside_box(&t, WX_UDIM_COLUMNS, WX_UDIM_ROWS)
+                                : outside_box(&t, 1.0, 1.0);
+    point2 q[3];
+    if (!oriented_copy(&t, t.tu0, t.tv0, r->width, r->height, q)) {
+        r->triangles_degenerate++;
+        return;
+    }
+    double tu, tv;
+    if (fixed_tile(r, &tu, &tv)) {
+        if (spans_tile(&t, tu, tv) && oriented_copy(&t, tu, tv, r->width, r->height, q)) {
+            draw_copy(q, tri, r, count);
+        }
+        return;
+    }
+    // REPEAT: the copy at every tile the triangle spans, v then u (integer
+    // counters: at 1e20 adding 1 to a double changes nothing).
+    const int nu = (int)(t.tu1 - t.tu0) + 1, nv = (int)(t.tv1 - t.tv0) + 1;
+    for (int b = 0; b < nv; ++b) {
+        for (int a = 0; a < nu; ++a) {
+            if (oriented_copy(&t, t.tu0 + a, t.tv0 + b, r->width, r->height, q)) {
+                draw_copy(q, tri, r, count);
+            }
         }
     }
 }
@@ -182,17 +307,26 @@ static wx_result pad(wx_uv_raster *r, int padding, wx_error *err)
     return WX_OK;
 }
 
-wx_result wx_uv_raster_build(const wx_mesh_data *mesh, int uv, int width, int height,
-                             int padding, wx_uv_raster *out, wx_error *err)
+wx_uv_raster_def wx_default_uv_raster_def(void)
+{
+    return (wx_uv_raster_def){ .tiles = WX_TILES_REPEAT };
+}
+
+wx_result wx_uv_raster_build(const wx_uv_raster_def *def, wx_uv_raster *out, wx_error *err)
 {
     memset(out, 0, sizeof *out);
+    const wx_mesh_data *mesh = def->mesh;
+    const int uv = def->uv, width = def->width, height = def->height;
     if (uv < 0 || uv >= WX_MESH_MAX_UV_CHANNELS || mesh->uvs[uv] == NULL || width <= 0 ||
-        height <= 0 || (int64_t)width * height > INT32_MAX) {
+        height <= 0 || (int64_t)width * height > INT32_MAX ||
+        (def->tiles == WX_TILES_UDIM && (def->udim < 0 || def->udim >= WX_UDIM_TILES))) {
         return wx_fail(err, WX_CAUSE_BAD_ARGUMENT, "texture: no UV channel %d or a bad size", uv);
     }
     const size_t texels = (size_t)width * (size_t)height;
     out->width = width;
     out->height = height;
+    out->tiles = def->tiles;
+    out->udim = def->tiles == WX_TILES_UDIM ? def->udim : 0;
     out->triangle = malloc(texels * sizeof *out->triangle);
     out->source = malloc(texels * sizeof *out->source);
     unsigned char *count = calloc(texels, 1);
@@ -211,8 +345,8 @@ wx_result wx_uv_raster_build(const wx_mesh_data *mesh, int uv, int width, int he
     }
     free(count);
     wx_result r = WX_OK;
-    if (padding > 0 && out->covered > 0) {
-        r = pad(out, padding, err);
+    if (def->padding > 0 && out->covered > 0) {
+        r = pad(out, def->padding, err);
     } else {
         for (size_t t = 0; t < texels; ++t) {
             out->source[t] = out->triangle[t] >= 0 ? (int32_t)t : -1;
@@ -239,11 +373,34 @@ bool wx_uv_raster_point(const wx_mesh_data *mesh, int uv, const wx_uv_raster *ra
         return false;
     }
     const uint32_t *idx = &mesh->indices[3 * (size_t)tri];
+    point2 c = { (double)(t % (size_t)raster->width), (double)(t / (size_t)raster->width) };
+    // The copy the raster drew here: its only one, else (REPEAT) the first in
+    // the raster's order whose copy holds the centre.
+    tri_uv tu;
+    double ctu = 0.0, ctv = 0.0;
+    if (!triangle_uvs(mesh, mesh->uvs[uv], tri, &tu)) {
+        return false;
+    }
+    if (!fixed_tile(raster, &ctu, &ctv)) {
+        ctu = tu.tu0;
+        ctv = tu.tv0;
+        bool found = tu.tiles == 1.0;
+        const int nu = (int)(tu.tu1 - tu.tu0) + 1, nv = (int)(tu.tv1 - tu.tv0) + 1;
+        point2 q[3];
+        for (int b = 0; !found && b < nv; ++b) {
+            for (int a = 0; !found && a < nu; ++a) {
+                found = oriented_copy(&tu, tu.tu0 + a, tu.tv0 + b, raster->width,
+                                      raster->height, q) &&
+                        covers_centre(q, c);
+                ctu = found ? tu.tu0 + a : ctu;
+                ctv = found ? tu.tv0 + b : ctv;
+            }
+        }
+    }
     point2 p[3];
     for (int k = 0; k < 3; ++k) {
-        p[k] = texel_of(&mesh->uvs[uv][2 * (size_t)idx[k]], raster->width, raster->height);
+        p[k] = texel_in_tile(tu.uv[k], ctu, ctv, raster->width, raster->height);
     }
-    point2 c = { (double)(t % (size_t)raster->width), (double)(t / (size_t)raster->width) };
     double b[3] = { edge(p[1], p[2], c), edge(p[2], p[0], c), edge(p[0], p[1], c) };
     double sum = b[0] + b[1] + b[2];
     double n[3] = { 0.0, 0.0, 0.0 }, w[3], local[3];
@@ -279,6 +436,68 @@ bool wx_uv_raster_point(const wx_mesh_data *mesh, int uv, const wx_uv_raster *ra
         normal[a] = len > 0.0 ? (float)(n[a] / len) : 0.0f;
     }
     return len > 0.0;
+}
+
+wx_result wx_uv_survey_build(const wx_mesh_data *mesh, int uv, int width, int height,
+                             wx_uv_survey *out, wx_error *err)
+{
+    memset(out, 0, sizeof *out);
+    if (uv < 0 || uv >= WX_MESH_MAX_UV_CHANNELS || mesh->uvs[uv] == NULL || width <= 0 ||
+        height <= 0) {
+        return wx_fail(err, WX_CAUSE_BAD_ARGUMENT, "texture: no UV channel %d or a bad size", uv);
+    }
+    double lo[2] = { INFINITY, INFINITY }, hi[2] = { -INFINITY, -INFINITY };
+    out->triangles = mesh->triangle_count;
+    for (int64_t tri = 0; tri < mesh->triangle_count; ++tri) {
+        tri_uv t;
+        if (!triangle_uvs(mesh, mesh->uvs[uv], tri, &t) ||
+            t.tiles > WX_UV_MAX_TILES_PER_TRIANGLE) {
+            out->triangles_unusable++;
+            continue;
+        }
+        for (int k = 0; k < 3; ++k) {
+            for (int a = 0; a < 2; ++a) {
+                lo[a] = fmin(lo[a], (double)t.uv[k][a]);
+                hi[a] = fmax(hi[a], (double)t.uv[k][a]);
+            }
+        }
+        out->triangles_outside_unit += outside_box(&t, 1.0, 1.0);
+        bool beyond_udim = outside_box(&t, WX_UDIM_COLUMNS, WX_UDIM_ROWS);
+        out->triangles_outside_udim += beyond_udim;
+        point2 q[3];
+        if (!oriented_copy(&t, t.tu0, t.tv0, width, height, q)) {
+            out->triangles_degenerate++;
+            continue;
+        }
+        out->triangles_in_other_tiles += t.tiles == 1.0 && !beyond_udim &&
+                                         (t.tu0 != 0.0 || t.tv0 != 0.0);
+        // Each copy is tested only while it can tell something new: the first
+        // covered centre anywhere, a UDIM tile's first.
+        const int nu = (int)(t.tu1 - t.tu0) + 1, nv = (int)(t.tv1 - t.tv0) + 1;
+        for (int b = 0; b < nv; ++b) {
+            for (int a = 0; a < nu; ++a) {
+                double tu = t.tu0 + a, tv = t.tv0 + b;
+                int k = tu >= 0.0 && tu < WX_UDIM_COLUMNS && tv >= 0.0 && tv < WX_UDIM_ROWS
+                            ? (int)tu + WX_UDIM_COLUMNS * (int)tv
+                            : -1;
+                bool known = k >= 0 ? (out->udim[k / 8] >> (k % 8)) & 1u : out->covers;
+                if (known || !oriented_copy(&t, tu, tv, width, height, q) ||
+                    !copy_covers_any(q, width, height)) {
+                    continue;
+                }
+                out->covers = true;
+                if (k >= 0) {
+                    out->udim[k / 8] |= (uint8_t)(1u << (k % 8));
+                    out->udim_count++;
+                }
+            }
+        }
+    }
+    for (int a = 0; a < 2; ++a) {
+        out->uv_min[a] = isfinite(lo[a]) ? lo[a] : 0.0;
+        out->uv_max[a] = isfinite(hi[a]) ? hi[a] : 0.0;
+    }
+    return WX_OK;
 }
 
 // ---------------------------------------------------------------------------

@@ -2239,10 +2239,14 @@ typedef struct texture_def {
     char file[256];
     int resolution, width, height, padding, uv, every;
     float radius, noise, max_radius;
+    int tiles;
 } texture_def;
 
 enum { TX_FILE, TX_RESOLUTION, TX_WIDTH, TX_HEIGHT, TX_PADDING, TX_UV, TX_EVERY, TX_RADIUS,
-       TX_NOISE, TX_MAX_RADIUS }; // bits of `present`
+       TX_NOISE, TX_MAX_RADIUS, TX_TILES }; // bits of `present`
+
+/// `tiles`, in the order of wx_uv_tiles.
+static const char *const uv_tiles_names[] = { "repeat", "udim", "clip", NULL };
 
 static const attr_spec texture_attrs[] = {
     // Required: a default name would clash between two TextureMaps.
@@ -2264,6 +2268,7 @@ static const attr_spec texture_attrs[] = {
     [TX_NOISE] = { "noise", T_FLOAT, offsetof(texture_def, noise), .range = R_POSITIVE },
     [TX_MAX_RADIUS] = { "maxRadius", T_FLOAT, offsetof(texture_def, max_radius),
                         .range = R_POSITIVE },
+    [TX_TILES] = { "tiles", T_ENUM, offsetof(texture_def, tiles), .choices = uv_tiles_names },
 };
 
 static wx_result parse_texture_map(parser *p, const xmlNode *node, void *user)
@@ -2310,7 +2315,7 @@ static wx_result parse_texture_map(parser *p, const xmlNode *node, void *user)
                            .padding = d.padding, .uv = d.uv, .every = d.every,
                            .adaptive = adaptive, .radius = adaptive ? 0.0f : d.radius,
                            .noise = d.noise, .max_radius = d.max_radius,
-                           .line = line_of(node) };
+                           .tiles = (wx_uv_tiles)d.tiles, .line = line_of(node) };
     memcpy(t->file, d.file, sizeof d.file);
     return WX_OK;
 }
@@ -3023,8 +3028,15 @@ static wx_result check_output_name_lengths(parser *p)
         int line = mask ? (p->output_map_line > 0 ? p->output_map_line
                                                   : s->cameras[s->output_index].line)
                         : s->textures[k].line;
+        // A UDIM texture's files are BASE.TTTT.exr, four digits each.
+        char own[WX_OUTPUT_NAME_MAX];
+        snprintf(own, sizeof own, "%s", file);
+        if (!mask && s->textures[k].tiles == WX_TILES_UDIM) {
+            snprintf(own, sizeof own, "%.*s.%04d.exr", (int)output_base_length(file), file,
+                     WX_UDIM_FIRST);
+        }
         char longest[WX_OUTPUT_NAME_MAX];
-        size_t len = longest_output_name(s, file, every, longest);
+        size_t len = longest_output_name(s, own, every, longest);
         if (len > WX_OUTPUT_FILE_NAME_MAX) {
             return fail_line(p, line, WX_CAUSE_PATH_TOO_LONG,
                              "<%s> file=\"%.24s...\" (%zu characters) gives the output name "

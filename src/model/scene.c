@@ -24,6 +24,19 @@ const char *wx_mesh_display_name(const wx_scene *scene, const wx_mesh *mesh)
     return mesh->path;
 }
 
+int wx_texture_file_tile(const wx_texture_map *t, int f)
+{
+    if (t->tiles != WX_TILES_UDIM) {
+        return -1;
+    }
+    for (int k = 0; k < WX_UDIM_TILES; ++k) {
+        if (wx_texture_has_tile(t, k) && f-- == 0) {
+            return k;
+        }
+    }
+    return -1;
+}
+
 bool wx_scene_set_path(char **slot, const char *path)
 {
     char *copy = NULL;

@@ -150,6 +150,21 @@ typedef struct wx_surface {
 #define WX_DEFAULT_TEXTURE_RESOLUTION 1024
 #define WX_DEFAULT_TEXTURE_PADDING 8
 
+/// How a <TextureMap> reads UVs outside the unit square (`tiles`,
+/// docs/texture.md "UVs outside [0,1]"); the order of the keywords.
+typedef enum wx_uv_tiles {
+    WX_TILES_REPEAT, ///< every UV tile folds onto the one texture, as a renderer's REPEAT reads it
+    WX_TILES_UDIM,   ///< one texture per UDIM tile 1001 + u + 10 v the UVs cover
+    WX_TILES_CLIP,   ///< the [0,1]^2 tile only; what lies outside is left out (CLIP)
+} wx_uv_tiles;
+
+/// UDIM tiles: 1001 + u + 10 v for u in 0..9, v in 0..99 (1001 to 2000, the
+/// tiles Blender reads: its IMA_UDIM_MAX).
+#define WX_UDIM_FIRST 1001
+#define WX_UDIM_COLUMNS 10
+#define WX_UDIM_ROWS 100
+#define WX_UDIM_TILES (WX_UDIM_COLUMNS * WX_UDIM_ROWS)
+
 /// A <TextureMap> of a <Mesh>: the mask's channels in the mesh's UV layout
 /// (docs/design.md section 11, docs/texture.md).
 typedef struct wx_texture_map {
@@ -167,8 +182,34 @@ typedef struct wx_texture_map {
     float radius;
     float noise;
     float max_radius;
+    wx_uv_tiles tiles;   ///< `tiles`, default repeat
+    /// tiles="udim": the tiles (k = u + 10 v) where a texel centre lies inside
+    /// a triangle of the UV layout, one bit each, known once the mesh is read
+    /// (udim_known; pipeline/texture_phase.h wx_textures_find_tiles): the
+    /// files BASE.(1001 + k).exr the run writes.
+    bool udim_known;
+    int udim_count;
+    uint8_t udim[WX_UDIM_TILES / 8];
     int line;
 } wx_texture_map;
+
+/// Whether UDIM tile k (0 to WX_UDIM_TILES - 1, tile number 1001 + k) is one of
+/// the texture's.
+static inline bool wx_texture_has_tile(const wx_texture_map *t, int k)
+{
+    return (t->udim[k / 8] >> (k % 8)) & 1u;
+}
+
+/// The files (each with its previews and frames) texture t writes: one, or
+/// with tiles="udim" one per tile its UVs cover (0 until known).
+static inline int wx_texture_file_count(const wx_texture_map *t)
+{
+    return t->tiles == WX_TILES_UDIM ? t->udim_count : 1;
+}
+
+/// The UDIM tile index k (tile number 1001 + k) of texture t's file f, or -1
+/// when the texture is not tiles="udim".
+int wx_texture_file_tile(const wx_texture_map *t, int f);
 
 /// The kinds of derived mask (docs/design.md section 12, docs/masks.md).
 typedef enum wx_mask_kind {

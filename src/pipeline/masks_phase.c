@@ -20,6 +20,15 @@ bool wx_masks_worth_keeping(const wx_scene *scene)
     return false;
 }
 
+int wx_mask_slot_texture(const wx_scene *scene, int t, int f)
+{
+    int slot = 1;
+    for (int k = 0; k < t; ++k) {
+        slot += wx_texture_file_count(&scene->textures[k]);
+    }
+    return slot + f;
+}
+
 wx_result wx_mask_context_init(const wx_scene *scene, const wx_maps *in_maps, bool keep,
                                wx_mask_context *ctx, wx_error *err)
 {
@@ -38,7 +47,7 @@ wx_result wx_mask_context_init(const wx_scene *scene, const wx_maps *in_maps, bo
     ctx->zero_impact = calloc(2 * largest + 1, sizeof *ctx->zero_impact);
     if (keep) {
         ctx->mask_count = scene->mask_count;
-        ctx->slots = WX_MASK_SLOT_TEXTURE(scene->texture_count);
+        ctx->slots = wx_mask_slot_texture(scene, scene->texture_count, 0);
         ctx->known = calloc((size_t)ctx->slots * (size_t)scene->mask_count, sizeof *ctx->known);
     }
     wx_result r = WX_OK;

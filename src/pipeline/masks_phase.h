@@ -25,14 +25,17 @@ typedef struct wx_mask_context {
     float height_min, height_max;
     /// When kept (the run gathers several frames): known[slot * mask_count + m],
     /// geometric mask m (wx_mask_is_geometric) at the points of target `slot`
-    /// (WX_MASK_SLOT_OUTPUT, WX_MASK_SLOT_TEXTURE(t)) once computed, else NULL.
+    /// (WX_MASK_SLOT_OUTPUT, wx_mask_slot_texture) once computed, else NULL.
     float **known;
     int slots, mask_count;
 } wx_mask_context;
 
-/// The targets a context keeps masks for: the output camera, TextureMap t.
+/// The targets a context keeps masks for: the output camera, then each file of
+/// each TextureMap (one, or one per UDIM tile: wx_texture_file_count).
 #define WX_MASK_SLOT_OUTPUT 0
-#define WX_MASK_SLOT_TEXTURE(t) (1 + (t))
+
+/// The slot of file f of TextureMap t.
+int wx_mask_slot_texture(const wx_scene *scene, int t, int f);
 
 /// Builds the context from the input cameras' maps (depth and normal), when the
 /// scene has masks (else leaves it not ready). Height's default range is the

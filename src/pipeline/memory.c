@@ -101,7 +101,9 @@ void wx_memory_estimate(const wx_scene *scene, unsigned phases, wx_memory_need *
     for (int t = 0; textures && t < scene->texture_count; ++t) {
         const wx_texture_map *tm = &scene->textures[t];
         double texels = (double)tm->width * (double)tm->height;
-        need->texture_raster_bytes += WX_TEXTURE_RASTER_BYTES_PER_TEXEL * texels;
+        // A raster per file (per UDIM tile), all held over the run.
+        need->texture_raster_bytes +=
+            WX_TEXTURE_RASTER_BYTES_PER_TEXEL * texels * wx_texture_file_count(tm);
         need->texture_write_bytes = fmax(need->texture_write_bytes,
                                          (double)wx_texture_bytes(scene, tm,
                                                                   (int64_t)input_texels) -
@@ -135,7 +137,8 @@ void wx_memory_estimate(const wx_scene *scene, unsigned phases, wx_memory_need *
         if (need->frame_bytes > 0.0 && wx_masks_worth_keeping(scene)) {
             double targets = out != NULL ? output_texels : 0.0;
             for (int t = 0; textures && t < scene->texture_count; ++t) {
-                targets += (double)scene->textures[t].width * (double)scene->textures[t].height;
+                targets += (double)scene->textures[t].width * (double)scene->textures[t].height *
+                           wx_texture_file_count(&scene->textures[t]);
             }
             int geometric = 0;
             for (int m = 0; m < scene->mask_count; ++m) {

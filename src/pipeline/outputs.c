@@ -19,6 +19,7 @@
 #include "core/array.h"
 #include "core/atomic_file.h"
 #include "pipeline/preset.h"
+#include "pipeline/texture_phase.h"
 
 void wx_preview_name(const char *mask_name, char *out, size_t cap)
 {
@@ -82,13 +83,15 @@ static bool grow_slots(wx_output_names *list)
     return true;
 }
 
-static wx_result add_name(wx_output_names *list, const char *fmt, ...)
-    __attribute__((format(printf, 2, 3)));
+static wx_result add_name(wx_output_names *list, char *clash, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
 
 // Adds a name unless the list has it already (bake and simulate both write
-// <camera>_dirt.exr). A hash set finds it: comparing with every name before
-// made a sequence of 100 000 frames cost 63 s before any work (issue 24).
-static wx_result add_name(wx_output_names *list, const char *fmt, ...)
+// <camera>_dirt.exr); then `clash` (WX_OUTPUT_NAME_MAX chars, may be NULL)
+// gets it if it holds none yet. A hash set finds it: comparing with every
+// name before made a sequence of 100 000 frames cost 63 s before any work
+// (issue 24).
+static wx_result add_name(wx_output_names *list, char *clash, const char *fmt, ...)
 {
     if (!wx_array_reserve((void **)&list->names, &list->capacity, list->count + 1,
                           sizeof *list->names, 16) ||
@@ -102,6 +105,8 @@ static wx_result add_name(wx_output_names *list, const char *fmt, ...)
     int64_t slot = name_slot(list, list->names[list->count]);
     if (list->slots[slot] == 0) {
         list->slots[slot] = ++list->count;
+    } else if (clash != NULL && clash[0] == '\0') {
+        snprintf(clash, WX_OUTPUT_NAME_MAX, "%s", list->names[list->count]);
     }
     return WX_OK;
 }
@@ -110,7 +115,7 @@ static wx_result add_name(wx_output_names *list, const char *fmt, ...)
 // without them is listed by the caller for the mask; a texture lists it here),
 // and its frames BASE.NNNN.exr for every k-th iteration.
 static wx_result add_sequence(const wx_scene *scene, const char *file, int every,
-                              wx_output_names *out)
+                              wx_output_names *out, char *clash)
 {
     char name[WX_OUTPUT_NAME_MAX];
     wx_result r = WX_OK;
@@ -118,15 +123,15 @@ static wx_result add_sequence(const wx_scene *scene, const char *file, int every
                 strcmp(scene->cameras[scene->output_index].output_file, file) == 0;
     if (!scene->substances_declared && !mask) {
         wx_preview_name(file, name, sizeof name);
-        r = add_name(out, "%s", name);
+        r = add_name(out, clash, "%s", name);
     }
     for (int s = 0; s < scene->substance_count && scene->substances_declared && r == WX_OK; ++s) {
         wx_channel_preview_name(file, scene->substances[s], name, sizeof name);
-        r = add_name(out, "%s", name);
+        r = add_name(out, clash, "%s", name);
     }
     for (int k = every; every > 0 && k <= scene->iterations && r == WX_OK; k += every) {
         wx_frame_name(file, k, name, sizeof name);
-        r = add_name(out, "%s", name);
+        r = add_name(out, clash, "%s", name);
     }
     return r;
 }
@@ -141,29 +146,53 @@ wx_result wx_output_names_list(const wx_scene *scene, unsigned phases, wx_output
         const wx_scene_camera *cam = &scene->cameras[c];
         int baked = (phases & WX_PHASE_BAKE) && baked_camera(cam) ? (cam->is_output ? 2 : 4) : 0;
         for (int k = 0; k < baked && r == WX_OK; ++k) {
-            r = add_name(out, "%s_%s.exr", cam->name, kinds[k]);
+            r = add_name(out, NULL, "%s_%s.exr", cam->name, kinds[k]);
         }
         if (r == WX_OK && (phases & WX_PHASE_SIMULATE) && !cam->is_output) {
-            r = add_name(out, "%s_dirt.exr", cam->name);
+            r = add_name(out, NULL, "%s_dirt.exr", cam->name);
         }
     }
     if (r == WX_OK && (phases & WX_PHASE_GATHER) && scene->output_index >= 0) {
         const wx_scene_camera *cam = &scene->cameras[scene->output_index];
         char png[WX_OUTPUT_NAME_MAX];
         wx_preview_name(cam->output_file, png, sizeof png);
-        r = add_name(out, "%s", cam->output_file);
+        r = add_name(out, NULL, "%s", cam->output_file);
         if (r == WX_OK) {
-            r = add_name(out, "%s", png);
+            r = add_name(out, NULL, "%s", png);
         }
         if (r == WX_OK) {
-            r = add_sequence(scene, cam->output_file, cam->every, out);
+            r = add_sequence(scene, cam->output_file, cam->every, out, NULL);
         }
     }
+    // A UDIM texture's names are known only with its mesh's tiles, after the
+    // parser has checked the others': from the first UDIM texture on, a name a
+    // texture repeats is refused.
+    char clash[WX_OUTPUT_NAME_MAX] = "";
+    bool udim = false;
     for (int t = 0; t < scene->texture_count && r == WX_OK && (phases & WX_PHASE_GATHER); ++t) {
         const wx_texture_map *tm = &scene->textures[t];
-        r = add_name(out, "%s", tm->file);
-        if (r == WX_OK) {
-            r = add_sequence(scene, tm->file, tm->every, out);
+        udim = udim || tm->tiles == WX_TILES_UDIM;
+        // One file, or with tiles="udim" one per tile (none until the tiles are
+        // known: wx_textures_find_tiles), each with its previews and frames.
+        for (int f = 0; f < wx_texture_file_count(tm) && r == WX_OK && clash[0] == '\0'; ++f) {
+            char own[WX_OUTPUT_NAME_MAX];
+            if (tm->tiles == WX_TILES_UDIM) {
+                wx_tile_name(tm->file, wx_texture_file_tile(tm, f), own, sizeof own);
+            } else {
+                snprintf(own, sizeof own, "%s", tm->file);
+            }
+            r = add_name(out, udim ? clash : NULL, "%s", own);
+            if (r == WX_OK) {
+                r = add_sequence(scene, own, tm->every, out, udim ? clash : NULL);
+            }
+        }
+        if (r == WX_OK && clash[0] != '\0') {
+            wx_output_names_free(out);
+            return wx_fail(err, WX_CAUSE_BAD_SCENE,
+                           "%s:%d: <TextureMap> file=\"%s\"%s writes '%s', which another "
+                           "output of the scene writes too; choose another file",
+                           scene->path, tm->line, tm->file,
+                           tm->tiles == WX_TILES_UDIM ? " tiles=\"udim\"" : "", clash);
         }
     }
     if (r != WX_OK) {

@@ -9,6 +9,7 @@
 #include <strings.h>
 
 #include "core/limits.h"
+#include "gather/texture.h"
 #include "io/mesh_import.h"
 #include "model/mesh.h"
 #include "pipeline/pipeline.h"
@@ -169,6 +170,77 @@ static void escape_attr(const char *in, char *out, size_t cap)
     out[n] = '\0';
 }
 
+// Whether the UVs are a UDIM layout: some triangle lies wholly in a tile other
+// than 1001 and covers a texel there (a layout in [0,1] whose borders a few UVs
+// overshoot by a hair is not one: REPEAT reads it right), and at most 1% of
+// the triangles reach outside the tiles 1001 to 2000 (slivers across u = 0 of
+// a UDIM asset: a renderer finds no tile there either).
+static bool udim_layout(const wx_uv_survey *s)
+{
+    bool beyond_first = false;
+    for (int k = 1; k < WX_UDIM_TILES; ++k) {
+        beyond_first = beyond_first || ((s->udim[k / 8] >> (k % 8)) & 1u);
+    }
+    int64_t usable = s->triangles - s->triangles_unusable;
+    return s->triangles_in_other_tiles > 0 && beyond_first &&
+           100 * s->triangles_outside_udim <= usable;
+}
+
+// The <TextureMap> of a mesh with UVs (docs/presets.md): tiles="udim" for a
+// UDIM layout, the default REPEAT otherwise, none when the layout covers no
+// texel (then a note here and on stderr).
+static void texture_map(text *t, const wx_init_def *def, const wx_uv_survey *s,
+                        const char *base, int R)
+{
+    const bool udim = udim_layout(s);
+    if (!(udim ? s->udim_count > 0 : s->covers)) {
+        char why[200], unusable[96] = "";
+        if (s->triangles_unusable > 0) {
+            snprintf(unusable, sizeof unusable, ", %lld a UV not finite or over %d tiles",
+                     (long long)s->triangles_unusable, WX_UV_MAX_TILES_PER_TRIANGLE);
+        }
+        snprintf(why, sizeof why, "of its %lld triangles, %lld have no area in UV%s",
+                 (long long)s->triangles, (long long)s->triangles_degenerate, unusable);
+        wx_note(def->quiet,
+                "%s: the mesh's UV layout covers no texel at %d x %d (%s): the scene has no "
+                "<TextureMap>",
+                def->mesh_path, R, R, why);
+        put(t,
+            "      <!-- The mesh has UVs, but its layout covers no texel at %d x %d:\n"
+            "           %s. No <TextureMap>: give the mesh a UV\n"
+            "           layout to add one (docs/texture.md). -->\n",
+            R, R, why);
+        return;
+    }
+    if (udim) {
+        int first = -1, last = -1;
+        for (int k = 0; k < WX_UDIM_TILES; ++k) {
+            if ((s->udim[k / 8] >> (k % 8)) & 1u) {
+                first = first < 0 ? k : first;
+                last = k;
+            }
+        }
+        put(t,
+            "      <!-- The mesh's UVs lie in %d UDIM tiles (%d to %d): one texture file per tile,\n"
+            "           %s_texture.%d.exr ...; Blender reads them through its <UDIM> token\n"
+            "           (docs/texture.md). -->\n"
+            "      <TextureMap file=\"%s_texture.exr\" resolution=\"%d\" tiles=\"udim\"/>\n",
+            s->udim_count, WX_UDIM_FIRST + first, WX_UDIM_FIRST + last, base,
+            WX_UDIM_FIRST + first, base, R);
+        return;
+    }
+    if (s->triangles_outside_unit > 0) {
+        put(t,
+            "      <!-- The mesh has UVs: the weathering in its own layout too (docs/texture.md).\n"
+            "           They reach from (%.4g, %.4g) to (%.4g, %.4g): outside [0,1] they wrap\n"
+            "           onto the texture as a renderer's REPEAT reads them. -->\n",
+            s->uv_min[0], s->uv_min[1], s->uv_max[0], s->uv_max[1]);
+    } else {
+        put(t, "      <!-- The mesh has UVs: the weathering in its own layout too (docs/texture.md). -->\n");
+    }
+    put(t, "      <TextureMap file=\"%s_texture.exr\" resolution=\"%d\"/>\n", base, R);
+}
+
 wx_result wx_scene_generate(const wx_init_def *def, char **out_text, wx_error *err)
 {
     *out_text = NULL;
@@ -193,6 +265,17 @@ wx_result wx_scene_generate(const wx_init_def *def, char **out_text, wx_error *e
     double lo[3], hi[3];
     memcpy(lo, mesh.bounds_min, sizeof lo);
     memcpy(hi, mesh.bounds_max, sizeof hi);
+    const int R = def->resolution > 0 ? def->resolution : 1024;
+    // How the TextureMap reads the UVs, or none when they cover no texel.
+    wx_uv_survey survey;
+    memset(&survey, 0, sizeof survey);
+    if (uvs && triangles > 0) {
+        r = wx_uv_survey_build(&mesh, 0, R, R, &survey, err);
+    }
+    if (r != WX_OK) {
+        wx_mesh_data_free(&mesh);
+        return r;
+    }
     wx_mesh_data_free(&mesh);
     if (triangles == 0) {
         return wx_fail(err, WX_CAUSE_BAD_MESH, "%s: the mesh has no triangles", def->mesh_path);
@@ -206,7 +289,6 @@ wx_result wx_scene_generate(const wx_init_def *def, char **out_text, wx_error *e
     if (!(size > 0.0) || !isfinite(size)) {
         return wx_fail(err, WX_CAUSE_BAD_MESH, "%s: the mesh has no extent", def->mesh_path);
     }
-    const int R = def->resolution > 0 ? def->resolution : 1024;
     const double unit = def->unit_m > 0.0 ? def->unit_m : 1.0;
     const double margin = 0.1 * size;
     const double texel = (size + 2.0 * margin) / R;
@@ -369,10 +451,7 @@ wx_result wx_scene_generate(const wx_init_def *def, char **out_text, wx_error *e
         put(&t, " deposit=\"%.6g\" erosion=\"%.6g\"/>\n", p->deposit, p->erosion);
     }
     if (uvs) {
-        put(&t,
-            "      <!-- The mesh has UVs: the weathering in its own layout too (docs/texture.md). -->\n"
-            "      <TextureMap file=\"%s_texture.exr\" resolution=\"%d\"/>\n",
-            base, R);
+        texture_map(&t, def, &survey, base, R);
     }
     put(&t, "    </Mesh>\n  </Geometry>\n");
     if (pi == PRESET_MOSS) {

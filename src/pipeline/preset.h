@@ -28,6 +28,7 @@ typedef struct wx_init_def {
     /// The scene's name (<Weathering name>, its default output folder), a
     /// plain name; NULL: none, the scene file's name is the scene's.
     const char *scene_name;
+    bool quiet; ///< no note on stderr (a UV layout that covers no texel)
 } wx_init_def;
 
 /// The mesh's name for the files and folders made from it (the generated
@@ -44,6 +45,9 @@ double wx_unit_metres(const char *name);
 
 /// Imports the mesh (WX_BAD_INPUT naming it when it cannot be read or has no
 /// triangles) and writes the scene's XML into *text (malloc'd, commented).
+/// A mesh with UVs gets a <TextureMap>: tiles="udim" when its UVs lie in UDIM
+/// tiles beyond 1001, and none (with a note in the scene and on stderr) when
+/// its layout covers no texel (docs/presets.md).
 wx_result wx_scene_generate(const wx_init_def *def, char **text, wx_error *err);
 
 #endif

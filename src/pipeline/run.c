@@ -72,6 +72,11 @@ wx_result wx_run_phases(wx_scene *scene, const wx_run_def *opts, unsigned phases
     if (r == WX_OK && (bake || textures_needed || bounds_needed)) {
         r = wx_geometry_load(scene, opts->quiet, &geometry, err);
     }
+    // The UDIM tiles the UVs cover name the files a tiles="udim" texture
+    // writes: the output checks and the memory estimate below need them.
+    if (r == WX_OK && textures_needed) {
+        wx_textures_find_tiles(scene, &geometry);
+    }
     for (int m = 0; r == WX_OK && m < geometry.count; ++m) {
         const wx_mesh_data *d = &geometry.meshes[m].data;
         if (d->triangle_count == 0) {

@@ -1,6 +1,7 @@
 // texture_phase.c: the scene's <TextureMap>s (texture_phase.h).
 #include "pipeline/texture_phase.h"
 
+#include <assert.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -68,6 +69,130 @@ static double mesh_area(const wx_mesh_data *mesh)
     return area;
 }
 
+void wx_tile_name(const char *file, int udim, char *out, size_t cap)
+{
+    size_t n = strlen(file);
+    size_t base = n >= 4 && strcmp(file + n - 4, ".exr") == 0 ? n - 4 : n;
+    snprintf(out, cap, "%.*s.%04d.exr", (int)base, file, WX_UDIM_FIRST + udim);
+}
+
+void wx_textures_find_tiles(wx_scene *scene, const wx_geometry *geometry)
+{
+    for (int i = 0; i < scene->texture_count; ++i) {
+        wx_texture_map *t = &scene->textures[i];
+        const wx_mesh_data *mesh = &geometry->meshes[t->mesh].data;
+        wx_uv_survey survey;
+        wx_error err;
+        if (t->tiles != WX_TILES_UDIM ||
+            wx_uv_survey_build(mesh, t->uv, t->width, t->height, &survey, &err) != WX_OK) {
+            continue; // a missing channel: the geometry's import refused it already
+        }
+        memcpy(t->udim, survey.udim, sizeof t->udim);
+        t->udim_count = survey.udim_count;
+        t->udim_known = true;
+    }
+}
+
+// "1001, 1002, 1011" (the first few, then "..."), for messages.
+static void tile_list(const wx_texture_map *t, char *out, size_t cap)
+{
+    out[0] = '\0';
+    int shown = 0;
+    for (int f = 0; f < t->udim_count; ++f) {
+        char number[16];
+        if (shown == 8) {
+            wx_list_append(out, cap, "...");
+            break;
+        }
+        snprintf(number, sizeof number, "%d", WX_UDIM_FIRST + wx_texture_file_tile(t, f));
+        wx_list_append(out, cap, number);
+        shown++;
+    }
+}
+
+// What `run` says of a texture's layout (as `info` does): coverage, overlaps,
+// triangles outside, left out, or no texel at all.
+static void report_layout(const wx_scene *scene, const wx_run_def *opts,
+                          const wx_texture_target *t)
+{
+    const wx_texture_map *def = t->def;
+    const wx_mesh *mesh = &scene->meshes[def->mesh];
+    const int64_t triangles = t->mesh.triangle_count;
+    int64_t covered = 0, padded = 0, overlapping = 0;
+    for (int f = 0; f < t->file_count; ++f) {
+        covered += t->files[f].raster.covered;
+        padded += t->files[f].raster.padded;
+        overlapping += t->files[f].raster.overlapping;
+    }
+    double texels = (double)def->width * (double)def->height * (t->file_count > 0 ? t->file_count : 1);
+    if (def->tiles == WX_TILES_UDIM) {
+        char tiles[128];
+        tile_list(def, tiles, sizeof tiles);
+        wx_note(opts->quiet,
+                "texture %s: %d UDIM tile%s (%s) of %d x %d texels over UV channel %d of '%s', "
+                "%.1f%% covered (%lld texels), %lld padded",
+                def->file, t->file_count, t->file_count == 1 ? "" : "s", tiles, def->width,
+                def->height, def->uv, wx_mesh_display_name(scene, mesh),
+                100.0 * (double)covered / texels, (long long)covered, (long long)padded);
+    } else {
+        wx_note(opts->quiet,
+                "texture %s: %d x %d texels over UV channel %d of '%s', %.1f%% covered "
+                "(%lld texels), %lld padded",
+                def->file, def->width, def->height, def->uv, wx_mesh_display_name(scene, mesh),
+                100.0 * (double)covered / texels, (long long)covered, (long long)padded);
+    }
+    if (overlapping > 0) {
+        wx_warn(opts->quiet,
+                "%s:%d: texture %s: %lld texels lie in more than one triangle of the UV "
+                "layout (overlapping UVs): each takes the first triangle's surface point",
+                scene->path, def->line, def->file, (long long)overlapping);
+    }
+    // Every file's raster counts the same triangles: the first's speak for all
+    // (a UDIM texture without a tile asks the survey).
+    int64_t outside = 0, unusable = 0;
+    wx_uv_survey survey;
+    wx_error ignored;
+    if (t->file_count > 0) {
+        outside = t->files[0].raster.triangles_outside;
+        unusable = t->files[0].raster.triangles_unusable;
+    } else if (wx_uv_survey_build(&t->mesh, def->uv, def->width, def->height, &survey,
+                                  &ignored) == WX_OK) {
+        outside = survey.triangles_outside_udim;
+        unusable = survey.triangles_unusable;
+    }
+    if (outside > 0 && def->tiles == WX_TILES_CLIP) {
+        wx_warn(opts->quiet,
+                "%s:%d: texture %s: %lld of %lld triangles reach outside the [0,1] UV tile; "
+                "only the tile is written (tiles=\"clip\")",
+                scene->path, def->line, def->file, (long long)outside, (long long)triangles);
+    } else if (outside > 0 && def->tiles == WX_TILES_REPEAT) {
+        wx_note(opts->quiet,
+                "%s:%d: texture %s: %lld of %lld triangles reach outside the [0,1] UV tile; "
+                "they wrap onto it as a renderer's REPEAT reads them",
+                scene->path, def->line, def->file, (long long)outside, (long long)triangles);
+    } else if (outside > 0) {
+        wx_warn(opts->quiet,
+                "%s:%d: texture %s: %lld of %lld triangles reach outside the UDIM tiles 1001 "
+                "to 2000 (u in [0,10], v in [0,100]); their parts there are not written",
+                scene->path, def->line, def->file, (long long)outside, (long long)triangles);
+    }
+    if (unusable > 0) {
+        wx_warn(opts->quiet,
+                "%s:%d: texture %s: %lld of %lld triangles have a UV that is not a finite "
+                "number%s; they are left out",
+                scene->path, def->line, def->file, (long long)unusable, (long long)triangles,
+                def->tiles == WX_TILES_CLIP ? "" : " or span more than 64 UV tiles");
+    }
+    if (covered == 0) {
+        wx_warn(opts->quiet,
+                def->tiles == WX_TILES_UDIM
+                    ? "%s:%d: texture %s: no texel centre of any UDIM tile lies inside a triangle "
+                      "of the UV layout: no file is written"
+                    : "%s:%d: texture %s: no texel centre lies inside a triangle of the UV layout",
+                scene->path, def->line, def->file);
+    }
+}
+
 wx_result wx_textures_prepare(const wx_scene *scene, const wx_geometry *geometry,
                               const wx_run_def *opts, wx_textures *out, wx_error *err)
 {
@@ -83,47 +208,36 @@ wx_result wx_textures_prepare(const wx_scene *scene, const wx_geometry *geometry
     for (int i = 0; i < scene->texture_count && r == WX_OK; ++i) {
         const wx_texture_map *def = &scene->textures[i];
         wx_texture_target *t = &out->items[i];
-        const wx_mesh *mesh = &scene->meshes[def->mesh];
         out->count = i + 1;
         t->def = def;
+        assert(def->tiles != WX_TILES_UDIM || def->udim_known); // wx_textures_find_tiles
         r = copy_mesh(&geometry->meshes[def->mesh].data, def->uv, &t->mesh, err);
-        if (r == WX_OK) {
-            r = wx_uv_raster_build(&t->mesh, def->uv, def->width, def->height, def->padding,
-                                   &t->raster, err);
+        const int files = wx_texture_file_count(def);
+        t->files = r == WX_OK ? calloc((size_t)files + 1, sizeof *t->files) : NULL;
+        if (r == WX_OK && t->files == NULL) {
+            r = wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (textures)");
+        }
+        int64_t covered = 0;
+        for (int f = 0; f < files && r == WX_OK; ++f) {
+            wx_uv_raster_def rd = { .mesh = &t->mesh,
+                                    .uv = def->uv,
+                                    .tiles = def->tiles,
+                                    .udim = wx_texture_file_tile(def, f),
+                                    .width = def->width,
+                                    .height = def->height,
+                                    .padding = def->padding };
+            t->files[f].udim = rd.udim;
+            r = wx_uv_raster_build(&rd, &t->files[f].raster, err);
+            t->file_count = r == WX_OK ? f + 1 : f;
+            covered += r == WX_OK ? t->files[f].raster.covered : 0;
         }
         if (r != WX_OK) {
             wx_error_prefix(err, "%s:%d: <TextureMap file=\"%s\">", scene->path, def->line,
                             def->file);
             break;
         }
-        const wx_uv_raster *ras = &t->raster;
-        t->texel = ras->covered > 0 ? (float)sqrt(mesh_area(&t->mesh) / (double)ras->covered)
-                                    : 1.0f;
-        double texels = (double)def->width * (double)def->height;
-        wx_note(opts->quiet,
-                "texture %s: %d x %d texels over UV channel %d of '%s', %.1f%% covered "
-                "(%lld texels), %lld padded",
-                def->file, def->width, def->height, def->uv, wx_mesh_display_name(scene, mesh),
-                100.0 * (double)ras->covered / texels, (long long)ras->covered,
-                (long long)ras->padded);
-        if (ras->overlapping > 0) {
-            wx_warn(opts->quiet,
-                    "%s:%d: texture %s: %lld texels lie in more than one triangle of the UV "
-                    "layout (overlapping UVs): each takes the first triangle's surface point",
-                    scene->path, def->line, def->file, (long long)ras->overlapping);
-        }
-        if (ras->triangles_outside > 0) {
-            wx_warn(opts->quiet,
-                    "%s:%d: texture %s: %lld of %lld triangles reach outside the [0,1] UV tile; "
-                    "only the tile is written",
-                    scene->path, def->line, def->file, (long long)ras->triangles_outside,
-                    (long long)t->mesh.triangle_count);
-        }
-        if (ras->covered == 0) {
-            wx_warn(opts->quiet,
-                    "%s:%d: texture %s: no texel centre lies inside a triangle of the UV layout",
-                    scene->path, def->line, def->file);
-        }
+        t->texel = covered > 0 ? (float)sqrt(mesh_area(&t->mesh) / (double)covered) : 1.0f;
+        report_layout(scene, opts, t);
     }
     if (r != WX_OK) {
         wx_textures_free(out);
@@ -134,8 +248,12 @@ wx_result wx_textures_prepare(const wx_scene *scene, const wx_geometry *geometry
 void wx_textures_free(wx_textures *textures)
 {
     for (int i = 0; i < textures->count; ++i) {
-        wx_mesh_data_free(&textures->items[i].mesh);
-        wx_uv_raster_free(&textures->items[i].raster);
+        wx_texture_target *t = &textures->items[i];
+        wx_mesh_data_free(&t->mesh);
+        for (int f = 0; f < t->file_count; ++f) {
+            wx_uv_raster_free(&t->files[f].raster);
+        }
+        free(t->files);
     }
     free(textures->items);
     memset(textures, 0, sizeof *textures);
@@ -222,10 +340,9 @@ static void free_planes(camera_planes *cache, int count, int planes)
 // (position, normal), the substances' sampled values for the Combines.
 static wx_result texture_masks(const wx_scene *scene, const wx_run_def *opts,
                                wx_mask_context *masks, int slot, const wx_texture_target *t,
-                               wx_image *image, const double *position, const float *normal,
-                               wx_error *err)
+                               const wx_uv_raster *ras, wx_image *image, const double *position,
+                               const float *normal, wx_error *err)
 {
-    const wx_uv_raster *ras = &t->raster;
     const size_t texels = (size_t)ras->width * (size_t)ras->height;
     const float *seen = image->channels[image->channel_count - 1];
     unsigned char *valid = malloc(texels + 1);
@@ -249,22 +366,31 @@ static wx_result texture_masks(const wx_scene *scene, const wx_run_def *opts,
     return r;
 }
 
-// One texture: sampled into `image` (its channels allocated) and written with
-// its previews (frame 0).
+// One file of a texture (the texture, or one UDIM tile): sampled into `image`
+// (its channels allocated) and written with its previews (frame 0).
 static wx_result write_texture(const wx_scene *scene, const wx_run_def *opts,
-                               const wx_texture_target *t, const wx_gather_view *views,
-                               float *const *planes, wx_mask_context *masks, int slot, int frame,
+                               const wx_texture_target *t, const wx_texture_file *file,
+                               const wx_gather_view *views, float *const *planes,
+                               wx_mask_context *masks, int slot, int frame,
                                char names[][WX_NAME_MAX], int channels, wx_phase_detail *detail,
                                wx_error *err)
 {
     const wx_texture_map *def = t->def;
+    const wx_uv_raster *ras = &file->raster;
     const char *channel_names[WX_IMAGE_MAX_CHANNELS];
     for (int c = 0; c < channels; ++c) {
         channel_names[c] = names[c];
     }
-    char path[WX_PATH_MAX], name[WX_OUTPUT_NAME_MAX];
-    wx_frame_name(def->file, frame, name, sizeof name);
-    wx_result r = wx_output_path(scene, opts, frame > 0 ? name : def->file, path, err);
+    // The file's own name: the texture's, or its tile's BASE.TTTT.exr; frames
+    // and previews are named from it.
+    char own[WX_OUTPUT_NAME_MAX], path[WX_PATH_MAX], name[WX_OUTPUT_NAME_MAX];
+    if (file->udim >= 0) {
+        wx_tile_name(def->file, file->udim, own, sizeof own);
+    } else {
+        snprintf(own, sizeof own, "%s", def->file);
+    }
+    wx_frame_name(own, frame, name, sizeof name);
+    wx_result r = wx_output_path(scene, opts, frame > 0 ? name : own, path, err);
     wx_image *image = calloc(1, sizeof *image);
     if (image == NULL) {
         return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "texture: out of memory");
@@ -287,7 +413,7 @@ static wx_result write_texture(const wx_scene *scene, const wx_run_def *opts,
     if (r == WX_OK) {
         wx_texture_def td = { .mesh = &t->mesh,
                               .uv = def->uv,
-                              .raster = &t->raster,
+                              .raster = ras,
                               .inputs = views,
                               .input_count = scene->input_count,
                               .smoothed = (const float *const *)planes,
@@ -300,12 +426,12 @@ static wx_result write_texture(const wx_scene *scene, const wx_run_def *opts,
     // The derived masks at the texels whose point is seen, then the padding of
     // every channel.
     if (r == WX_OK && scene->mask_count > 0) {
-        r = texture_masks(scene, opts, masks, slot, t, image, position, normal, err);
+        r = texture_masks(scene, opts, masks, slot, t, ras, image, position, normal, err);
     }
     free(position);
     free(normal);
     if (r == WX_OK) {
-        wx_texture_pad(&t->raster, image->channels, channels);
+        wx_texture_pad(ras, image->channels, channels);
     }
     double t1 = wx_now_s();
     if (r == WX_OK) {
@@ -314,6 +440,11 @@ static wx_result write_texture(const wx_scene *scene, const wx_run_def *opts,
         char uv[16];
         snprintf(uv, sizeof uv, "%d", def->uv);
         wx_image_set_string(image, "weatheringUVChannel", uv);
+        if (file->udim >= 0) {
+            char tile[16];
+            snprintf(tile, sizeof tile, "%d", WX_UDIM_FIRST + file->udim);
+            wx_image_set_string(image, "weatheringUDIMTile", tile);
+        }
         image->threads = opts->threads;
         r = wx_image_check_finite(image, path, err);
     }
@@ -328,14 +459,14 @@ static wx_result write_texture(const wx_scene *scene, const wx_run_def *opts,
             r = wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "texture: out of memory (preview)");
         }
         for (size_t i = 0; alpha != NULL && i < texels; ++i) {
-            alpha[i] = t->raster.source[i] >= 0 ? 1.0f : INFINITY;
+            alpha[i] = ras->source[i] >= 0 ? 1.0f : INFINITY;
         }
     }
     for (int c = 0; c + 1 < channels && r == WX_OK && frame == 0; ++c) {
         if (channels == 2) {
-            wx_preview_name(def->file, name, sizeof name);
+            wx_preview_name(own, name, sizeof name);
         } else {
-            wx_channel_preview_name(def->file, names[c], name, sizeof name);
+            wx_channel_preview_name(own, names[c], name, sizeof name);
         }
         r = wx_output_path(scene, opts, name, path, err);
         if (r == WX_OK) {
@@ -403,9 +534,10 @@ wx_result wx_textures_write(const wx_scene *scene, const wx_run_def *opts,
                 detail->compute += wx_now_s() - t0;
             }
         }
-        if (r == WX_OK) {
-            r = write_texture(scene, opts, t, views, cache[slot].planes, masks,
-                              WX_MASK_SLOT_TEXTURE(i), frame, names, channels, detail, err);
+        for (int f = 0; f < t->file_count && r == WX_OK; ++f) {
+            r = write_texture(scene, opts, t, &t->files[f], views, cache[slot].planes, masks,
+                              wx_mask_slot_texture(scene, i, f), frame, names, channels, detail,
+                              err);
         }
         if (r != WX_OK) {
             wx_error_prefix(err, "texture %s", t->def->file);

@@ -6,6 +6,7 @@
 #define WX_TEXTURE_PHASE_H
 
 #include <stdbool.h>
+#include <stddef.h>
 #include <stdint.h>
 
 #include "core/error.h"
@@ -17,12 +18,20 @@
 #include "pipeline/masks_phase.h"
 #include "pipeline/pipeline.h"
 
+/// One file of a <TextureMap>: the texture, or with tiles="udim" one tile.
+typedef struct wx_texture_file {
+    int udim; ///< the UDIM tile (number 1001 + udim), -1 for a texture without tiles
+    wx_uv_raster raster;
+} wx_texture_file;
+
 /// One <TextureMap>, ready to be sampled: what its mesh needs of the import
-/// (positions, normals, indices and the UV channel, owned copies) and the raster.
+/// (positions, normals, indices and the UV channel, owned copies) and the
+/// raster of each of its files.
 typedef struct wx_texture_target {
     const wx_texture_map *def;
     wx_mesh_data mesh;
-    wx_uv_raster raster;
+    int file_count;
+    wx_texture_file *files;
     float texel; ///< a texel's world size: the mesh's area over the covered texels, square-rooted
 } wx_texture_target;
 
@@ -31,6 +40,16 @@ typedef struct wx_textures {
     int count;
     wx_texture_target *items;
 } wx_textures;
+
+/// The UDIM tiles of every tiles="udim" <TextureMap> (the tiles where a texel
+/// centre lies inside a triangle of its UV layout), from `geometry` imported
+/// with their UV channels: the files the run writes, which the output checks
+/// and the memory estimate need before any work. The others are left alone.
+void wx_textures_find_tiles(wx_scene *scene, const wx_geometry *geometry);
+
+/// The name of tile `udim` of texture file `file`: BASE.(1001 + udim).exr,
+/// BASE the file without its ".exr" (as the frames' BASE.NNNN.exr).
+void wx_tile_name(const char *file, int udim, char *out, size_t cap);
 
 /// Rasterises every <TextureMap> from `geometry` (imported by
 /// wx_geometry_load with the UV channels they read, before the bake releases
@@ -48,9 +67,10 @@ bool wx_texture_writes_frame(const wx_texture_map *t, int frame);
 /// Writes the textures of frame `frame` from the input cameras' maps in memory
 /// (in_maps: one per input camera in scene order, depth, normal and the dirt
 /// planes a gather reads; `masks` the derived masks' context, texture t's
-/// points in its slot WX_MASK_SLOT_TEXTURE(t)): frame 0 every texture's
+/// points in the slots wx_mask_slot_texture gives): frame 0 every texture's
 /// BASE.exr and previews, frame k > 0 BASE.NNNN.exr for those whose `every`
-/// divides k. `detail` (may be NULL) gets the compute and write times added.
+/// divides k; with tiles="udim" each tile's BASE.TTTT.exr, its previews and
+/// frames BASE.TTTT.NNNN.exr. `detail` (may be NULL) gets the compute and write times added.
 wx_result wx_textures_write(const wx_scene *scene, const wx_run_def *opts,
                             const wx_textures *textures, const wx_maps *in_maps,
                             wx_mask_context *masks, int frame, wx_phase_detail *detail,
@@ -64,7 +84,7 @@ int wx_texture_channels(const wx_scene *scene, char names[][WX_NAME_MAX]);
 
 /// What `info` and the memory check count for texture `t` of `scene` whose
 /// smoothing runs on input cameras of `camera_texels` texels in all: bytes at
-/// the peak of writing it.
+/// the peak of writing one of its files, with that file's raster.
 int64_t wx_texture_bytes(const wx_scene *scene, const wx_texture_map *t, int64_t camera_texels);
 
 #endif

@@ -21,7 +21,11 @@ BUILD/blender-test/addon/, and checks:
   worldToCamera is the camera's, and worldToNDC puts every bounding-box corner
   where Blender's camera sees it (all to 1e-4);
 - bad input: a program path that does not exist gives {'CANCELLED'} with an
-  error report naming it, and no traceback.
+  error report naming it, and no traceback;
+- UDIM: a cube whose top face's UVs lie in tile 1002 gets tiles="udim", the
+  tiles 1001 and 1002 as files, and tiled images (<UDIM> in their path) whose
+  tile 1002 holds the dirtier top; a plane whose UVs are one point gets no
+  TextureMap (BUILD/blender-test/addon-udim/).
 
 With --render PNG it also renders the weathered objects with EEVEE (a ground
 plane, a sun) into PNG (docs/images/blender-addon.png). Prints one line per
@@ -34,6 +38,7 @@ import contextlib
 import io
 import math
 import os
+import re
 import sys
 import time
 import traceback
@@ -157,10 +162,11 @@ def inside(poly, x, y):
     return True
 
 
-def face_means(obj, image):
+def face_means(obj, image, tile=None):
     """{'top': mean, 'side': mean, 'bottom': mean} of the image's R over the
     texels whose centre lies in a face of obj's active UV layout, by the
-    face's normal in world space."""
+    face's normal in world space. With tile = (u, v), the image is that UV
+    tile's (UDIM): only the faces inside it count, moved onto [0,1]^2."""
     w, h, pixels = image_pixels(image)
     mesh = obj.data
     uv = mesh.uv_layers.active.data
@@ -172,6 +178,10 @@ def face_means(obj, image):
         if kind is None:
             continue
         corners = [tuple(uv[i].uv) for i in poly.loop_indices]
+        if tile is not None:
+            corners = [(a - tile[0], b - tile[1]) for a, b in corners]
+            if not all(-1e-6 <= c <= 1 + 1e-6 for corner in corners for c in corner):
+                continue
         us, vs = [c[0] for c in corners], [c[1] for c in corners]
         for j in range(max(0, int(min(vs) * h) - 1), min(h, int(max(vs) * h) + 2)):
             for i in range(max(0, int(min(us) * w) - 1), min(w, int(max(us) * w) + 2)):
@@ -375,8 +385,93 @@ def main(build, render_png):
           "objects, and the note '%s'" % (view["width"], view["height"],
                                          notes[0][1] if notes else ""))
 
+    udim_object(scene, folder)
+
     if render_png:
         render(scene, cube, sphere, render_png)
+
+
+def udim_object(scene, folder):
+    """A cube whose top face's UVs are moved into UDIM tile 1002 (the rest in
+    1001), weathered with a plane whose UVs are all one point: init reads the
+    cube's layout as UDIM, the run writes Tiles_texture.1001.exr and .1002.exr,
+    and the add-on loads each channel as one tiled image (source 'TILED',
+    <UDIM> in its path, tiles 1001 and 1002 read from their files); the top,
+    in tile 1002, is dirtier than the sides. The plane's layout covers no
+    texel: no TextureMap, the camera mask only."""
+    bpy.ops.mesh.primitive_cube_add(size=2.0, location=(-3.5, 0.0, 1.0))
+    obj = bpy.context.active_object
+    obj.name = "Tiles"
+    uv = obj.data.uv_layers.active.data
+    for poly in obj.data.polygons:
+        if poly.normal.z > 0.99:
+            for i in poly.loop_indices:
+                uv[i].uv.x += 1.0
+    bpy.ops.mesh.primitive_plane_add(size=2.0, location=(-3.5, -3.0, 0.0))
+    flat = bpy.context.active_object
+    flat.name = "Flat"
+    for loop in flat.data.uv_layers.active.data:
+        loop.uv = (0.5, 0.5)
+    bpy.ops.object.select_all(action="DESELECT")
+    obj.select_set(True)
+    flat.select_set(True)
+    bpy.context.view_layer.objects.active = obj
+    settings = scene.weathering
+    saved = settings.output_folder
+    settings.output_folder = os.path.join(os.path.dirname(folder), "addon-udim")
+    out = os.path.join(settings.output_folder, "out")
+    try:
+        result, message, stderr = run_operator()
+        if not check(result == {"FINISHED"}, "a UDIM object: the run returns {'FINISHED'} (%s)"
+                     % (message or result)):
+            print(stderr)
+            return
+        tree = scene_xml.load(os.path.join(settings.output_folder, "scene.xml"))
+        tex = [t for t in tree.getroot().iter("TextureMap")]
+        flat_mesh = [m for m in tree.getroot().iter("Mesh") if m.get("file") == "meshes/Flat.obj"]
+        flat_nodes = {n.label for n in flat.active_material.node_tree.nodes
+                      if n.type == "TEX_IMAGE"}
+        check(len(flat_mesh) == 1 and flat_mesh[0].find("TextureMap") is None
+              and flat_nodes == {"mask Y (shot)"},
+              "a plane whose UVs are one point: no TextureMap, the camera mask only (%s)"
+              % ", ".join(sorted(flat_nodes)))
+        written = sorted(f for f in os.listdir(out) if f.startswith("Tiles_texture."))
+        tile_files = [f for f in written if re.match(r"Tiles_texture\.[0-9]{4}\.exr$", f)]
+        check(len(tex) == 1 and tex[0].get("tiles") == "udim" and "Tiles_texture.exr" not in written
+              and tile_files == ["Tiles_texture.1001.exr", "Tiles_texture.1002.exr"],
+              "its TextureMap is tiles=\"udim\" (init's choice) and the run wrote the tiles "
+              "1001 and 1002 only: %s" % ", ".join(tile_files))
+        nodes = obj.active_material.node_tree.nodes
+        images = {n.label: n.image for n in nodes if n.type == "TEX_IMAGE"
+                  and not n.label.startswith("mask")}
+        tiled = all(im is not None and im.source == "TILED" and "<UDIM>" in im.filepath
+                    and sorted(t.number for t in im.tiles) == [1001, 1002]
+                    and all(tuple(t.size) == (RESOLUTION, RESOLUTION) for t in im.tiles)
+                    and im.colorspace_settings.name == "Non-Color"
+                    for im in images.values())
+        check({"Y", "seen"} <= set(images) and tiled,
+              "its image nodes %s hold tiled images %s with tiles 1001 and 1002 of %d x %d "
+              "read from their files" % (", ".join(sorted(images)),
+                                         images["Y"].filepath if "Y" in images else None,
+                                         RESOLUTION, RESOLUTION))
+        top = face_means(obj, shading_image(os.path.join(out, "Tiles_texture.1002_Y.exr")),
+                         tile=(1, 0))["top"]
+        side = face_means(obj, shading_image(os.path.join(out, "Tiles_texture.1001_Y.exr")),
+                          tile=(0, 0))["side"]
+        print("     UDIM: top (tile 1002) %.4g (%d texels), sides (tile 1001) %.4g (%d)"
+              % (top[0], top[1], side[0], side[1]))
+        check(top[1] > 100 and side[1] > 400 and top[0] > 1.5 * side[0],
+              "the top face in tile 1002 is dirtier than the sides in tile 1001 "
+              "(%.4g > 1.5 x %.4g)" % (top[0], side[0]))
+    finally:
+        settings.output_folder = saved
+        bpy.data.objects.remove(obj)
+        bpy.data.objects.remove(flat)
+
+
+def shading_image(path):
+    """One file as an image of its own (a tile's split channel)."""
+    return bpy.data.images.load(path, check_existing=True)
 
 
 def render(scene, cube, sphere, path):

@@ -11,8 +11,9 @@
 // At a covered pixel the UV is interpolated (affine is exact for an
 // orthographic projection) and the texture's channel and its `seen` are
 // sampled bilinearly in texel space (x = u*W - 0.5, y = (1-v)*H - 0.5, clamped
-// at the borders). The mesh is taken as the file gives it (scenes place meshes
-// as they are).
+// at the borders; a UV outside [0,1] first taken modulo 1, as the default
+// tiles="repeat" writes it). The mesh is taken as the file gives it (scenes
+// place meshes as they are).
 //
 //   make build/tools/render_texture
 //   build/tools/render_texture MESH TEXTURE.exr [--channel NAME] [--uv N]
@@ -206,9 +207,12 @@ typedef struct texture {
     const float *seen;
 } texture;
 
-// Bilinear in texel space, centres at integers, clamped at the borders.
+// Bilinear in texel space, centres at integers, clamped at the borders; UVs
+// outside [0,1] wrap (REPEAT, docs/texture.md), those inside are read as they are.
 static float sample(const texture *tex, const float *plane, double u, double v)
 {
+    u = u < 0.0 || u > 1.0 ? u - floor(u) : u;
+    v = v < 0.0 || v > 1.0 ? v - floor(v) : v;
     double x = u * tex->width - 0.5, y = (1.0 - v) * tex->height - 0.5;
     x = fmin(fmax(x, 0.0), tex->width - 1.0);
     y = fmin(fmax(y, 0.0), tex->height - 1.0);
