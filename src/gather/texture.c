@@ -411,10 +411,18 @@ bool wx_uv_raster_point(const wx_mesh_data *mesh, int uv, const wx_uv_raster *ra
             n[a] += w[k] * nk[a];
         }
     }
-    // On the smooth surface the bake draws (its depth maps hold this point).
+    // On the smooth surface the bake draws (its depth maps hold this point),
+    // with the normal its normal maps hold there.
     wx_mesh_phong_point(mesh, tri, w, local);
     for (int a = 0; a < 3; ++a) {
         position[a] = mesh->origin[a] + local[a];
+    }
+    if (wx_mesh_triangle_curves(mesh, tri)) {
+        float smooth[3];
+        wx_mesh_phong_normal(mesh, tri, w, smooth);
+        for (int a = 0; a < 3; ++a) {
+            n[a] = smooth[a];
+        }
     }
     double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
     if (!(len > 1e-6)) {

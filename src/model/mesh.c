@@ -92,6 +92,61 @@ void wx_mesh_phong_point(const wx_mesh_data *mesh, int64_t tri, const double w[3
     memcpy(out, q, sizeof q);
 }
 
+void wx_mesh_phong_normal(const wx_mesh_data *mesh, int64_t tri, const double w[3],
+                          float out[3])
+{
+    // p(w) = flat(w) - s sum_k w_k ((flat(w) - p_k) . n_k) n_k, flat(w) = sum w_k p_k
+    // (s = WX_PHONG_SHAPE); its derivatives along w1 - w0 and w2 - w0 span the
+    // tangent plane.
+    const uint32_t *idx = &mesh->indices[3 * (size_t)tri];
+    double p[3][3], n[3][3], flat[3] = { 0, 0, 0 }, interpolated[3] = { 0, 0, 0 };
+    for (int k = 0; k < 3; ++k) {
+        const float *pk = &mesh->positions[3 * (size_t)idx[k]];
+        const float *nk = &mesh->normals[3 * (size_t)idx[k]];
+        double len = sqrt((double)nk[0] * nk[0] + (double)nk[1] * nk[1] + (double)nk[2] * nk[2]);
+        for (int a = 0; a < 3; ++a) {
+            p[k][a] = pk[a];
+            n[k][a] = len > 1e-6 ? nk[a] / len : 0.0;
+            flat[a] += w[k] * pk[a];
+            interpolated[a] += w[k] * nk[a];
+        }
+    }
+    double along[3];
+    for (int k = 0; k < 3; ++k) {
+        along[k] = 0.0;
+        for (int a = 0; a < 3; ++a) {
+            along[k] += (flat[a] - p[k][a]) * n[k][a];
+        }
+    }
+    double tangent[2][3];
+    for (int d = 0; d < 2; ++d) {
+        int to = d + 1; // the derivative along w_to - w0
+        double edge[3];
+        for (int a = 0; a < 3; ++a) {
+            edge[a] = p[to][a] - p[0][a];
+        }
+        for (int a = 0; a < 3; ++a) {
+            double t = edge[a];
+            for (int k = 0; k < 3; ++k) {
+                double dw = k == to ? 1.0 : k == 0 ? -1.0 : 0.0;
+                double dalong = edge[0] * n[k][0] + edge[1] * n[k][1] + edge[2] * n[k][2];
+                t -= WX_PHONG_SHAPE * (dw * along[k] + w[k] * dalong) * n[k][a];
+            }
+            tangent[d][a] = t;
+        }
+    }
+    double c[3] = { tangent[0][1] * tangent[1][2] - tangent[0][2] * tangent[1][1],
+                    tangent[0][2] * tangent[1][0] - tangent[0][0] * tangent[1][2],
+                    tangent[0][0] * tangent[1][1] - tangent[0][1] * tangent[1][0] };
+    double len = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+    double sign = c[0] * interpolated[0] + c[1] * interpolated[1] + c[2] * interpolated[2] < 0.0
+                      ? -1.0
+                      : 1.0;
+    for (int a = 0; a < 3; ++a) {
+        out[a] = len > 0.0 ? (float)(sign * c[a] / len) : (float)interpolated[a];
+    }
+}
+
 // Whether the normals at the two ends of an edge differ: only then does the
 // smooth surface leave the flat triangle along it.
 static bool edge_curves(const wx_mesh_data *mesh, uint32_t a, uint32_t b)
@@ -100,7 +155,7 @@ static bool edge_curves(const wx_mesh_data *mesh, uint32_t a, uint32_t b)
     return na[0] != nb[0] || na[1] != nb[1] || na[2] != nb[2];
 }
 
-static bool triangle_curves(const wx_mesh_data *mesh, int64_t t)
+bool wx_mesh_triangle_curves(const wx_mesh_data *mesh, int64_t t)
 {
     const uint32_t *idx = &mesh->indices[3 * t];
     return edge_curves(mesh, idx[0], idx[1]) || edge_curves(mesh, idx[1], idx[2]) ||
@@ -151,7 +206,7 @@ int64_t wx_mesh_curved_triangles(const wx_mesh_data *mesh)
 {
     int64_t n = 0;
     for (int64_t t = 0; t < mesh->triangle_count; ++t) {
-        n += triangle_curves(mesh, t);
+        n += wx_mesh_triangle_curves(mesh, t);
     }
     return n;
 }
@@ -195,7 +250,7 @@ wx_result wx_mesh_smooth_subdivide(wx_mesh_data *mesh, int level, wx_error *err)
     size_t v = old_v, t_out = 0;
     for (int64_t t = 0; t < mesh->triangle_count; ++t) {
         const uint32_t *idx = &mesh->indices[3 * t];
-        if (!triangle_curves(mesh, t)) {
+        if (!wx_mesh_triangle_curves(mesh, t)) {
             memcpy(&indices[3 * t_out], idx, 3 * sizeof *idx);
             materials[t_out++] = mesh->materials[t];
             continue;
@@ -208,13 +263,9 @@ wx_result wx_mesh_smooth_subdivide(wx_mesh_data *mesh, int level, wx_error *err)
                                 (double)j / level };
                 double p[3];
                 wx_mesh_phong_point(mesh, t, w, p);
+                wx_mesh_phong_normal(mesh, t, w, &normals[3 * v]);
                 for (int a = 0; a < 3; ++a) {
                     positions[3 * v + (size_t)a] = (float)p[a];
-                    double n = 0.0;
-                    for (int k = 0; k < 3; ++k) {
-                        n += w[k] * mesh->normals[3 * (size_t)idx[k] + (size_t)a];
-                    }
-                    normals[3 * v + (size_t)a] = (float)n;
                 }
                 for (int a = 0; a < 4 && colors != NULL; ++a) {
                     double c = 0.0;

@@ -62,9 +62,21 @@ void wx_mesh_data_free(wx_mesh_data *mesh);
 void wx_mesh_phong_point(const wx_mesh_data *mesh, int64_t tri, const double w[3],
                          double out[3]);
 
+/// The unit normal of that smooth surface at weights w (the cross product of
+/// its derivatives, turned to the side of the interpolated vertex normals):
+/// what the normal maps and the TextureMaps read, so that the area a texel
+/// covers is the area of the surface the depth maps hold. A triangle whose
+/// normals are its plane's gets its plane's normal.
+void wx_mesh_phong_normal(const wx_mesh_data *mesh, int64_t tri, const double w[3],
+                          float out[3]);
+
 /// The length of the edges whose two vertex normals differ at `quantile`
 /// (0.9: nine in ten are shorter; 1: the longest); 0 for a flat-shaded mesh.
 double wx_mesh_curved_edge_length(const wx_mesh_data *mesh, double quantile);
+
+/// Whether triangle t has an edge whose vertex normals differ (the bake draws
+/// it on its smooth surface, with wx_mesh_phong_normal's normals).
+bool wx_mesh_triangle_curves(const wx_mesh_data *mesh, int64_t t);
 
 /// How many triangles have an edge whose vertex normals differ.
 int64_t wx_mesh_curved_triangles(const wx_mesh_data *mesh);
@@ -74,8 +86,8 @@ int64_t wx_mesh_curved_triangles(const wx_mesh_data *mesh);
 #define WX_SMOOTH_MAX_TRIANGLES 1000000.0
 
 /// Replaces every triangle that has an edge whose normals differ by level x
-/// level triangles on its smooth surface (wx_mesh_phong_point), normals and
-/// colours interpolated, so that a renderer draws the surface the normals
+/// level triangles on its smooth surface (wx_mesh_phong_point), with its
+/// normals there (wx_mesh_phong_normal) and colours interpolated, so that a renderer draws the surface the normals
 /// describe; the other triangles stay. Shared edges are cut at the same points
 /// on both sides (no cracks). UVs are not carried (the bake does not read
 /// them). level <= 1 changes nothing.

@@ -64,22 +64,25 @@ void wx_uniform_cone(const float axis[3], float spread, float u1, float u2, floa
     }
 }
 
-// The Kronecker sequence R5 (Roberts 2018): alpha_k = 1 / phi^k, phi the root of
-// x^6 = x + 1. Its points n = 0, 1, 2, ... cover the unit cube evenly, and so
-// do the points of any run of consecutive n.
-static const double R5_ALPHA[WX_EMIT_DIMENSIONS] = { 0.8812714616335696, 0.7766393890897682,
-                                                     0.6844301295853426, 0.6031687406857283,
-                                                     0.5315553977157913 };
+// The Kronecker sequences R1, R2, R3 (Roberts 2018): alpha_k = 1 / phi_d^k,
+// phi_d the root of x^(d+1) = x + 1. Their points n = 0, 1, 2, ... cover the
+// unit cube evenly, and so do the points of any run of consecutive n.
+static const double R_ALPHA[3][3] = {
+    { 0.6180339887498949, 0.0, 0.0 },
+    { 0.7548776662466927, 0.5698402909980532, 0.0 },
+    { 0.8191725133961645, 0.6710436067037893, 0.5497004779019703 },
+};
 
-void wx_emitter_uniforms(uint64_t seed, uint64_t id, double u[WX_EMIT_DIMENSIONS])
+void wx_emitter_uniforms(uint64_t seed, uint64_t id, int dimensions, double *u)
 {
     uint64_t serial = id & ((UINT64_C(1) << 48) - 1), emitter = id >> 48;
-    for (int k = 0; k < WX_EMIT_DIMENSIONS; ++k) {
+    const double *alpha = R_ALPHA[dimensions - 1];
+    for (int k = 0; k < dimensions; ++k) {
         // One random shift of the whole sequence per seed, emitter and
         // dimension (Cranley and Patterson 1976): a seed moves every point.
         double shift = wx_particle_random(seed, wx_particle_id((uint32_t)emitter, WX_EMIT_SHIFT_SERIAL),
                                           WX_RANDOM_EMIT_BOX + (uint64_t)k);
-        double x = shift + (double)serial * R5_ALPHA[k];
+        double x = shift + (double)serial * alpha[k];
         u[k] = x - floor(x);
     }
 }
@@ -87,20 +90,39 @@ void wx_emitter_uniforms(uint64_t seed, uint64_t id, double u[WX_EMIT_DIMENSIONS
 void wx_emitter_sample(const wx_emitter *e, uint64_t seed, uint64_t id, float pos[3],
                        float vel[3])
 {
-    double u[WX_EMIT_DIMENSIONS];
-    wx_emitter_uniforms(seed, id, u);
     if (e->kind == WX_EMITTER_BOX) {
-        float d[3];
+        // The start from the sequence of as many dimensions as the box has
+        // extent (a rectangle: R2 over its two axes); the direction from the
+        // particle's own random numbers: a direction drawn from the same
+        // sequence would be tied to the start, and a cone of rain would print
+        // the sequence's lattice as stripes.
+        int axes[3], d_count = 0;
         for (int k = 0; k < 3; ++k) {
-            pos[k] = e->box_min[k] + (float)u[k] * (e->box_max[k] - e->box_min[k]);
+            pos[k] = e->box_min[k];
+            if (e->box_max[k] > e->box_min[k]) {
+                axes[d_count++] = k;
+            }
         }
-        float u1 = (float)u[3], u2 = (float)u[4];
+        double u[3];
+        if (d_count > 0) {
+            wx_emitter_uniforms(seed, id, d_count, u);
+        }
+        for (int j = 0; j < d_count; ++j) {
+            int k = axes[j];
+            pos[k] = e->box_min[k] + (float)u[j] * (e->box_max[k] - e->box_min[k]);
+        }
+        float u1 = wx_particle_random(seed, id, WX_RANDOM_EMIT_0);
+        float u2 = wx_particle_random(seed, id, WX_RANDOM_EMIT_1);
+        float d[3];
         wx_uniform_cone(e->dir, e->spread * 0.017453292519943295f, u1, u2, d);
         for (int k = 0; k < 3; ++k) {
             vel[k] = e->speed * d[k];
         }
         return;
     }
+    // The point and hemisphere emitters draw a direction only: from R2.
+    double u[2];
+    wx_emitter_uniforms(seed, id, 2, u);
     float u1 = (float)u[0], u2 = (float)u[1];
     float d[3];
     if (e->kind == WX_EMITTER_HEMISPHERE) {

@@ -29,25 +29,24 @@ void wx_uniform_hemisphere(float u1, float u2, float d[3]);
 /// from two uniforms: cos(theta) uniform in [cos(spread), 1], phi in [0, 2 pi).
 void wx_uniform_cone(const float axis[3], float spread, float u1, float u2, float d[3]);
 
-/// Uniform numbers an emitter draws per particle: three for a box's position,
-/// two for a direction.
-#define WX_EMIT_DIMENSIONS 5
 /// A serial number no particle reaches (2^48 - 1): the shift of the sequence.
 #define WX_EMIT_SHIFT_SERIAL ((UINT64_C(1) << 48) - 1)
 
-/// The particle's WX_EMIT_DIMENSIONS numbers in [0, 1): point number `serial`
-/// (the low 48 bits of id) of a low-discrepancy sequence, shifted at random per
-/// seed and emitter. A steady rain then covers a surface evenly instead of
-/// with Poisson clumps (the noise between seeds drops, docs/physics.md), and
-/// the particle's start still depends only on the seed and its id.
-void wx_emitter_uniforms(uint64_t seed, uint64_t id, double u[WX_EMIT_DIMENSIONS]);
+/// The particle's `dimensions` (1 to 3) numbers in [0, 1): point number
+/// `serial` (the low 48 bits of id) of the low-discrepancy sequence R_d,
+/// shifted at random per seed and emitter. A steady rain then covers a surface
+/// evenly instead of with Poisson clumps (the noise between seeds drops,
+/// docs/physics.md), and the particle's start still depends only on the seed
+/// and its id.
+void wx_emitter_uniforms(uint64_t seed, uint64_t id, int dimensions, double *u);
 
 /// Start position and velocity of the particle with id `id` (see wx_particle_id):
 /// PointEmitter: the centre, speed times a uniform direction; HemisphereEmitter:
 /// c + radius*d with d uniform on the upper hemisphere, velocity -speed*d;
 /// BoxEmitter (docs/design.md section 8): a point uniform in [min, max],
 /// velocity speed times a direction uniform in the cone of `spread` degrees
-/// around `dir`. "Uniform": from wx_emitter_uniforms.
+/// around `dir`. The start (and a point or hemisphere emitter's direction) from
+/// wx_emitter_uniforms; a box's direction from the particle's random numbers.
 void wx_emitter_sample(const wx_emitter *e, uint64_t seed, uint64_t id, float pos[3],
                        float vel[3]);
 
