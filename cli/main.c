@@ -517,10 +517,11 @@ static void print_texture(const wx_scene *scene, const wx_texture_map *t, const 
     } else {
         double n = (double)w * (double)h;
         printf("    coverage: about %.1f%% of the texels covered, %.2f%% overlapping, %.1f%% "
-               "padding (on %d x %d); %lld of %lld triangles reach outside the [0,1] tile\n",
+               "padding (on %d x %d); %lld of %lld triangles reach outside the [0,1] tile; "
+               "%lld without usable UVs\n",
                100.0 * (double)r.covered / n, 100.0 * (double)r.overlapping / n,
                100.0 * (double)r.padded / n, w, h, (long long)r.triangles_outside,
-               (long long)mesh->triangle_count);
+               (long long)mesh->triangle_count, (long long)r.triangles_unusable);
         wx_uv_raster_free(&r);
     }
     int64_t input_texels = 0;

@@ -56,21 +56,75 @@ static bool in_tile(const float *uv)
     return uv[0] >= 0.0f && uv[0] <= 1.0f && uv[1] >= 0.0f && uv[1] <= 1.0f;
 }
 
+// Whether the triangle's corners span an area in 3D.
+static bool has_area(const wx_mesh_data *mesh, const uint32_t *idx)
+{
+    const float *a = &mesh->positions[3 * (size_t)idx[0]];
+    const float *b = &mesh->positions[3 * (size_t)idx[1]];
+    const float *c = &mesh->positions[3 * (size_t)idx[2]];
+    double e1[3], e2[3];
+    for (int k = 0; k < 3; ++k) {
+        e1[k] = (double)b[k] - a[k];
+        e2[k] = (double)c[k] - a[k];
+    }
+    double n[3] = { e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                    e1[0] * e2[1] - e1[1] * e2[0] };
+    return n[0] != 0.0 || n[1] != 0.0 || n[2] != 0.0;
+}
+
+static bool far_uv(const float *uv)
+{
+    return !(fabsf(uv[0]) <= WX_UV_FAR && fabsf(uv[1]) <= WX_UV_FAR);
+}
+
+// The columns of row y where the centre may be inside edge a -> b of a
+// positively oriented triangle, widened by what rounding can move: [*lo, *hi]
+// narrowed to them. The exact test (edge, inside) decides within.
+static void edge_span(point2 a, point2 b, double y, double *lo, double *hi)
+{
+    double dy = b.y - a.y, dx = b.x - a.x;
+    if (dy == 0.0) {
+        if (dx * (y - a.y) < 0.0) {
+            *hi = -1.0; // the whole row is outside this edge
+        }
+        return;
+    }
+    double x = a.x + dx * (y - a.y) / dy; // where the edge crosses the row
+    double slack = 2.0 + 1e-12 * (fabs(x) + fabs(a.x) + fabs(b.x) +
+                                  fabs(dx) * (fabs(y) + fabs(a.y) + fabs(b.y)) / fabs(dy));
+    if (dy > 0.0) {
+        *hi = fmin(*hi, x + slack); // inside: left of the crossing
+    } else {
+        *lo = fmax(*lo, x - slack);
+    }
+}
+
 static void raster_triangle(const wx_mesh_data *mesh, const float *uvs, int32_t tri,
                             wx_uv_raster *r, unsigned char *count)
 {
     const uint32_t *idx = &mesh->indices[3 * (size_t)tri];
     point2 p[3];
-    bool outside = false;
+    bool outside = false, far = false, finite = true;
     for (int k = 0; k < 3; ++k) {
         const float *uv = &uvs[2 * (size_t)idx[k]];
         p[k] = texel_of(uv, r->width, r->height);
         outside = outside || !in_tile(uv);
+        finite = finite && isfinite(uv[0]) && isfinite(uv[1]);
+        far = far || far_uv(uv);
+    }
+    if (!finite) {
+        r->triangles_unusable++;
+        return;
     }
     r->triangles_outside += outside;
+    if (far) {
+        return; // no texel position survives in float that far out (texture.h)
+    }
     double area = edge(p[0], p[1], p[2]);
     if (!(area != 0.0) || !isfinite(area)) {
         r->triangles_degenerate++;
+        // A triangle with a surface but no extent in UV can hold no texel.
+        r->triangles_unusable += mesh->positions != NULL && has_area(mesh, idx);
         return;
     }
     if (area < 0.0) {
@@ -78,12 +132,31 @@ static void raster_triangle(const wx_mesh_data *mesh, const float *uvs, int32_t 
         p[1] = p[2];
         p[2] = t;
     }
+    // The texel centres of the bounding box within the tile, clamped in double
+    // before any cast.
     double x0 = fmin(p[0].x, fmin(p[1].x, p[2].x)), x1 = fmax(p[0].x, fmax(p[1].x, p[2].x));
     double y0 = fmin(p[0].y, fmin(p[1].y, p[2].y)), y1 = fmax(p[0].y, fmax(p[1].y, p[2].y));
-    int i0 = (int)fmax(0.0, ceil(x0)), i1 = (int)fmin(r->width - 1.0, floor(x1));
-    int j0 = (int)fmax(0.0, ceil(y0)), j1 = (int)fmin(r->height - 1.0, floor(y1));
+    x0 = fmax(0.0, ceil(x0));
+    x1 = fmin(r->width - 1.0, floor(x1));
+    y0 = fmax(0.0, ceil(y0));
+    y1 = fmin(r->height - 1.0, floor(y1));
+    if (!(x0 <= x1 && y0 <= y1)) {
+        return;
+    }
+    const int j0 = (int)y0, j1 = (int)y1;
     for (int j = j0; j <= j1; ++j) {
-        for (int i = i0; i <= i1; ++i) {
+        // Only the columns near the triangle's span of this row are tested, so
+        // a long thin triangle costs its rows, not its bounding box.
+        double lo = x0, hi = x1;
+        edge_span(p[1], p[2], j, &lo, &hi);
+        edge_span(p[2], p[0], j, &lo, &hi);
+        edge_span(p[0], p[1], j, &lo, &hi);
+        lo = fmax(x0, ceil(lo));
+        hi = fmin(x1, floor(hi));
+        if (!(lo <= hi)) {
+            continue;
+        }
+        for (int i = (int)lo; i <= (int)hi; ++i) {
             point2 c = { i, j };
             if (!inside(edge(p[1], p[2], c), p[1], p[2]) ||
                 !inside(edge(p[2], p[0], c), p[2], p[0]) ||

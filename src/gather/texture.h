@@ -38,11 +38,25 @@ typedef struct wx_uv_raster {
     int64_t padded;            ///< texels that take a neighbour's values
     int64_t triangles_outside; ///< triangles reaching outside the [0,1]^2 tile
     int64_t triangles_degenerate; ///< triangles of zero area in UV (never cover a texel)
+    /// Triangles with no usable UVs: a UV that is not a finite number, or no
+    /// area in UV for a triangle that has one in 3D (Assimp gives an OBJ face
+    /// without `vt` (0, 0) at every corner, and reads `vt nan nan` as 0 0).
+    int64_t triangles_unusable;
 } wx_uv_raster;
+
+/// A UV farther than this from 0 (in either coordinate) puts its triangle
+/// outside the tile without drawing it: float holds no position within a tile
+/// finer than 1/128 there, and a triangle reaching that far from the tile
+/// crosses it as a sliver (its texel coordinates would pass 2^31 at the
+/// largest size). The triangle counts among triangles_outside.
+#define WX_UV_FAR 65536.0f
 
 /// Rasterises UV channel `uv` of `mesh` (which must hold it, with positions,
 /// normals and indices) into a width x height raster with `padding` texels of
-/// bleed (0: none). Overlaps go to the triangle of lowest index. WX_FAIL when
+/// bleed (0: none). Overlaps go to the triangle of lowest index. Any UV is
+/// safe: texel indices are clamped in double before a cast, and a triangle
+/// costs the rows it spans within the tile and the texels near its edges, so
+/// the time is bounded by triangles x height + covered texels. WX_FAIL when
 /// out of memory; WX_BAD_ARGUMENT when the channel is missing.
 wx_result wx_uv_raster_build(const wx_mesh_data *mesh, int uv, int width, int height,
                              int padding, wx_uv_raster *out, wx_error *err);

@@ -119,6 +119,14 @@ wx_result wx_textures_prepare(const wx_scene *scene, const wx_geometry *geometry
                     scene->path, def->line, def->file, (long long)ras->triangles_outside,
                     (long long)t->mesh.triangle_count);
         }
+        if (ras->triangles_unusable > 0) {
+            wx_warn(opts->quiet,
+                    "%s:%d: texture %s: %lld of %lld triangles have no usable UVs (not finite "
+                    "numbers, or all three corners at one point or on one line in UV: an OBJ "
+                    "face without vt); they cover no texel",
+                    scene->path, def->line, def->file, (long long)ras->triangles_unusable,
+                    (long long)t->mesh.triangle_count);
+        }
         if (ras->covered == 0) {
             wx_warn(opts->quiet,
                     "%s:%d: texture %s: no texel centre lies inside a triangle of the UV layout",
