@@ -912,8 +912,9 @@ static void mesh_base(const char *path, char *out, size_t cap)
 }
 
 // The scene text for the mesh of `args`: its path written as given when
-// `as_given`, else absolute.
-static int generate(const cli_args *args, bool as_given, char **text)
+// `as_given`, else absolute; checked as the file `scene_path` (NULL: in the
+// current folder) before it is handed back.
+static int generate(const cli_args *args, bool as_given, const char *scene_path, char **text)
 {
     char mesh_ref[WX_PATH_MAX];
     if (as_given) {
@@ -926,7 +927,9 @@ static int generate(const cli_args *args, bool as_given, char **text)
                         .mesh_ref = mesh_ref,
                         .preset = args->preset,
                         .resolution = args->resolution,
-                        .unit_m = args->units != NULL ? wx_unit_metres(args->units) : 1.0 };
+                        .unit_m = args->units != NULL ? wx_unit_metres(args->units) : 1.0,
+                        .scene_path = scene_path,
+                        .quiet = args->quiet };
     wx_error err;
     wx_result r = wx_scene_generate(&def, text, &err);
     if (r != WX_OK) {
@@ -973,24 +976,25 @@ static int command_init(const cli_args *args)
     // current folder and the path is relative, else absolute.
     bool as_given = strchr(scene_path, '/') == NULL && args->scene_path[0] != '/';
     char *text = NULL;
-    int status = generate(args, as_given, &text);
+    int status = generate(args, as_given, scene_path, &text);
     if (status != WX_OK) {
         return status;
     }
+    // What the scene says, read as a run will read it, before it is written
+    // (generate checked it already: nothing that does not load is written).
+    wx_scene scene;
     wx_error err;
-    wx_result r = wx_write_file_atomic(scene_path, text, strlen(text), &err);
+    wx_result r = wx_scene_load_text(scene_path, text, strlen(text), &scene, &err);
+    if (r == WX_OK) {
+        r = wx_write_file_atomic(scene_path, text, strlen(text), &err);
+        if (r != WX_OK) {
+            wx_scene_free(&scene);
+        }
+    }
     free(text);
     if (r != WX_OK) {
         fprintf(stderr, "weathering: %s\n", err.message);
         return r;
-    }
-    // What the scene says, checked as a run would read it.
-    wx_scene scene;
-    r = wx_scene_load(scene_path, &scene, &err);
-    if (r != WX_OK) {
-        fprintf(stderr, "weathering: the generated scene does not load (a bug): %s\n",
-                err.message);
-        return WX_FAIL;
     }
     if (!args->quiet) {
         fprintf(stderr,
@@ -1019,7 +1023,7 @@ static int command_run(const cli_args *args)
         snprintf(out_dir, sizeof out_dir, "out/%s", base);
     }
     char *text = NULL;
-    int status = generate(args, false, &text);
+    int status = generate(args, false, NULL, &text);
     if (status != WX_OK) {
         return status;
     }

@@ -256,18 +256,17 @@ static wx_result read_file(const char *path, char **text, size_t *size, wx_error
     return WX_OK;
 }
 
-static wx_result read_document(const char *path, xmlDocPtr *out, wx_error *err)
+// Parses the text of the scene file `path` (the text is the caller's).
+static wx_result parse_document(const char *path, const char *text, size_t size,
+                                xmlDocPtr *out, wx_error *err)
 {
     *out = NULL;
-    char *text;
-    size_t size;
-    wx_result r = read_file(path, &text, &size, err);
-    if (r != WX_OK) {
-        return r;
+    if (size > (size_t)SCENE_MAX_BYTES) {
+        return wx_fail(err, WX_CAUSE_TOO_MANY, "%s: scene file too large (over %ld bytes)", path,
+                       SCENE_MAX_BYTES);
     }
     xmlParserCtxtPtr ctxt = xmlNewParserCtxt();
     if (ctxt == NULL) {
-        free(text);
         return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "%s: out of memory", path);
     }
     xml_errors st = { 0 };
@@ -281,7 +280,6 @@ static wx_result read_document(const char *path, xmlDocPtr *out, wx_error *err)
     bool well_formed = ctxt->wellFormed != 0;
     xmlSetStructuredErrorFunc(old_context, old_handler);
     xmlFreeParserCtxt(ctxt);
-    free(text);
     if (st.set || doc == NULL || !well_formed) {
         xmlFreeDoc(doc);
         if (st.set) {
@@ -291,6 +289,19 @@ static wx_result read_document(const char *path, xmlDocPtr *out, wx_error *err)
     }
     *out = doc;
     return WX_OK;
+}
+
+static wx_result read_document(const char *path, xmlDocPtr *out, wx_error *err)
+{
+    *out = NULL;
+    char *text;
+    size_t size;
+    wx_result r = read_file(path, &text, &size, err);
+    if (r == WX_OK) {
+        r = parse_document(path, text, size, out, err);
+        free(text);
+    }
+    return r;
 }
 
 // ---------------------------------------------------------------------------
@@ -2961,13 +2972,16 @@ static wx_result scene_init(wx_scene *s, const char *path, wx_error *err)
     return WX_OK;
 }
 
-wx_result wx_scene_load(const char *path, wx_scene *out, wx_error *err)
+// Loads the scene `path` from `text` (read from the file when NULL).
+static wx_result load(const char *path, const char *text, size_t size, wx_scene *out,
+                      wx_error *err)
 {
     memset(out, 0, sizeof *out);
     wx_result r = scene_init(out, path, err);
     xmlDocPtr doc = NULL;
     if (r == WX_OK) {
-        r = read_document(path, &doc, err);
+        r = text != NULL ? parse_document(path, text, size, &doc, err)
+                         : read_document(path, &doc, err);
     }
     if (r == WX_OK) {
         // Numbers are read with '.' as the decimal point whatever the locale.
@@ -2985,4 +2999,15 @@ wx_result wx_scene_load(const char *path, wx_scene *out, wx_error *err)
         wx_scene_free(out);
     }
     return r;
+}
+
+wx_result wx_scene_load(const char *path, wx_scene *out, wx_error *err)
+{
+    return load(path, NULL, 0, out, err);
+}
+
+wx_result wx_scene_load_text(const char *path, const char *text, size_t size, wx_scene *out,
+                             wx_error *err)
+{
+    return load(path, text, size, out, err);
 }

@@ -14,4 +14,10 @@
 /// to free) and err holds "path:LINE: message" (WX_BAD_INPUT) or an I/O error.
 wx_result wx_scene_load(const char *path, wx_scene *out, wx_error *err);
 
+/// wx_scene_load of `size` bytes of `text` as if they were the file `path`,
+/// which need not exist: its folder resolves relative paths, messages name it.
+/// What `init` checks before it writes a generated scene.
+wx_result wx_scene_load_text(const char *path, const char *text, size_t size, wx_scene *out,
+                             wx_error *err);
+
 #endif
