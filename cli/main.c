@@ -718,6 +718,10 @@ static int command_info(const cli_args *args)
             }
         }
     }
+    if (imported) {
+        // Cameras that would bake nothing (a mesh without thickness, edge-on).
+        wx_geometry_warn_blind(&scene, &geometry, scene.path, args->quiet);
+    }
     for (int t = 0; t < scene.texture_count; ++t) {
         print_texture(&scene, &scene.textures[t], &geometry.meshes[scene.textures[t].mesh].data);
     }

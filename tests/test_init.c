@@ -279,6 +279,28 @@ TEST(init_makes_a_valid_scene_or_refuses_the_mesh)
     }
 }
 
+// A mesh with no thickness along an axis (every vertex at z = 0) is seen
+// edge-on by the cameras along the other axes: they record no surface, so
+// the collider lets every particle through and the run is all zero. `init`
+// and `info` used to say nothing; both warn now, naming the cameras and the
+// flat axis. A solid mesh gets no such warning.
+TEST(a_mesh_without_thickness_is_warned_about)
+{
+    const char *dir = ensure_tmpdir();
+    ensure_write_file(dir, "sheet.obj",
+                      "v -1 0 0\nv 1 0 0\nv 1 2 0\nv -1 2 0\nf 1 2 3\nf 1 3 4\n");
+    ENSURE(run_in(dir, "init sheet.obj%s%s", "", "") == 0);
+    const char *warning = "cameras 'left', 'right' and 'top' record no surface";
+    ENSURE(strstr(out, warning) != NULL);
+    ENSURE(strstr(out, "has no thickness along Z (every vertex at z = 0)") != NULL);
+    ENSURE(run_in(dir, "info sheet.xml%s%s", "", "") == 0);
+    ENSURE(strstr(out, "weathering: warning: sheet.xml: ") != NULL && strstr(out, warning));
+    ENSURE(run_in(dir, "init '%s' -o cube.xml%s", data_file("texture_cube.obj"), "") == 0);
+    ENSURE(strstr(out, "record no surface") == NULL);
+    ENSURE(run_in(dir, "info cube.xml%s%s", "", "") == 0);
+    ENSURE(strstr(out, "record no surface") == NULL);
+}
+
 int main(void)
 {
     RUN(presets_make_valid_scenes_and_rain_dirties_the_top);
@@ -286,5 +308,6 @@ int main(void)
     RUN(run_a_mesh_and_split_its_texture);
     RUN(bad_input_is_exit_2);
     RUN(init_makes_a_valid_scene_or_refuses_the_mesh);
+    RUN(a_mesh_without_thickness_is_warned_about);
     return ensure_summary();
 }

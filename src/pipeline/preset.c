@@ -9,7 +9,9 @@
 
 #include "io/mesh_import.h"
 #include "io/scene_xml.h"
+#include "model/geometry.h"
 #include "model/mesh.h"
+#include "pipeline/bake_phase.h"
 
 const char *const wx_preset_names[] = { "rain", "dust", "soot", "moss" };
 const int wx_preset_count = 4;
@@ -508,6 +510,11 @@ static wx_result generate(const wx_init_def *def, const preset *p, int pi,
                        def->mesh_path, lo[0], lo[1], lo[2], hi[0], hi[1], hi[2],
                        load_err.message);
     }
+    // A mesh the generated cameras see edge-on (no thickness along an axis)
+    // gets its scene, with the warning that its run will be all zero.
+    wx_geometry_mesh one = { .data = *mesh };
+    wx_geometry geometry = { .count = 1, .meshes = &one };
+    wx_geometry_warn_blind(&scene, &geometry, def->mesh_path, def->quiet);
     wx_scene_free(&scene);
     *out_text = t.s;
     return WX_OK;

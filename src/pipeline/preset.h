@@ -48,7 +48,8 @@ double wx_unit_metres(const char *name);
 /// too large (WX_INIT_MIN_SIZE, WX_INIT_MAX_SIZE) or lies too far from the
 /// origin for its size (floats there more than a quarter of a camera
 /// texel apart), or when the scene check refuses the scene for any other
-/// reason.
+/// reason. Warns (unless def->quiet) when the generated cameras would see the
+/// mesh edge-on (wx_geometry_warn_blind).
 wx_result wx_scene_generate(const wx_init_def *def, char **text, wx_error *err);
 
 #endif
