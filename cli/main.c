@@ -728,10 +728,10 @@ static int command_info(const cli_args *args)
     // The pilot uses the geometry up (its arrays go to the renderer).
     wx_pilot_report pilot;
     wx_error pilot_err;
+    wx_memory_need need;
+    wx_memory_estimate_geometry(&scene, WX_PHASE_ALL, imported ? &geometry : NULL, &need);
     wx_result pilot_r = wx_pilot_run(&scene, &opts, &geometry, &pilot, &pilot_err);
     wx_geometry_free(&geometry);
-    wx_memory_need need;
-    wx_memory_estimate(&scene, WX_PHASE_ALL, &need);
     double available = wx_memory_available();
     const double mib = 1024.0 * 1024.0;
     char frame[96] = "";
@@ -740,11 +740,12 @@ static int command_info(const cli_args *args)
                  need.frame_bytes / mib);
     }
     printf("memory: about %.0f MiB at the peak (the %s: program %.0f, bake %.0f with %.0f for "
-           "the meshes, simulation %.0f with %.0f for %lld particles if all were alive at "
-           "once%s, gather %.0f; MiB)",
+           "the meshes, simulation %.0f with %.0f for at most %.0f particles alive at once of "
+           "%.0f emitted%s, gather %.0f; MiB)",
            need.total_bytes / mib, need.phase, need.baseline_bytes / mib, need.bake_bytes / mib,
            need.mesh_bytes / mib, (need.sim_map_bytes + need.particle_bytes) / mib,
-           need.particle_bytes / mib, (long long)need.particles, frame, need.gather_bytes / mib);
+           need.particle_bytes / mib, need.particles_alive, need.particles, frame,
+           need.gather_bytes / mib);
     if (available >= 0.0) {
         printf(" of %.0f MiB available%s", available / (1024.0 * 1024.0),
                need.total_bytes > available ? ": too much, a run would be refused" : "");

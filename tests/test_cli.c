@@ -182,7 +182,7 @@ TEST(info_lists_substances_loads_exchanges_and_rules)
                                 "'mask.0002.exr' to 'mask.0004.exr', one after every 2 "
                                 "iterations\n"));
     // The memory estimate counts the particles of every iteration and the frames.
-    ENSURE(ensure_contains(out, "for 2000 particles if all were alive at once and "));
+    ENSURE(ensure_contains(out, "for at most 2000 particles alive at once of 2000 emitted and "));
     ENSURE(ensure_contains(out, "for a frame of the mask's sequence"));
 }
 
