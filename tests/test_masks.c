@@ -472,7 +472,8 @@ TEST(huge_curvature_radius_is_the_largest_window)
     const double R = 1.0, frame = 2.4 * R, texel = frame / px;
     char masks[512];
     snprintf(masks, sizeof masks,
-             "<Curvature name=\"huge\" radius=\"1e30\"/><Curvature name=\"window\" radius=\"%.9g\"/>"
+             "<Curvature name=\"huge\" radius=\"1e30\"/>"
+             "<Curvature name=\"window\" radius=\"%.9g\"/>"
              "<Curvature name=\"one\" radius=\"%.9g\"/>",
              10.0, 1.0 * texel);
     char mesh[PATH_MAX + 32];

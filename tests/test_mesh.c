@@ -843,7 +843,8 @@ TEST(a_fan_of_many_faces_smooths_in_bounded_time)
         double mx = 0.5 * ((double)b[0] + c[0]) + m.origin[0];
         double mz = 0.5 * ((double)b[2] + c[2]) + m.origin[2];
         double horizontal = sqrt((double)n[0] * n[0] + (double)n[2] * n[2]);
-        double cosine = ((double)n[0] * mx + (double)n[2] * mz) / (horizontal * sqrt(mx * mx + mz * mz));
+        double cosine =
+            ((double)n[0] * mx + (double)n[2] * mz) / (horizontal * sqrt(mx * mx + mz * mz));
         ENSURE(n[1] > 0.0f && cosine > cos(10.0 * 3.14159265358979 / 180.0));
         ENSURE_NEAR((double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2], 1.0, 1e-5);
         tips++;

@@ -674,8 +674,9 @@ TEST(huge_uvs_end_info_and_run)
     ENSURE(weathering_in(dir, "init far.obj --resolution 1024", true) == 0);
     char build[PATH_MAX];
     ENSURE(realpath(ensure_build_dir(), build) != NULL);
-    ENSURE(ensure_shell(out, sizeof out, "cd '%s' && timeout 120 '%s/weathering' info far.xml 2>&1",
-                        dir, build) == 0);
+    ENSURE(ensure_shell(out, sizeof out,
+                        "cd '%s' && timeout 120 '%s/weathering' info far.xml 2>&1", dir,
+                        build) == 0);
     ENSURE(strstr(out, "4 of 4 triangles reach outside the [0,1] tile") != NULL);
     ENSURE(ensure_shell(out, sizeof out,
                         "cd '%s' && timeout 300 '%s/weathering' run far.xml --out far 2>&1", dir,

@@ -758,7 +758,8 @@ static bool same_vertex(const struct aiMesh *mesh, unsigned a, unsigned b, unsig
             return false;
         }
     }
-    return mesh->mColors[0] == NULL || same_floats(&mesh->mColors[0][a].r, &mesh->mColors[0][b].r, 4);
+    return mesh->mColors[0] == NULL ||
+           same_floats(&mesh->mColors[0][a].r, &mesh->mColors[0][b].r, 4);
 }
 
 // Numbers the corners of `mesh`'s triangles by joined vertex (see above).
@@ -782,8 +783,9 @@ static bool prepare_mesh(const struct aiMesh *mesh, unsigned uv_channels, mesh_p
     }
     const size_t corners = 3 * tris;
     uint32_t *tri_face = malloc(tris * sizeof *tri_face);
-    float *normal = mesh->mNormals == NULL ? malloc(3 * (size_t)mesh->mNumVertices * sizeof *normal)
-                                           : NULL;
+    float *normal = mesh->mNormals == NULL
+                        ? malloc(3 * (size_t)mesh->mNumVertices * sizeof *normal)
+                        : NULL;
     out->corner = malloc(corners * sizeof *out->corner);
     out->source = malloc(corners * sizeof *out->source);
     out->normal = malloc(3 * corners * sizeof *out->normal);
