@@ -677,6 +677,15 @@ TEST(formats_without_a_unit_are_left_as_they_are)
 
 // --- import time (issue 24 item 8) ------------------------------------------------------
 
+// Seconds of a time bound: ten times longer under AddressSanitizer, whose
+// instrumentation slows Assimp's parsing several times (the old import's
+// quadratic steps stay far beyond it either way).
+#ifdef WX_ASAN
+#define TIME_SCALE 10.0
+#else
+#define TIME_SCALE 1.0
+#endif
+
 // An OBJ of about `bytes` whose faces join three of eight positions (the
 // corners of a unit cube) at random; with `uvs`, each face has a texture
 // coordinate of its own at its first corner, so no two corners share every
@@ -754,7 +763,7 @@ TEST(faces_on_few_positions_import_in_linear_time)
             double seconds = import_seconds(path, u == 1 ? 1u : 0u, &triangles);
             printf("        %s: %lld triangles in %.2f s\n", name, (long long)triangles, seconds);
             ENSURE(triangles > sizes[k] / 40);
-            ENSURE(seconds < bounds[k]);
+            ENSURE(seconds < TIME_SCALE * bounds[k]);
         }
     }
     alarm(0);
@@ -795,13 +804,13 @@ TEST(a_huge_polygon_is_refused_at_once)
                      "vertices); triangulate the mesh in the program that made it",
                      sides[k]);
             ENSURE(refused_with(path, WX_CAUSE_TOO_MANY, rest));
-            ENSURE(wx_now_s() - t0 < 2.0);
+            ENSURE(wx_now_s() - t0 < TIME_SCALE * 2.0);
         } else {
             int64_t triangles = 0;
             double seconds = import_seconds(path, 1u, &triangles);
             printf("        %d-gon: %lld triangles in %.2f s\n", sides[k], (long long)triangles,
                    seconds);
-            ENSURE(triangles == sides[k] - 2 && seconds < 5.0);
+            ENSURE(triangles == sides[k] - 2 && seconds < TIME_SCALE * 5.0);
         }
     }
     alarm(0);
@@ -831,7 +840,7 @@ TEST(a_fan_of_many_faces_smooths_in_bounded_time)
     wx_error err = { 0 };
     double t0 = wx_now_s();
     ENSURE(wx_mesh_import(path, &m, &err) == WX_OK);
-    ENSURE(wx_now_s() - t0 < 5.0);
+    ENSURE(wx_now_s() - t0 < TIME_SCALE * 5.0);
     ENSURE(m.triangle_count == SIDES);
     int tips = 0;
     for (int64_t t = 0; t < m.triangle_count; ++t) {
