@@ -597,10 +597,7 @@ static void print_texture(const wx_scene *scene, const wx_texture_map *t, const 
                    t->tiles == WX_TILES_UDIM   ? "the UDIM tiles 1001 to 2000 (not written)"
                    : t->tiles == WX_TILES_CLIP ? "the [0,1] tile (not written)"
                                                : "the [0,1] tile (they wrap, as REPEAT reads them)");
-            if (r.triangles_unusable > 0) {
-                printf("; %lld left out (a UV not finite%s)", (long long)r.triangles_unusable,
-                       t->tiles == WX_TILES_CLIP ? "" : " or over 64 UV tiles");
-            }
+            printf("; %lld without usable UVs", (long long)r.triangles_unusable);
         }
         printf("\n");
         wx_uv_raster_free(&r);
@@ -809,16 +806,20 @@ static int command_info(const cli_args *args)
             }
         }
     }
+    if (imported) {
+        // Cameras that would bake nothing (a mesh without thickness, edge-on).
+        wx_geometry_warn_blind(&scene, &geometry, scene.path, args->quiet);
+    }
     for (int t = 0; t < scene.texture_count; ++t) {
         print_texture(&scene, &scene.textures[t], &geometry.meshes[scene.textures[t].mesh].data);
     }
     // The pilot uses the geometry up (its arrays go to the renderer).
     wx_pilot_report pilot;
     wx_error pilot_err;
+    wx_memory_need need;
+    wx_memory_estimate_geometry(&scene, WX_PHASE_ALL, imported ? &geometry : NULL, &need);
     wx_result pilot_r = wx_pilot_run(&scene, &opts, &geometry, &pilot, &pilot_err);
     wx_geometry_free(&geometry);
-    wx_memory_need need;
-    wx_memory_estimate(&scene, WX_PHASE_ALL, &need);
     double available = wx_memory_available();
     const double mib = 1024.0 * 1024.0;
     char frame[96] = "";
@@ -827,11 +828,12 @@ static int command_info(const cli_args *args)
                  need.frame_bytes / mib);
     }
     printf("memory: about %.0f MiB at the peak (the %s: program %.0f, bake %.0f with %.0f for "
-           "the meshes, simulation %.0f with %.0f for %lld particles if all were alive at "
-           "once%s, gather %.0f; MiB)",
+           "the meshes, simulation %.0f with %.0f for at most %.0f particles alive at once of "
+           "%.0f emitted%s, gather %.0f; MiB)",
            need.total_bytes / mib, need.phase, need.baseline_bytes / mib, need.bake_bytes / mib,
            need.mesh_bytes / mib, (need.sim_map_bytes + need.particle_bytes) / mib,
-           need.particle_bytes / mib, (long long)need.particles, frame, need.gather_bytes / mib);
+           need.particle_bytes / mib, need.particles_alive, need.particles, frame,
+           need.gather_bytes / mib);
     if (available >= 0.0) {
         printf(" of %.0f MiB available%s", available / (1024.0 * 1024.0),
                need.total_bytes > available ? ": too much, a run would be refused" : "");
@@ -1013,8 +1015,11 @@ static bool is_scene_file(const char *path)
 }
 
 // The scene text for the mesh of `args`: its path written as given when
-// `as_given`, else absolute; `scene_name` (may be NULL) becomes <Weathering name>.
-static int generate(const cli_args *args, bool as_given, const char *scene_name, char **text)
+// `as_given`, else absolute; `scene_name` (may be NULL) becomes <Weathering
+// name>; checked as the file `scene_path` (NULL: in the current folder)
+// before it is handed back.
+static int generate(const cli_args *args, bool as_given, const char *scene_name,
+                    const char *scene_path, char **text)
 {
     char mesh_ref[WX_PATH_MAX];
     if (as_given) {
@@ -1029,6 +1034,7 @@ static int generate(const cli_args *args, bool as_given, const char *scene_name,
                         .resolution = args->resolution,
                         .unit_m = args->units != NULL ? wx_unit_metres(args->units) : 1.0,
                         .scene_name = scene_name,
+                        .scene_path = scene_path,
                         .quiet = args->quiet };
     wx_error err;
     wx_result r = wx_scene_generate(&def, text, &err);
@@ -1098,25 +1104,24 @@ static int command_init(const cli_args *args)
     // current folder and the path is relative, else absolute.
     bool as_given = strchr(scene_path, '/') == NULL && args->scene_path[0] != '/';
     char *text = NULL;
-    status = generate(args, as_given, NULL, &text);
+    status = generate(args, as_given, NULL, scene_path, &text);
     if (status != WX_OK) {
         return status;
     }
-    // What the scene says, checked as a run would read it, before it is written.
-    wx_error err;
+    // What the scene says, read as a run will read it, before it is written
+    // (generate checked it already: nothing that does not load is written).
     wx_scene scene;
+    wx_error err;
     wx_result r = wx_scene_load_text(scene_path, text, strlen(text), &scene, &err);
-    if (r != WX_OK) {
-        fprintf(stderr, "weathering: the generated scene does not load (a bug): %s\n",
-                err.message);
-        free(text);
-        return WX_FAIL;
+    if (r == WX_OK) {
+        r = wx_write_file_atomic(scene_path, text, strlen(text), &err);
+        if (r != WX_OK) {
+            wx_scene_free(&scene);
+        }
     }
-    r = wx_write_file_atomic(scene_path, text, strlen(text), &err);
     free(text);
     if (r != WX_OK) {
         fprintf(stderr, "weathering: %s\n", err.message);
-        wx_scene_free(&scene);
         return r;
     }
     if (!args->quiet) {
@@ -1145,12 +1150,12 @@ static int command_run(const cli_args *args)
     } else {
         snprintf(out_dir, sizeof out_dir, "out/%s", base);
     }
+    snprintf(scene_path, sizeof scene_path, "%s/scene.xml", out_dir);
     char *text = NULL;
-    int status = generate(args, false, base, &text);
+    int status = generate(args, false, base, scene_path, &text);
     if (status != WX_OK) {
         return status;
     }
-    snprintf(scene_path, sizeof scene_path, "%s/scene.xml", out_dir);
     cli_args scene_args = *args;
     scene_args.scene_path = scene_path;
     scene_args.out_dir = out_dir;

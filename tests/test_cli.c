@@ -183,7 +183,7 @@ TEST(info_lists_substances_loads_exchanges_and_rules)
                                 "'mask.0002.exr' to 'mask.0004.exr', one after every 2 "
                                 "iterations\n"));
     // The memory estimate counts the particles of every iteration and the frames.
-    ENSURE(ensure_contains(out, "for 2000 particles if all were alive at once and "));
+    ENSURE(ensure_contains(out, "for at most 2000 particles alive at once of 2000 emitted and "));
     ENSURE(ensure_contains(out, "for a frame of the mask's sequence"));
     // What the sequence costs: 2 frames of 4 channels of 32 x 32 floats; a
     // gather of 1024 texels, 1 input camera and 4 substances at 400 ns each.
@@ -247,6 +247,34 @@ TEST(info_on_a_bad_scene_gives_file_line_and_status_2)
     ENSURE(ensure_contains(out, expected));
 }
 
+// An emitter of rate="1e300": its count overflowed the cast to int64_t (to a
+// negative number, which the memory check let through), and once that was
+// clamped, info's pilot thinned it too little and its particle arrays' size
+// wrapped: info crashed. Now info reports it too large, and run refuses it
+// before any work.
+TEST(an_absurd_emission_rate_is_refused_not_a_crash)
+{
+    const char *dir = ensure_tmpdir();
+    char args[4200], *scene = ensure_read_file("xml_scenes/thesis_box.xml");
+    ENSURE(scene != NULL);
+    char *rate = strstr(scene, "rate=\"");
+    ENSURE(rate != NULL);
+    char *end = strchr(rate + 6, '"');
+    static char text[65536];
+    snprintf(text, sizeof text, "%.*srate=\"1e300%s", (int)(rate - scene), scene, end);
+    free(scene);
+    // The thesis box's maps are ../maps/ of its scene.
+    char sub[4200];
+    snprintf(sub, sizeof sub, "%s/flood", dir);
+    ENSURE(ensure_shell(out, sizeof out, "mkdir -p '%s' && cp -r maps '%s/'", sub, dir) == 0);
+    const char *path = ensure_write_file(sub, "flood.xml", text);
+    snprintf(args, sizeof args, "info %s", path);
+    ENSURE(weathering(args) == 0);
+    ENSURE(ensure_contains(out, "too much, a run would be refused"));
+    snprintf(args, sizeof args, "run %s --out %s/flood -q", path, dir);
+    ENSURE(weathering(args) == 2);
+    ENSURE(ensure_contains(out, "would emit 9.223e+18 particles"));
+}
 
 // The build folder as an absolute path (the tests below change folders).
 static const char *build_dir(void)
@@ -507,6 +535,7 @@ int main(void)
     RUN(info_lists_substances_loads_exchanges_and_rules);
     RUN(info_estimates_a_sequence_of_100000_frames);
     RUN(info_on_a_bad_scene_gives_file_line_and_status_2);
+    RUN(an_absurd_emission_rate_is_refused_not_a_crash);
     RUN(stats_never_overwrites_anything);
     RUN(stale_cleanup_and_default_folder_stay_in_their_place);
     RUN(overlong_paths_are_refused);

@@ -39,6 +39,13 @@ TEST(emission_count_is_floor_of_rate_times_time)
     ENSURE(wx_emitter_count_at(&slow, 0.1) == 33);  // 33.3
     ENSURE(wx_emitter_count_at(&slow, 0.3) == 99);  // 99.9
     ENSURE(wx_emitter_count_at(&slow, 1.0) == 333);
+    // Beyond int64_t: the most there is, never a negative count (the cast of
+    // 1e300 overflowed to INT64_MIN, and the memory check passed a run of
+    // -9.2e18 particles).
+    wx_emitter flood = point_emitter(1e300, 0, 1.0, 1);
+    ENSURE(wx_emitter_count_at(&flood, 0.5) == INT64_MAX);
+    flood.rate = 1e19;
+    ENSURE(wx_emitter_count_at(&flood, 1.0) == INT64_MAX);
 }
 
 // The simulation emits exactly that many, step after step.

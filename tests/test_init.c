@@ -376,6 +376,104 @@ TEST(init_never_writes_over_the_mesh_and_checks_its_target)
     free(mesh);
 }
 
+// A tetrahedron with corners at the origin and at `size` along each axis,
+// offset by (ox, oy, oz).
+static void write_tetrahedron(const char *dir, const char *name, double size, double ox,
+                              double oy, double oz)
+{
+    char text[1024];
+    snprintf(text, sizeof text,
+             "v %.17g %.17g %.17g\nv %.17g %.17g %.17g\nv %.17g %.17g %.17g\n"
+             "v %.17g %.17g %.17g\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n",
+             ox, oy, oz, ox + size, oy, oz, ox, oy + size, oz, ox, oy, oz + size);
+    ensure_write_file(dir, name, text);
+}
+
+// Whether `dir` holds no file but the meshes (*.obj).
+static bool only_meshes_in(const char *dir)
+{
+    char listing[4096];
+    ensure_shell(listing, sizeof listing, "cd '%s' && ls -A | grep -v '\\.obj$'", dir);
+    return listing[0] == '\0';
+}
+
+// `init` used to exit 1 "the generated scene does not load (a bug)" and leave
+// that scene behind for meshes at 1e30, 3e38 or 1e-30 across, a 1 m model at
+// UTM coordinates, and a mesh whose file name breaks the XML (a "--" in the
+// header comment, Latin-1 bytes in the path). Now each one either gets a
+// scene that loads, or is refused with exit 2 naming the mesh, and no file is
+// written; the scene is checked in memory before it is written.
+TEST(init_makes_a_valid_scene_or_refuses_the_mesh)
+{
+    static char dir[PATH_MAX];
+    snprintf(dir, sizeof dir, "%s/refuse", ensure_tmpdir());
+    ENSURE(ensure_shell(out, sizeof out, "mkdir -p '%s'", dir) == 0);
+    write_tetrahedron(dir, "huge.obj", 1e30, 0, 0, 0);
+    write_tetrahedron(dir, "max.obj", 3e38, -1.5e38, 0, 0);
+    write_tetrahedron(dir, "tiny.obj", 1e-30, 0, 0, 0);
+    write_tetrahedron(dir, "utm.obj", 1.0, 500000.0, 0.0, 5e6);
+    write_tetrahedron(dir, "latin\xe9.obj", 1.0, 0, 0, 0);
+    static const char *const refused[][2] = {
+        { "huge.obj", "is 1e+30 across, larger than" },
+        { "max.obj", "is 3e+38 across, larger than" },
+        { "tiny.obj", "is 1e-30 across, smaller than" },
+        { "utm.obj", "is only 1 across but has coordinates up to 5e+06" },
+        { "latin\xe9.obj", "not UTF-8 text" },
+    };
+    for (size_t k = 0; k < sizeof refused / sizeof refused[0]; ++k) {
+        char name[64];
+        snprintf(name, sizeof name, "'%s'", refused[k][0]);
+        ENSURE(run_in(dir, "init %s%s", name, "") == 2);
+        ENSURE(strstr(out, "weathering: ") == out && strchr(out, '\n') == out + strlen(out) - 1);
+        char shown[128];
+        wx_printable(refused[k][0], shown, sizeof shown);
+        ENSURE(strstr(out, shown) != NULL);
+        ENSURE(strstr(out, refused[k][1]) != NULL);
+        ENSURE(strstr(out, "a bug") == NULL);
+        ENSURE(only_meshes_in(dir));
+        // `run MESH` refuses it the same way, before making its folder.
+        ENSURE(run_in(dir, "run %s --out o -q%s", name, "") == 2);
+        ENSURE(only_meshes_in(dir));
+    }
+    // Made: "--" in the name (the header comment shows "-_"), a mesh 1e4 or
+    // 1e-5 across, a 1 m model 500 m from the origin.
+    write_tetrahedron(dir, "a--b.obj", 1.0, 0, 0, 0);
+    write_tetrahedron(dir, "wide.obj", 1e4, 0, 0, 0);
+    write_tetrahedron(dir, "small.obj", 1e-5, 0, 0, 0);
+    write_tetrahedron(dir, "near.obj", 1.0, 300.0, 0.0, 400.0);
+    static const char *const made[] = { "a--b", "wide", "small", "near" };
+    for (size_t k = 0; k < sizeof made / sizeof made[0]; ++k) {
+        ENSURE(run_in(dir, "init %s.obj -q%s", made[k], "") == 0);
+        char path[PATH_MAX + 64];
+        snprintf(path, sizeof path, "%s/%s.xml", dir, made[k]);
+        ENSURE(schema_accepts(path));
+        ENSURE(run_in(dir, "info %s.xml%s", made[k], "") == 0);
+        ENSURE(strstr(out, "every vertex lies inside an input camera's frame") != NULL);
+    }
+}
+
+// A mesh with no thickness along an axis (every vertex at z = 0) is seen
+// edge-on by the cameras along the other axes: they record no surface, so
+// the collider lets every particle through and the run is all zero. `init`
+// and `info` used to say nothing; both warn now, naming the cameras and the
+// flat axis. A solid mesh gets no such warning.
+TEST(a_mesh_without_thickness_is_warned_about)
+{
+    const char *dir = ensure_tmpdir();
+    ensure_write_file(dir, "sheet.obj",
+                      "v -1 0 0\nv 1 0 0\nv 1 2 0\nv -1 2 0\nf 1 2 3\nf 1 3 4\n");
+    ENSURE(run_in(dir, "init sheet.obj%s%s", "", "") == 0);
+    const char *warning = "cameras 'left', 'right' and 'top' record no surface";
+    ENSURE(strstr(out, warning) != NULL);
+    ENSURE(strstr(out, "has no thickness along Z (every vertex at z = 0)") != NULL);
+    ENSURE(run_in(dir, "info sheet.xml%s%s", "", "") == 0);
+    ENSURE(strstr(out, "weathering: warning: sheet.xml: ") != NULL && strstr(out, warning));
+    ENSURE(run_in(dir, "init '%s' -o cube.xml%s", data_file("texture_cube.obj"), "") == 0);
+    ENSURE(strstr(out, "record no surface") == NULL);
+    ENSURE(run_in(dir, "info cube.xml%s%s", "", "") == 0);
+    ENSURE(strstr(out, "record no surface") == NULL);
+}
+
 int main(void)
 {
     RUN(presets_make_valid_scenes_and_rain_dirties_the_top);
@@ -386,5 +484,7 @@ int main(void)
     RUN(run_mesh_folder_is_plain_and_named_after_the_mesh);
     RUN(run_mesh_keeps_a_users_scene_and_leaves_nothing_on_refusal);
     RUN(init_never_writes_over_the_mesh_and_checks_its_target);
+    RUN(init_makes_a_valid_scene_or_refuses_the_mesh);
+    RUN(a_mesh_without_thickness_is_warned_about);
     return ensure_summary();
 }

@@ -460,6 +460,42 @@ TEST(frames_copy_the_geometric_masks)
     }
 }
 
+// <Curvature radius="1e30"> overflowed the cast of its reach to int and became
+// one texel without a word: it is the largest neighbourhood (32 target texels
+// each way, docs/masks.md), so it equals a radius of 10 (533 texels, wider than
+// the unit sphere and clamped to that window too) byte for byte, and differs
+// from one texel's.
+TEST(huge_curvature_radius_is_the_largest_window)
+{
+    const char *dir = ensure_tmpdir();
+    const int px = 128;
+    const double R = 1.0, frame = 2.4 * R, texel = frame / px;
+    char masks[512];
+    snprintf(masks, sizeof masks,
+             "<Curvature name=\"huge\" radius=\"1e30\"/>"
+             "<Curvature name=\"window\" radius=\"%.9g\"/>"
+             "<Curvature name=\"one\" radius=\"%.9g\"/>",
+             10.0, 1.0 * texel);
+    char mesh[PATH_MAX + 32];
+    snprintf(mesh, sizeof mesh, "%s/sphere.ply", dir);
+    ENSURE(sphere_write_mesh_scaled(mesh, 64, 128, R));
+    write_scene(dir, "k.xml", "sphere.ply", 0.0, frame, px, masks, "", NULL);
+    ENSURE(weathering_in(dir, "run k.xml --out k -q", true) == 0);
+    char path[PATH_MAX];
+    snprintf(path, sizeof path, "%s/k/mask.exr", dir);
+    int w, h;
+    float *huge = ensure_read_channel(path, "huge.Y", &w, &h);
+    float *window = ensure_read_channel(path, "window.Y", &w, &h);
+    float *one = ensure_read_channel(path, "one.Y", &w, &h);
+    bool read = huge != NULL && window != NULL && one != NULL;
+    bool same = read && memcmp(huge, window, (size_t)w * (size_t)h * sizeof *huge) == 0;
+    bool differs = read && memcmp(huge, one, (size_t)w * (size_t)h * sizeof *huge) != 0;
+    free(huge);
+    free(window);
+    free(one);
+    ENSURE(read && same && differs);
+}
+
 int main(void)
 {
     RUN(sigmoid_and_sun_direction);
@@ -467,6 +503,7 @@ int main(void)
     RUN(floor_beside_a_wall);
     RUN(inside_a_closed_box);
     RUN(sphere_curvature_and_height);
+    RUN(huge_curvature_radius_is_the_largest_window);
     RUN(masks_in_a_texture);
     RUN(same_bytes_for_any_thread_count);
     RUN(frames_copy_the_geometric_masks);

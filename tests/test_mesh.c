@@ -12,6 +12,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "core/progress.h"
 #include "ensure.h"
 #include "model/mesh.h"
 #include "io/mesh_import.h"
@@ -594,13 +595,15 @@ TEST(out_of_memory_inside_assimp_is_a_failure_not_bad_input)
         printf("        (skipped under valgrind, which aborts when operator new fails)\n");
         return;
     }
-    // The bunny (69,451 triangles, 2.4 MB) needs about 90 MB of address space
-    // to import; with 16 MiB more than the child has, Assimp's allocations fail.
+    // The bunny (69,451 triangles, 2.4 MB) needs about 30 MB of address space
+    // to import (Assimp's reading most of it, since the import smooths and
+    // joins by itself); with 4 MiB more than the child has, Assimp's
+    // allocations fail.
     char bunny[4200];
     snprintf(bunny, sizeof bunny, "%s/../xml_scenes/meshes/stanford-bunny.obj",
              ensure_tests_dir());
     child_result res;
-    ENSURE(import_in_child(NULL, bunny, 16LL << 20, &res));
+    ENSURE(import_in_child(NULL, bunny, 4LL << 20, &res));
     ENSURE(res.code == WX_FAIL && res.cause == WX_CAUSE_OUT_OF_MEMORY);
     char want[4400];
     // What Assimp 5.2.5 reports: std::bad_alloc's what(), caught in the importer.
@@ -859,6 +862,193 @@ TEST(flat_shading_is_not_cut)
     wx_mesh_data_free(&m);
 }
 
+// --- import time (issue 24 item 8) ------------------------------------------------------
+
+// Seconds of a time bound: ten times longer under AddressSanitizer, whose
+// instrumentation slows Assimp's parsing several times (the old import's
+// quadratic steps stay far beyond it either way).
+#ifdef WX_ASAN
+#define TIME_SCALE 10.0
+#else
+#define TIME_SCALE 1.0
+#endif
+
+// An OBJ of about `bytes` whose faces join three of eight positions (the
+// corners of a unit cube) at random; with `uvs`, each face has a texture
+// coordinate of its own at its first corner, so no two corners share every
+// attribute. Assimp's smoothing with an angle and its joining compared each
+// vertex with every other at its position: 100 KB took 2.8 s, 400 KB 64 s.
+static const char *write_faces_on_few_positions(const char *dir, const char *name, long bytes,
+                                                bool uvs)
+{
+    char path[4200];
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    FILE *f = fopen(path, "w");
+    if (f == NULL) {
+        return NULL;
+    }
+    long n = 0;
+    for (int i = 0; i < 8; ++i) {
+        n += fprintf(f, "v %d %d %d\n", i & 1, (i >> 1) & 1, (i >> 2) & 1);
+    }
+    if (uvs) {
+        n += fprintf(f, "vt 0 0\nvt 1 0\n");
+    }
+    uint64_t state = 7;
+    for (long face = 0; n < bytes; ++face) {
+        int c[3];
+        for (int k = 0; k < 3; ++k) {
+            do {
+                state = state * 6364136223846793005ull + 1442695040888963407ull;
+                c[k] = 1 + (int)((state >> 33) % 8);
+            } while ((k > 0 && c[k] == c[0]) || (k > 1 && c[k] == c[1]));
+        }
+        if (uvs) {
+            n += fprintf(f, "vt %.5f %.5f\nf %d/%ld %d/1 %d/2\n", (double)(face % 997) / 997.0,
+                         (double)(face % 991) / 991.0, c[0], face + 3, c[1], c[2]);
+        } else {
+            n += fprintf(f, "f %d %d %d\n", c[0], c[1], c[2]);
+        }
+    }
+    return fclose(f) == 0 ? name : NULL;
+}
+
+// Seconds to import `path` (with the UV channels of the mask `uv_channels`),
+// its triangle count in *triangles (-1 on failure).
+static double import_seconds(const char *path, unsigned uv_channels, int64_t *triangles)
+{
+    wx_mesh_data m;
+    wx_error err = { 0 };
+    double t0 = wx_now_s();
+    wx_result r = wx_mesh_import_uvs(path, uv_channels, &m, &err);
+    double seconds = wx_now_s() - t0;
+    *triangles = r == WX_OK ? m.triangle_count : -1;
+    if (r != WX_OK) {
+        fprintf(stderr, "    %s\n", err.message);
+    }
+    wx_mesh_data_free(&m);
+    return seconds;
+}
+
+// Faces reusing a few positions import in time linear in the file: 100 KB,
+// 400 KB and 4 MB, with and without a UV of their own per face (the old
+// import: 2.8 s, 64 s, hours; with UVs 5 MB took over 100 s). Measured here
+// at 0.03, 0.06 and 0.5 s: the bound leaves room for a busy machine.
+TEST(faces_on_few_positions_import_in_linear_time)
+{
+    alarm(300);
+    const char *dir = make_dir("few_positions");
+    static const long sizes[3] = { 100000, 400000, 4000000 };
+    static const double bounds[3] = { 2.0, 2.0, 10.0 };
+    for (int u = 0; u < 2; ++u) {
+        for (int k = 0; k < 3; ++k) {
+            char name[64], path[4200];
+            snprintf(name, sizeof name, "faces_%ld_%s.obj", sizes[k], u ? "uvs" : "plain");
+            ENSURE(write_faces_on_few_positions(dir, name, sizes[k], u == 1) != NULL);
+            snprintf(path, sizeof path, "%s/%s", dir, name);
+            int64_t triangles = 0;
+            double seconds = import_seconds(path, u == 1 ? 1u : 0u, &triangles);
+            printf("        %s: %lld triangles in %.2f s\n", name, (long long)triangles, seconds);
+            ENSURE(triangles > sizes[k] / 40);
+            ENSURE(seconds < TIME_SCALE * bounds[k]);
+        }
+    }
+    alarm(0);
+}
+
+// One polygon of 32400 vertices took Assimp's triangulation about 40 s (its
+// time grows with the square of the vertices): refused at once, naming the
+// largest face. A polygon of 4096 vertices (WX_MESH_POLYGON_FREE) is still
+// triangulated, as are quads.
+TEST(a_huge_polygon_is_refused_at_once)
+{
+    alarm(120);
+    const char *dir = make_dir("polygons");
+    static const int sides[2] = { 32400, 4096 };
+    for (int k = 0; k < 2; ++k) {
+        char name[64], path[4200];
+        snprintf(name, sizeof name, "polygon_%d.obj", sides[k]);
+        snprintf(path, sizeof path, "%s/%s", dir, name);
+        FILE *f = fopen(path, "w");
+        ENSURE(f != NULL);
+        for (int i = 0; i < sides[k]; ++i) {
+            double a = 2.0 * 3.14159265358979 * i / sides[k];
+            fprintf(f, "v %.7f %.7f 0\nvt %.5f %.5f\n", cos(a), sin(a), 0.5 + 0.5 * cos(a),
+                    0.5 + 0.5 * sin(a));
+        }
+        fprintf(f, "f");
+        for (int i = 0; i < sides[k]; ++i) {
+            fprintf(f, " %d/%d", i + 1, i + 1);
+        }
+        fprintf(f, "\n");
+        ENSURE(fclose(f) == 0);
+        double t0 = wx_now_s();
+        if (k == 0) {
+            char rest[256];
+            snprintf(rest, sizeof rest,
+                     "its polygons are too large to triangulate (the largest has %d vertices; "
+                     "triangulating a face takes time growing with the square of its "
+                     "vertices); triangulate the mesh in the program that made it",
+                     sides[k]);
+            ENSURE(refused_with(path, WX_CAUSE_TOO_MANY, rest));
+            ENSURE(wx_now_s() - t0 < TIME_SCALE * 2.0);
+        } else {
+            int64_t triangles = 0;
+            double seconds = import_seconds(path, 1u, &triangles);
+            printf("        %d-gon: %lld triangles in %.2f s\n", sides[k], (long long)triangles,
+                   seconds);
+            ENSURE(triangles == sides[k] - 2 && seconds < TIME_SCALE * 5.0);
+        }
+    }
+    alarm(0);
+}
+
+// Where more than PREP_EXACT_NORMALS face normals meet (the tip of a cone of
+// 2000 sides), the normals are summed by cells of the sphere: bounded time,
+// and each tip normal still leans the way its own face does, upwards.
+TEST(a_fan_of_many_faces_smooths_in_bounded_time)
+{
+    const char *dir = make_dir("fan");
+    enum { SIDES = 2000 };
+    char path[4200];
+    snprintf(path, sizeof path, "%s/cone.obj", dir);
+    FILE *f = fopen(path, "w");
+    ENSURE(f != NULL);
+    fprintf(f, "v 0 1 0\n");
+    for (int i = 0; i < SIDES; ++i) {
+        double a = 2.0 * 3.14159265358979 * i / SIDES;
+        fprintf(f, "v %.7f 0 %.7f\n", cos(a), sin(a));
+    }
+    for (int i = 0; i < SIDES; ++i) {
+        fprintf(f, "f 1 %d %d\n", 2 + (i + 1) % SIDES, 2 + i);
+    }
+    ENSURE(fclose(f) == 0);
+    wx_mesh_data m;
+    wx_error err = { 0 };
+    double t0 = wx_now_s();
+    ENSURE(wx_mesh_import(path, &m, &err) == WX_OK);
+    ENSURE(wx_now_s() - t0 < TIME_SCALE * 5.0);
+    ENSURE(m.triangle_count == SIDES);
+    int tips = 0;
+    for (int64_t t = 0; t < m.triangle_count; ++t) {
+        const uint32_t *idx = &m.indices[3 * t];
+        const float *apex = &m.positions[3 * (size_t)idx[0]], *n = &m.normals[3 * (size_t)idx[0]];
+        ENSURE_NEAR(apex[1] + m.origin[1], 1.0, 1e-6);
+        // The face's own outward direction in the ground plane: its base's middle.
+        const float *b = &m.positions[3 * (size_t)idx[1]], *c = &m.positions[3 * (size_t)idx[2]];
+        double mx = 0.5 * ((double)b[0] + c[0]) + m.origin[0];
+        double mz = 0.5 * ((double)b[2] + c[2]) + m.origin[2];
+        double horizontal = sqrt((double)n[0] * n[0] + (double)n[2] * n[2]);
+        double cosine =
+            ((double)n[0] * mx + (double)n[2] * mz) / (horizontal * sqrt(mx * mx + mz * mz));
+        ENSURE(n[1] > 0.0f && cosine > cos(10.0 * 3.14159265358979 / 180.0));
+        ENSURE_NEAR((double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2], 1.0, 1e-5);
+        tips++;
+    }
+    ENSURE(tips == SIDES);
+    wx_mesh_data_free(&m);
+}
+
 int main(void)
 {
     RUN(smooth_surface_of_a_coarse_sphere_is_rounder);
@@ -884,5 +1074,8 @@ int main(void)
     RUN(fbx_from_blender_arrives_in_metres);
     RUN(fbx_unit_that_is_not_positive_is_refused);
     RUN(formats_without_a_unit_are_left_as_they_are);
+    RUN(faces_on_few_positions_import_in_linear_time);
+    RUN(a_huge_polygon_is_refused_at_once);
+    RUN(a_fan_of_many_faces_smooths_in_bounded_time);
     return ensure_summary();
 }

@@ -16,6 +16,7 @@
 #include "core/limits.h"
 #include "io/scene_xml.h"
 #include "model/image.h"
+#include "pipeline/memory.h"
 #include "pipeline/outputs.h"
 #include "pipeline/pipeline.h"
 #include "pipeline/simulate_phase.h"
@@ -697,6 +698,77 @@ TEST(thesis_format_scene_runs_with_defaults)
     ENSURE(comment != NULL && name != NULL);
 }
 
+// --- particles alive at once (issue 24 item 15) ----------------------------------
+
+// The memory estimate counts the particles alive at once, from the longest a
+// particle can live (pipeline/memory.c). A drop from rest falls 5 m to the
+// floor of a 10 m box in 1.01 s with dt = 0.01 (semi-implicit Euler: 101
+// steps); the bound is (-0.049 + sqrt(0.049^2 + 98)) / 9.8 + 0.01 = 1.0151 s.
+// On a floor under steady rain, the most particles alive in any step never
+// pass the bound: for drops that die at their first hit it is within 1.6x;
+// for bouncing ones (maxCollisions 3, resilience 1) the bound is the run.
+TEST(particles_alive_stay_within_the_memory_bound)
+{
+    fx_scene f;
+    fx_scene_init(&f);
+    fx_gravity(&f, 9.8f);
+    f.scene.bbox_size = 10.0f;
+    f.scene.time_step = 0.01;
+    f.scene.steps = 300;
+    wx_emitter *drop = fx_emitter(&f, WX_EMITTER_POINT, 0, 0, 0);
+    drop->speed = 0.0f;
+    drop->max_collisions = 1;
+    double b = 0.049;
+    ENSURE_NEAR(wx_memory_particle_lifetime(&f.scene, drop),
+                (-b + sqrt(b * b + 98.0)) / 9.8 + 0.01, 1e-6); // 9.8 as a float
+    fx_scene_free(&f);
+
+    static const struct {
+        int max_collisions;
+        float resilience, friction;
+        double least_share; // of the bound, that the busiest step reaches
+    } cases[3] = { { 1, 0.2f, 0.5f, 0.6 }, { 3, 0.2f, 0.5f, 0.0 }, { 3, 1.0f, 1.0f, 0.0 } };
+    for (int c = 0; c < 3; ++c) {
+        floor_scene(&f, 64, 0.0f, 0.5f);
+        fx_gravity(&f, 9.8f);
+        f.scene.bbox_size = 12.0f;
+        f.scene.bbox_center[1] = 4.0f;
+        f.scene.time_step = 0.01;
+        f.scene.steps = 400;
+        f.scene.collider.resilience = cases[c].resilience;
+        f.scene.collider.friction = cases[c].friction;
+        wx_emitter *e = fx_emitter(&f, WX_EMITTER_BOX, 0, 0, 0);
+        for (int k = 0; k < 3; k += 2) {
+            e->box_min[k] = -4.0f;
+            e->box_max[k] = 4.0f;
+        }
+        e->box_min[1] = e->box_max[1] = 6.0f;
+        e->dir[1] = -1.0f;
+        e->speed = 2.0f;
+        e->rate = 20000;
+        e->end = 3.0;
+        e->max_collisions = cases[c].max_collisions;
+        double bound = wx_memory_particles_alive(&f.scene, e);
+        wx_sim *sim = start(&f, 2);
+        ENSURE(sim != NULL);
+        int64_t most = 0;
+        wx_error err;
+        for (int s = 0; s < 400; ++s) {
+            ENSURE(wx_sim_step(sim, &err) == WX_OK);
+            wx_particle_view view;
+            wx_sim_particles(sim, &view);
+            most = view.count > most ? view.count : most;
+        }
+        wx_sim_destroy(sim);
+        printf("        maxCollisions %d, R %g, F %g: at most %lld alive, bound %.0f (of 60000)\n",
+               cases[c].max_collisions, (double)cases[c].resilience,
+               (double)cases[c].friction, (long long)most, bound);
+        ENSURE((double)most <= bound);
+        ENSURE((double)most >= cases[c].least_share * bound);
+        fx_scene_free(&f);
+    }
+}
+
 int main(void)
 {
     RUN(drop_at_rest_lands_on_the_texel_below);
@@ -711,5 +783,6 @@ int main(void)
     RUN(pinned_determinism_hash);
     RUN(recent_hits_are_bounded_and_newest);
     RUN(thesis_format_scene_runs_with_defaults);
+    RUN(particles_alive_stay_within_the_memory_bound);
     return ensure_summary();
 }

@@ -11,8 +11,10 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "ensure.h"
+#include "core/progress.h"
 #include "gather/texture.h"
 #include "io/exr.h"
 #include "model/image.h"
@@ -278,20 +280,22 @@ TEST(uv_raster_leaves_out_what_no_renderer_can_read)
     wx_uv_raster r;
     wx_error err;
     ENSURE(wx_uv_raster_build(&rd, &r, &err) == WX_OK);
-    ENSURE(r.triangles_unusable == 4 && r.triangles_degenerate == 1);
+    // 1e30 apart, NaN, infinity, the largest float (beyond WX_UV_FAR) and 65
+    // tiles are unusable.
+    ENSURE(r.triangles_unusable == 5 && r.triangles_degenerate == 0);
     ENSURE(r.covered == 64 * 64 && r.overlapping == 64 * 64);
     wx_uv_raster_free(&r);
-    // CLIP draws one copy at most: only the non-finite UVs are unusable, and
-    // the giant triangles are clipped to the tile.
+    // CLIP draws one copy at most: the UVs not finite or beyond WX_UV_FAR are
+    // unusable, and the triangle of 65 tiles is clipped to the tile.
     rd.tiles = WX_TILES_CLIP;
     ENSURE(wx_uv_raster_build(&rd, &r, &err) == WX_OK);
-    ENSURE(r.triangles_unusable == 2 && r.triangles_degenerate == 1 && r.covered > 0);
+    ENSURE(r.triangles_unusable == 4 && r.triangles_degenerate == 0 && r.covered > 0);
     wx_uv_raster_free(&r);
     // UDIM: tile 1011 (u 0..1, v 1..2) holds a part of the 8 x 8 triangle.
     rd.tiles = WX_TILES_UDIM;
     rd.udim = 10;
     ENSURE(wx_uv_raster_build(&rd, &r, &err) == WX_OK);
-    ENSURE(r.triangles_unusable == 4 && r.covered == 64 * 64 && r.overlapping == 0);
+    ENSURE(r.triangles_unusable == 5 && r.covered == 64 * 64 && r.overlapping == 0);
     wx_uv_raster_free(&r);
     wx_uv_survey s;
     ENSURE(wx_uv_survey_build(&mesh, 0, 64, 64, &s, &err) == WX_OK);
@@ -905,6 +909,209 @@ TEST(uniform_dirt_has_no_seam_between_cameras)
     }
 }
 
+// The raster of the [0,1] tile alone (tiles="clip"), as the tests of huge UVs
+// read it.
+static wx_result clip_raster(const wx_mesh_data *mesh, int uv, int width, int height,
+                             int padding, wx_uv_raster *raster, wx_error *err)
+{
+    wx_uv_raster_def d = wx_default_uv_raster_def();
+    d.mesh = mesh;
+    d.uv = uv;
+    d.width = width;
+    d.height = height;
+    d.padding = padding;
+    d.tiles = WX_TILES_CLIP;
+    return wx_uv_raster_build(&d, raster, err);
+}
+
+// UVs far outside the tile (1e30, 3e6 tiles, FLT_MAX) used to overflow the
+// cast of their texel index to int and spin over 2^31 columns: the raster now
+// takes bounded time, counts those triangles outside the tile and covers only
+// what the in-tile square covers. A long thin triangle across the tile costs
+// its rows. A non-finite UV makes its triangle unusable (not outside); a
+// triangle with no area in UV but one in 3D is unusable too, one with no area
+// at all is neither. (Before the fix this test hung: the alarm fails it.)
+TEST(huge_and_unusable_uvs_are_bounded_and_counted)
+{
+    alarm(120);
+    enum { SQUARE_V = 4, EXTRA = 8 };
+    float positions[3 * (SQUARE_V + 3 * EXTRA)], normals[3 * (SQUARE_V + 3 * EXTRA)];
+    float uvs[2 * (SQUARE_V + 3 * EXTRA)];
+    uint32_t indices[3 * (2 + EXTRA)];
+    wx_mesh_data mesh;
+    square_mesh(&mesh, positions, normals, uvs, indices, false);
+    wx_uv_raster alone, r;
+    wx_error err;
+    ENSURE(clip_raster(&mesh, 0, 1024, 1024, 0, &alone, &err) == WX_OK);
+    // Extra triangles, three vertices each, at positions of a unit right triangle.
+    const float big = 3.0e38f;
+    const float extra[EXTRA][6] = {
+        { 1e30f, 1e30f, 2e30f, 1e30f, 1e30f, 2e30f },  // far: outside
+        { 3e6f, 0.5f, 3e6f + 1.0f, 0.5f, 3e6f, 0.6f }, // u = 3e6: outside
+        { 0.5f, 0.5f, big, 0.5f, 0.5f, big },          // reaches FLT_MAX: outside
+        { -1e30f, 0.2f, 0.3f, 0.2f, 0.3f, 0.9f },      // one corner at -1e30: outside
+        { -1e4f, 0.5f, 1e4f, 0.5f, 1e4f, 0.5001f },    // thin, across the tile: drawn
+        { NAN, 0.1f, 0.2f, 0.1f, 0.2f, 0.2f },         // not finite: unusable
+        { 0.9f, 0.9f, 0.9f, 0.9f, 0.9f, 0.9f },        // a point in UV: unusable
+        { 0.1f, 0.1f, 0.2f, 0.2f, 0.3f, 0.3f },        // a line in UV, no area: neither
+    };
+    for (int e = 0; e < EXTRA; ++e) {
+        for (int k = 0; k < 3; ++k) {
+            int v = SQUARE_V + 3 * e + k;
+            uvs[2 * v] = extra[e][2 * k];
+            uvs[2 * v + 1] = extra[e][2 * k + 1];
+            positions[3 * v] = k == 1 ? 1.0f : 0.0f;
+            positions[3 * v + 1] = k == 2 && e != EXTRA - 1 ? 1.0f : 0.0f;
+            positions[3 * v + 2] = 0.0f;
+            normals[3 * v] = normals[3 * v + 1] = 0.0f;
+            normals[3 * v + 2] = 1.0f;
+            indices[3 * (2 + e) + k] = (uint32_t)v;
+        }
+    }
+    mesh.vertex_count = SQUARE_V + 3 * EXTRA;
+    mesh.triangle_count = 2 + EXTRA;
+    double t0 = wx_now_s();
+    ENSURE(clip_raster(&mesh, 0, 1024, 1024, 8, &r, &err) == WX_OK);
+    double seconds = wx_now_s() - t0;
+    alarm(0);
+    ENSURE(seconds < 5.0);
+    ENSURE(r.triangles_outside == 1);  // the thin one
+    // The four beyond WX_UV_FAR, NaN, and the point with an area in 3D.
+    ENSURE(r.triangles_unusable == 6);
+    // The thin triangle covers at most one row of 1024 (v 0.5 to 0.5001 is a
+    // tenth of a texel): its centres, where it crosses one, and the square's.
+    ENSURE(r.covered >= alone.covered && r.covered <= alone.covered + 1024);
+    for (int64_t t = 0; t < 1024 * 1024; ++t) {
+        ENSURE(r.triangle[t] < 2 + 4); // never a far, NaN or degenerate triangle
+    }
+    wx_uv_raster_free(&alone);
+    wx_uv_raster_free(&r);
+}
+
+// The rows-only raster against a brute-force test of every texel centre on
+// random triangles in and around the tile: every covered centre lies inside
+// its triangle (or within rounding of its edge), and every centre clearly
+// inside some triangle is covered.
+TEST(uv_raster_rows_agree_with_brute_force)
+{
+    enum { TRIS = 60, W = 97, H = 64 };
+    float positions[9 * TRIS], normals[9 * TRIS], uvs[6 * TRIS];
+    uint32_t indices[3 * TRIS];
+    wx_mesh_data mesh;
+    memset(&mesh, 0, sizeof mesh);
+    uint64_t state = 12345;
+    for (int v = 0; v < 3 * TRIS; ++v) {
+        for (int k = 0; k < 2; ++k) {
+            state = state * 6364136223846793005ull + 1442695040888963407ull;
+            uvs[2 * v + k] = -0.5f + 2.0f * (float)(state >> 40) / 16777216.0f;
+        }
+        positions[3 * v] = uvs[2 * v];
+        positions[3 * v + 1] = uvs[2 * v + 1];
+        positions[3 * v + 2] = 0.0f;
+        normals[3 * v] = normals[3 * v + 1] = 0.0f;
+        normals[3 * v + 2] = 1.0f;
+        indices[v] = (uint32_t)v;
+    }
+    mesh.vertex_count = 3 * TRIS;
+    mesh.triangle_count = TRIS;
+    mesh.positions = positions;
+    mesh.normals = normals;
+    mesh.indices = indices;
+    mesh.uvs[0] = uvs;
+    wx_uv_raster r;
+    wx_error err;
+    ENSURE(clip_raster(&mesh, 0, W, H, 0, &r, &err) == WX_OK);
+    for (int j = 0; j < H; ++j) {
+        for (int i = 0; i < W; ++i) {
+            double cx = (i + 0.5) / W, cy = 1.0 - (j + 0.5) / H;
+            int inside_clearly = -1;
+            bool in_covering = false;
+            for (int t = 0; t < TRIS; ++t) {
+                const float *a = &uvs[6 * t], *b = &uvs[6 * t + 2], *c = &uvs[6 * t + 4];
+                double d = (b[0] - a[0]) * (double)(c[1] - a[1]) -
+                           (b[1] - a[1]) * (double)(c[0] - a[0]);
+                double w0 = ((b[0] - cx) * (c[1] - cy) - (b[1] - cy) * (c[0] - cx)) / d;
+                double w1 = ((c[0] - cx) * (a[1] - cy) - (c[1] - cy) * (a[0] - cx)) / d;
+                double w2 = 1.0 - w0 - w1;
+                double least = fmin(w0, fmin(w1, w2));
+                if (least > 1e-9 && inside_clearly < 0) {
+                    inside_clearly = t;
+                }
+                if (t == r.triangle[(size_t)j * W + (size_t)i]) {
+                    in_covering = least > -1e-9;
+                }
+            }
+            int32_t got = r.triangle[(size_t)j * W + (size_t)i];
+            ENSURE(got < 0 || in_covering);
+            ENSURE(inside_clearly < 0 || got >= 0);
+        }
+    }
+    wx_uv_raster_free(&r);
+}
+
+// Faces of an OBJ without `vt` and `vt nan nan` (which Assimp reads as 0 0)
+// used to vanish from the texture without a word: `info` now counts the
+// triangles without usable UVs, and `run` warns with their number.
+TEST(obj_faces_without_usable_uvs_are_reported)
+{
+    const char *dir = ensure_tmpdir();
+    char *cube = ensure_read_file(data_file("texture_cube.obj"));
+    ENSURE(cube != NULL);
+    // The -Y face without vt, the +X face on one `vt nan nan`.
+    static const char *const from[] = { "f 1/5/2 2/6/2 6/7/2", "f 1/5/2 6/7/2 5/8/2",
+                                        "f 6/9/3 2/10/3 4/11/3", "f 6/9/3 4/11/3 8/12/3" };
+    static const char *const to[] = { "f 1//2 2//2 6//2", "f 1//2 6//2 5//2",
+                                      "f 6/25/3 2/25/3 4/25/3", "f 6/25/3 4/25/3 8/25/3" };
+    static char text[16384];
+    snprintf(text, sizeof text, "%s\nvt nan nan\n", cube);
+    free(cube);
+    for (int k = 0; k < 4; ++k) {
+        char *at = strstr(text, from[k]);
+        ENSURE(at != NULL);
+        size_t n = strlen(from[k]), m = strlen(to[k]);
+        memmove(at + m, at + n, strlen(at + n) + 1);
+        memcpy(at, to[k], m);
+    }
+    ensure_write_file(dir, "holes.obj", text);
+    char scene[8192];
+    snprintf(scene, sizeof scene, cube_scene, 1, 1000, "holes.obj", 0);
+    ensure_write_file(dir, "holes.xml", scene);
+    ENSURE(weathering_in(dir, "info holes.xml", true) == 0);
+    ENSURE(strstr(out, "0 of 12 triangles reach outside the [0,1] tile (they wrap, as REPEAT "
+                       "reads them); 4 without usable UVs") != NULL);
+    ENSURE(weathering_in(dir, "run holes.xml --out holes", true) == 0);
+    ENSURE(strstr(out, "4 of 12 triangles have no usable UVs") != NULL);
+}
+
+// A mesh whose UVs are 1e30 (u x texels past 2^31, as u = 3e6 at 1024) used
+// to make `info` and `run` spin forever (a triangle there started its columns
+// at INT_MIN): both end, counting those triangles as without usable UVs.
+TEST(huge_uvs_end_info_and_run)
+{
+    const char *dir = ensure_tmpdir();
+    ensure_write_file(dir, "far.obj",
+                      "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n"
+                      "vt 1e30 1e30\nvt 1e30 0.2\nvt 1.1e30 0.2\nvt 1e30 0.8\nvt 0.2 0.2\n"
+                      "f 1/2 3/3 2/4\nf 1/1 2/2 4/3\nf 1/5 4/2 3/3\nf 2/1 3/2 4/5\n");
+    // 64 texels keep the run short; u = 1e30 passes 2^31 at any size. init
+    // leaves the TextureMap out (the layout covers no texel): give it one.
+    ENSURE(weathering_in(dir, "init far.obj --resolution 64", true) == 0);
+    ENSURE(ensure_shell(NULL, 0,
+                        "cd '%s' && sed -i 's|</Mesh>|<TextureMap file=\"far_texture.exr\" "
+                        "resolution=\"64\"/></Mesh>|' far.xml",
+                        dir) == 0);
+    char build[PATH_MAX];
+    ENSURE(realpath(ensure_build_dir(), build) != NULL);
+    ENSURE(ensure_shell(out, sizeof out,
+                        "cd '%s' && timeout 120 '%s/weathering' info far.xml 2>&1", dir,
+                        build) == 0);
+    ENSURE(strstr(out, "4 without usable UVs") != NULL);
+    ENSURE(ensure_shell(out, sizeof out,
+                        "cd '%s' && timeout 300 '%s/weathering' run far.xml --out far 2>&1", dir,
+                        build) == 0);
+    ENSURE(strstr(out, "4 of 4 triangles have no usable UVs") != NULL);
+}
+
 int main(void)
 {
     RUN(uv_raster_counts_ties_overlaps_and_padding);
@@ -918,5 +1125,9 @@ int main(void)
     RUN(uniform_dirt_has_no_seam_between_cameras);
     RUN(texture_through_the_output_camera_equals_the_mask);
     RUN(mesh_without_uvs_is_refused);
+    RUN(huge_and_unusable_uvs_are_bounded_and_counted);
+    RUN(uv_raster_rows_agree_with_brute_force);
+    RUN(obj_faces_without_usable_uvs_are_reported);
+    RUN(huge_uvs_end_info_and_run);
     return ensure_summary();
 }

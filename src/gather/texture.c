@@ -78,6 +78,13 @@ static bool triangle_uvs(const wx_mesh_data *mesh, const float *uvs, int64_t tri
     return true;
 }
 
+// Whether the triangle's UVs lie within WX_UV_FAR of 0 (tiles tu0..tu1, tv0..tv1).
+static bool near_enough(const tri_uv *t)
+{
+    return fmax(fabs(t->tu0), fabs(t->tu1 + 1.0)) <= WX_UV_FAR &&
+           fmax(fabs(t->tv0), fabs(t->tv1 + 1.0)) <= WX_UV_FAR;
+}
+
 static bool spans_tile(const tri_uv *t, double tu, double tv)
 {
     return tu >= t->tu0 && tu <= t->tu1 && tv >= t->tv0 && tv <= t->tv1;
@@ -191,12 +198,29 @@ static bool fixed_tile(const wx_uv_raster *r, double *tu, double *tv)
     return true;
 }
 
+// Whether the triangle's corners span an area in 3D.
+static bool has_area(const wx_mesh_data *mesh, const uint32_t *idx)
+{
+    const float *a = &mesh->positions[3 * (size_t)idx[0]];
+    const float *b = &mesh->positions[3 * (size_t)idx[1]];
+    const float *c = &mesh->positions[3 * (size_t)idx[2]];
+    double e1[3], e2[3];
+    for (int k = 0; k < 3; ++k) {
+        e1[k] = (double)b[k] - a[k];
+        e2[k] = (double)c[k] - a[k];
+    }
+    double n[3] = { e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                    e1[0] * e2[1] - e1[1] * e2[0] };
+    return n[0] != 0.0 || n[1] != 0.0 || n[2] != 0.0;
+}
+
 static void raster_triangle(const wx_mesh_data *mesh, const float *uvs, int32_t tri,
                             wx_uv_raster *r, unsigned char *count)
 {
     tri_uv t;
     if (!triangle_uvs(mesh, uvs, tri, &t) ||
-        (r->tiles != WX_TILES_CLIP && t.tiles > WX_UV_MAX_TILES_PER_TRIANGLE)) {
+        (r->tiles != WX_TILES_CLIP && t.tiles > WX_UV_MAX_TILES_PER_TRIANGLE) ||
+        !near_enough(&t)) {
         r->triangles_unusable++;
         return;
     }
@@ -206,6 +230,10 @@ static void raster_triangle(const wx_mesh_data *mesh, const float *uvs, int32_t 
     point2 q[3];
     if (!oriented_copy(&t, t.tu0, t.tv0, r->width, r->height, q)) {
         r->triangles_degenerate++;
+        // A triangle with a surface but no extent in UV can hold no texel:
+        // an OBJ face without `vt` (Assimp gives it (0, 0) at every corner).
+        r->triangles_unusable += mesh->positions != NULL &&
+                                 has_area(mesh, &mesh->indices[3 * (size_t)tri]);
         return;
     }
     double tu, tv;
@@ -459,7 +487,7 @@ wx_result wx_uv_survey_build(const wx_mesh_data *mesh, int uv, int width, int he
     for (int64_t tri = 0; tri < mesh->triangle_count; ++tri) {
         tri_uv t;
         if (!triangle_uvs(mesh, mesh->uvs[uv], tri, &t) ||
-            t.tiles > WX_UV_MAX_TILES_PER_TRIANGLE) {
+            t.tiles > WX_UV_MAX_TILES_PER_TRIANGLE || !near_enough(&t)) {
             out->triangles_unusable++;
             continue;
         }

@@ -64,10 +64,21 @@ typedef struct wx_uv_raster {
     /// [0,10] x [0,100] of UV (their part there is left out).
     int64_t triangles_outside;
     int64_t triangles_degenerate; ///< triangles of zero area in UV (never cover a texel)
-    /// Triangles with a non-finite UV, or (REPEAT, UDIM) spanning more than
-    /// WX_UV_MAX_TILES_PER_TRIANGLE tiles: never drawn.
+    /// Triangles with no usable UVs, never drawn: a UV that is not a finite
+    /// number or lies beyond WX_UV_FAR, (REPEAT, UDIM) more than
+    /// WX_UV_MAX_TILES_PER_TRIANGLE tiles spanned, or no area in UV for a
+    /// triangle that has one in 3D (Assimp
+    /// gives an OBJ face without `vt` (0, 0) at every corner, and reads `vt
+    /// nan nan` as 0 0).
     int64_t triangles_unusable;
 } wx_uv_raster;
+
+/// A UV farther than this from 0 (in either coordinate) makes its triangle
+/// unusable in every mode: float holds no position within a tile finer than
+/// 1/128 there, and a triangle reaching that far crosses the tile as a sliver
+/// whose edges double precision no longer places (at 1e30 or u = 3e6 the
+/// texel index passed 2^31, which used to make `info` and `run` spin).
+#define WX_UV_FAR 65536.0
 
 /// The default: REPEAT, no padding; mesh, uv and the size to be set.
 wx_uv_raster_def wx_default_uv_raster_def(void);

@@ -1,6 +1,9 @@
 // geometry.c: the scene's meshes matched to their <Surface>s (geometry.h).
 #include "model/geometry.h"
 
+#include "core/matrix.h"
+
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -67,4 +70,33 @@ void wx_geometry_free(wx_geometry *geometry)
     }
     free(geometry->meshes);
     memset(geometry, 0, sizeof *geometry);
+}
+
+double wx_geometry_texels_seen(const wx_mesh_data *mesh, const wx_camera *camera)
+{
+    double m[16];
+    if (mesh->positions == NULL || mesh->indices == NULL ||
+        !wx_matrix_is_orthographic(camera->wtc)) {
+        return 0.0;
+    }
+    // Texel coordinates of a position relative to the mesh's origin, in double.
+    wx_matrix_fold_origin(camera->wtc, mesh->origin, m);
+    const double w = m[15], W = camera->width, H = camera->height;
+    double total = 0.0;
+    for (int64_t t = 0; t < mesh->triangle_count; ++t) {
+        double x[3], y[3];
+        bool reaches = false;
+        for (int k = 0; k < 3; ++k) {
+            const float *p = &mesh->positions[3 * (size_t)mesh->indices[3 * t + k]];
+            double u = (p[0] * m[0] + p[1] * m[4] + p[2] * m[8] + m[12]) / w;
+            double v = (p[0] * m[1] + p[1] * m[5] + p[2] * m[9] + m[13]) / w;
+            x[k] = u * W;
+            y[k] = v * H;
+            reaches = reaches || (u >= 0.0 && u <= 1.0 && v >= 0.0 && v <= 1.0);
+        }
+        if (reaches) {
+            total += 0.5 * fabs((x[1] - x[0]) * (y[2] - y[0]) - (x[2] - x[0]) * (y[1] - y[0]));
+        }
+    }
+    return total;
 }

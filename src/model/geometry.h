@@ -7,6 +7,7 @@
 #include <stdint.h>
 
 #include "core/error.h"
+#include "model/camera.h"
 #include "model/mesh.h"
 #include "model/scene.h"
 
@@ -37,5 +38,13 @@ wx_result wx_geometry_match(const wx_scene *scene, int mesh_index, wx_geometry_m
 
 /// Frees everything; the struct is zeroed.
 void wx_geometry_free(wx_geometry *geometry);
+
+/// The texels of `camera`'s map that the mesh's triangles cover, as the sum of
+/// their projected areas in texels (overlaps counted twice) over the triangles
+/// that reach into its frame: about 0 when the camera sees the mesh edge-on
+/// (a mesh without thickness along its view), so that its bake records no
+/// surface. 0 when the mesh's arrays are released or the camera is not
+/// orthographic.
+double wx_geometry_texels_seen(const wx_mesh_data *mesh, const wx_camera *camera);
 
 #endif

@@ -287,3 +287,58 @@ wx_result wx_bake_scene(wx_scene *scene, const wx_run_def *opts, wx_error *err)
 {
     return wx_bake_scene_stats(scene, opts, NULL, err);
 }
+
+int wx_geometry_warn_blind(const wx_scene *scene, const wx_geometry *geometry, const char *what,
+                           bool quiet)
+{
+    char cameras[512] = "", flat[512] = "";
+    int blind = 0, last = -1;
+    for (int c = 0; c < scene->camera_count; ++c) {
+        const wx_scene_camera *sc = &scene->cameras[c];
+        if (sc->is_output || !sc->has_view || wx_has_path(sc->depth_path)) {
+            continue; // not baked: its maps say what it sees
+        }
+        double texels = 0.0;
+        for (int m = 0; m < geometry->count && texels < 1.0; ++m) {
+            texels += wx_geometry_texels_seen(&geometry->meshes[m].data, &sc->camera);
+        }
+        if (texels < 1.0) {
+            if (last >= 0) {
+                char name[WX_NAME_MAX + 4];
+                snprintf(name, sizeof name, "'%s'", scene->cameras[last].name);
+                wx_list_append(cameras, sizeof cameras, name);
+            }
+            last = c;
+            blind++;
+        }
+    }
+    if (blind == 0) {
+        return 0;
+    }
+    char tail[WX_NAME_MAX + 16];
+    snprintf(tail, sizeof tail, "%s'%s'", blind > 1 ? " and " : "", scene->cameras[last].name);
+    snprintf(cameras + strlen(cameras), sizeof cameras - strlen(cameras), "%s", tail);
+    static const char axes[3] = { 'x', 'y', 'z' };
+    for (int m = 0; m < geometry->count && m < scene->mesh_count; ++m) {
+        const wx_mesh_data *d = &geometry->meshes[m].data;
+        for (int k = 0; k < 3 && d->triangle_count > 0; ++k) {
+            if (d->bounds_max[k] - d->bounds_min[k] == 0.0) {
+                size_t n = strlen(flat);
+                snprintf(flat + n, sizeof flat - n,
+                         "%smesh '%s' has no thickness along %c (every vertex at %c = %g)",
+                         n > 0 ? "; " : ": ", wx_mesh_display_name(scene, &scene->meshes[m]),
+                         axes[k] - 32, axes[k], d->bounds_min[k]);
+                break;
+            }
+        }
+    }
+    wx_warn(quiet,
+            "%s: camera%s %s record%s no surface: the meshes cover less than a texel of %s "
+            "frame%s (edge-on)%s; particles pass wherever a camera that frames them records no "
+            "surface, so nothing will be hit in %s frame%s and the maps and masks stay zero "
+            "(give the model some thickness; docs/physics.md)",
+            what, blind > 1 ? "s" : "", cameras, blind > 1 ? "" : "s",
+            blind > 1 ? "their" : "its", blind > 1 ? "s" : "", flat,
+            blind > 1 ? "their" : "its", blind > 1 ? "s" : "");
+    return blind;
+}

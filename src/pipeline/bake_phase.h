@@ -21,6 +21,18 @@
 /// triangles is a warning (unless quiet). On failure `out` is left empty.
 wx_result wx_geometry_load(const wx_scene *scene, bool quiet, wx_geometry *out, wx_error *err);
 
+/// Warns (unless quiet) about the input cameras to bake that would record no
+/// surface: the meshes' triangles cover less than one texel of their frames
+/// (the meshes are edge-on to them, such as a mesh with no thickness along an
+/// axis, every vertex at z = 0, seen from the side). A point in such a
+/// camera's frame never lies behind a surface it records, so the collider
+/// lets every particle through there (docs/physics.md): the run would be all
+/// zero. Names each mesh without thickness along an axis. `what` begins the
+/// message (the scene file, or the mesh for `init`). Returns the number of
+/// such cameras.
+int wx_geometry_warn_blind(const wx_scene *scene, const wx_geometry *geometry, const char *what,
+                           bool quiet);
+
 /// Renders with the geometry already imported (wx_geometry_load), handing each
 /// baked camera's maps to `on_maps` (raster/bake.h) instead of writing them:
 /// what the pilot of `info` flies on. `stats` may be NULL.

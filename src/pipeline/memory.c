@@ -6,6 +6,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <sys/resource.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -17,7 +18,129 @@
 #include "pipeline/texture_phase.h"
 #include "sim/emitter.h"
 
+// ---------------------------------------------------------------------------
+// Particles alive at once (docs/reliability.md, "Particles alive at once")
+
+// The longest a free flight can last: a particle whose height above the
+// solver box's floor is at most h, whose upward speed is at most w, and whose
+// upward acceleration is at most -alpha (alpha > 0) leaves the box below
+// within this time. With the semi-implicit Euler step (v += dt a; x += dt v)
+// after n steps y <= y0 + n dt w - alpha dt^2 n (n + 1) / 2, which is below
+// the floor once t = n dt passes the root of alpha t^2 / 2 + (alpha dt / 2 - w)
+// t - h = 0; one step more for the step in which it happens.
+static double flight_bound(double w, double h, double alpha, double dt)
+{
+    double b = w - 0.5 * alpha * dt;
+    return (b + sqrt(b * b + 2.0 * alpha * h)) / alpha + dt;
+}
+
+double wx_memory_particle_lifetime(const wx_scene *scene, const wx_emitter *e)
+{
+    const double dt = scene->time_step;
+    const double run = wx_scene_duration(scene) * (scene->iterations > 1 ? scene->iterations : 1);
+    const double mass = e->mass > 0.0f ? e->mass : 1.0;
+    // Gravity pulls down; wind and turbulence may push up, each turbulence
+    // component by at most its strength (force_field.c clamps it).
+    double g = 0.0, up = 0.0, turbulence = 0.0;
+    double wind[3] = { 0.0, 0.0, 0.0 };
+    for (int f = 0; f < scene->field_count; ++f) {
+        const wx_field *fd = &scene->fields[f];
+        if (fd->kind == WX_FIELD_GRAVITY) {
+            g += fd->strength;
+        } else if (fd->kind == WX_FIELD_WIND) {
+            double len = sqrt((double)fd->dir[0] * fd->dir[0] + (double)fd->dir[1] * fd->dir[1] +
+                              (double)fd->dir[2] * fd->dir[2]);
+            for (int k = 0; k < 3 && len > 0.0; ++k) {
+                wind[k] += fd->strength * fd->dir[k] / len / mass;
+            }
+        } else {
+            turbulence += fabs((double)fd->strength) / mass;
+        }
+    }
+    up = fmax(0.0, wind[1]) + turbulence;
+    const double alpha = g - up; // the least downward acceleration
+    if (!(alpha > 0.0) || !(dt > 0.0)) {
+        return run; // nothing takes a particle out of the box: it may fly to the end
+    }
+    // Its speed: the constant forces (gravity, wind) keep the energy of a free
+    // flight, a collision never raises it (a bounce keeps R of the normal
+    // part, a slide F of the tangential part: R, F <= 1) but for adherence's
+    // pull (A dt / m into the surface, at right angles to what a slide keeps),
+    // and the box bounds the potential: |v|^2 <= speed^2 + 2 |a| diagonal +
+    // collisions x pull^2. Turbulence adds at most its strength x sqrt(3) a
+    // second, over at most the run.
+    const double a = sqrt(wind[0] * wind[0] + (wind[1] - g) * (wind[1] - g) + wind[2] * wind[2]);
+    const double H = scene->bbox_size, diagonal = sqrt(3.0) * H;
+    const double pull = scene->collider.adherence * dt / mass;
+    const double M = e->max_collisions >= 1 ? e->max_collisions : 1;
+    const double speed = sqrt((double)e->speed * e->speed + 2.0 * a * diagonal + M * pull * pull) +
+                         sqrt(3.0) * turbulence * run;
+    // The first flight starts at the emitter, at most this fast upwards.
+    double top = e->kind == WX_EMITTER_BOX        ? fmax(e->box_min[1], e->box_max[1])
+                 : e->kind == WX_EMITTER_HEMISPHERE ? e->center[1] + e->radius
+                                                    : e->center[1];
+    double h0 = fmin(H, fmax(0.0, top - (scene->bbox_center[1] - 0.5 * H)));
+    double w0 = e->speed;
+    if (e->kind == WX_EMITTER_BOX) {
+        // The most upward direction of the cone: its axis tilted up by the spread.
+        double from_up = acos(fmax(-1.0, fmin(1.0, (double)e->dir[1])));
+        w0 = e->speed * cos(fmax(0.0, from_up - e->spread * 3.14159265358979 / 180.0));
+    }
+    // A particle dies at its maxCollisions-th collision (or earlier); each
+    // collision ends a flight, and the next one starts at most
+    // max(R, F) x speed + pull upwards.
+    double rho = fmax(scene->collider.resilience, scene->collider.friction);
+    double w = fmin(speed, rho * speed + pull);
+    double life = flight_bound(w0, h0, alpha, dt) + (M - 1.0) * flight_bound(w, H, alpha, dt);
+    return fmin(run, life);
+}
+
+double wx_memory_particles_alive(const wx_scene *scene, const wx_emitter *e)
+{
+    const double T = wx_scene_duration(scene);
+    const double iterations = scene->iterations > 1 ? scene->iterations : 1;
+    // Each iteration emits over [start, min(end, T)] at `rate`.
+    double emitting = fmax(0.0, fmin(e->end, T) - e->start);
+    double total = iterations * (double)wx_emitter_count_at(e, T);
+    if (!(emitting > 0.0) || !(e->rate > 0.0)) {
+        return 0.0;
+    }
+    // A particle alive at time t was emitted within the lifetime L before it:
+    // the busiest window of length L holds q whole iterations and a part of
+    // one more, so at most q emitting spans and min(L - q T, span) of another.
+    double L = wx_memory_particle_lifetime(scene, e);
+    double q = T > 0.0 ? floor(L / T) : iterations;
+    double seconds = q >= iterations ? iterations * emitting
+                                     : q * emitting + fmin(L - q * T, emitting);
+    // Counts are floors of rate x time in each span: one more per span.
+    double alive = e->rate * seconds + fmin(q + 1.0, iterations);
+    return fmin(total, alive);
+}
+
+// The memory importing one mesh takes at its peak (docs/reliability.md): the
+// file (Assimp reads it whole) and, per triangle, what Assimp's scene, the
+// import's joining and its arrays hold; an OBJ's vertices are its faces'
+// corners. Without the imported triangles, WX_MESH_BYTES_PER_FILE_BYTE of
+// the file.
+static double mesh_import_bytes(const char *path, double file_bytes, const wx_mesh_data *data)
+{
+    if (data == NULL) {
+        return WX_MESH_BYTES_PER_FILE_BYTE * file_bytes;
+    }
+    size_t n = strlen(path);
+    bool obj = n >= 4 && strcasecmp(path + n - 4, ".obj") == 0;
+    return WX_MESH_BYTES_PER_IMPORTED_FILE_BYTE * file_bytes +
+           (obj ? WX_MESH_BYTES_PER_OBJ_TRIANGLE : WX_MESH_BYTES_PER_TRIANGLE) *
+               (double)data->triangle_count;
+}
+
 void wx_memory_estimate(const wx_scene *scene, unsigned phases, wx_memory_need *need)
+{
+    wx_memory_estimate_geometry(scene, phases, NULL, need);
+}
+
+void wx_memory_estimate_geometry(const wx_scene *scene, unsigned phases,
+                                 const wx_geometry *geometry, wx_memory_need *need)
 {
     memset(need, 0, sizeof *need);
     need->baseline_bytes = WX_MEMORY_BASELINE;
@@ -68,11 +191,15 @@ void wx_memory_estimate(const wx_scene *scene, unsigned phases, wx_memory_need *
         for (int m = 0; m < scene->mesh_count; ++m) {
             struct stat st;
             double bytes = stat(scene->meshes[m].path, &st) == 0 ? (double)st.st_size : 0.0;
-            need->mesh_bytes += WX_MESH_BYTES_PER_FILE_BYTE * bytes;
+            const wx_mesh_data *data =
+                geometry != NULL && m < geometry->count ? &geometry->meshes[m].data : NULL;
+            need->mesh_bytes += mesh_import_bytes(scene->meshes[m].path, bytes, data);
             // Its smooth surface (raster/bake.c): at most WX_SMOOTH_MAX_TRIANGLES,
-            // and at most 64 times the triangles a file of that size holds.
+            // and at most 64 times its triangles (a file holds a triangle per 16
+            // bytes at the most, when it was not imported).
+            double triangles = data != NULL ? (double)data->triangle_count : bytes / 16.0;
             need->mesh_bytes += WX_SMOOTH_BYTES_PER_TRIANGLE *
-                                fmin(WX_SMOOTH_MAX_TRIANGLES, 64.0 * bytes / 16.0);
+                                fmin(WX_SMOOTH_MAX_TRIANGLES, 64.0 * triangles);
             if (bytes > largest_file) {
                 largest_file = bytes;
                 need->mesh_line = scene->meshes[m].line;
@@ -156,16 +283,19 @@ void wx_memory_estimate(const wx_scene *scene, unsigned phases, wx_memory_need *
         largest = -1.0;
         double duration = wx_scene_duration(scene);
         for (int e = 0; e < scene->emitter_count; ++e) {
-            // The emitters emit again in every iteration (docs/design.md section 9).
+            // The emitters emit again in every iteration (docs/design.md
+            // section 9); only those alive at once take memory.
             double n = iterations * (double)wx_emitter_count_at(&scene->emitters[e], duration);
+            double alive = wx_memory_particles_alive(scene, &scene->emitters[e]);
             need->particles += n;
-            if (n > largest) {
-                largest = n;
+            need->particles_alive += alive;
+            if (alive > largest) {
+                largest = alive;
                 need->emitter_line = scene->emitters[e].line;
             }
         }
         need->bytes_per_particle = WX_BYTES_PER_PARTICLE + WX_BYTES_PER_PARTICLE_LOAD * (S - 1);
-        need->particle_bytes = need->particles * need->bytes_per_particle;
+        need->particle_bytes = need->particles_alive * need->bytes_per_particle;
     }
     if (phases & WX_PHASE_GATHER) {
         need->gather_bytes =
@@ -273,10 +403,11 @@ static double gib(double bytes)
     return bytes / (1024.0 * 1024.0 * 1024.0);
 }
 
-wx_result wx_memory_check(const wx_scene *scene, unsigned phases, wx_error *err)
+wx_result wx_memory_check(const wx_scene *scene, unsigned phases, const wx_geometry *geometry,
+                          wx_error *err)
 {
     wx_memory_need need;
-    wx_memory_estimate(scene, phases, &need);
+    wx_memory_estimate_geometry(scene, phases, geometry, &need);
     double available = wx_memory_available();
     if (available < 0.0 || need.total_bytes <= available) {
         return WX_OK;
@@ -290,11 +421,12 @@ wx_result wx_memory_check(const wx_scene *scene, unsigned phases, wx_error *err)
     }
     if (strcmp(need.phase, "simulation") == 0 && need.particle_bytes > need.sim_map_bytes) {
         return wx_fail(err, WX_CAUSE_MEMORY_LIMIT,
-                       "%s:%d: the emitters would emit %.4g particles: with the maps that "
-                       "needs about %.3g GiB (%.0f bytes per particle, %.3g GiB of maps), "
-                       "but only %.3g GiB of memory is available; lower the rate%s the "
-                       "duration%s (see docs/reliability.md)",
-                       scene->path, need.emitter_line, need.particles, gib(need.total_bytes),
+                       "%s:%d: the emitters would emit %.4g particles, up to %.4g alive at "
+                       "once: with the maps that needs about %.3g GiB (%.0f bytes per "
+                       "particle, %.3g GiB of maps), but only %.3g GiB of memory is "
+                       "available; lower the rate%s the duration%s (see docs/reliability.md)",
+                       scene->path, need.emitter_line, need.particles, need.particles_alive,
+                       gib(need.total_bytes),
                        need.bytes_per_particle, gib(need.sim_map_bytes), gib(available),
                        scene->iterations > 1 ? "," : " or",
                        scene->iterations > 1 ? " or the iterations" : "");

@@ -7,6 +7,7 @@
 #include <stdbool.h>
 
 #include "core/error.h"
+#include "model/geometry.h"
 #include "model/scene.h"
 
 /// Memory a run needs at its peak, estimated before work starts from the scene
@@ -14,14 +15,17 @@
 /// phases (they run one after the other; each frees what the next does not use).
 typedef struct wx_memory_need {
     double baseline_bytes;     ///< the program and its libraries (WX_MEMORY_BASELINE)
-    double mesh_bytes;         ///< importing the meshes: WX_MESH_BYTES_PER_FILE_BYTE x their files
+    double mesh_bytes;         ///< importing the meshes (mesh_import_bytes in memory.c)
     double bake_bytes;         ///< the bake: GL context, framebuffer, images being written, meshes
     double sim_map_bytes;      ///< the simulation's maps, collider and dirt (without particles)
     double frame_bytes;        ///< part of sim_map_bytes: a frame of the mask's sequence
     double particles;          ///< particles the emitters emit over all the iterations
+    /// At most this many alive at once: per emitter, what it emits in the
+    /// longest a particle can live (wx_memory_particles_alive).
+    double particles_alive;
     double bytes_per_particle; ///< WX_BYTES_PER_PARTICLE, + WX_BYTES_PER_PARTICLE_LOAD per
                                ///< substance beyond the first
-    double particle_bytes;     ///< as if every particle emitted were alive at once
+    double particle_bytes;     ///< particles_alive x bytes_per_particle
     double gather_bytes;       ///< the gather: the maps it reads, its planes, the files it writes
     /// TextureMaps (docs/texture.md): their UV rasters, held from the start of
     /// the run to its end, and the largest one's writing (its image and the
@@ -48,14 +52,26 @@ typedef struct wx_memory_need {
 /// the phases that follow it in the same run (measured: Spot's run peaks 57 MB
 /// above its gather alone).
 #define WX_BAKE_RESIDUE_BYTES (48.0 * 1024.0 * 1024.0)
-/// Bytes per byte of mesh file while Assimp imports it (measured: about 18 for
-/// OBJ; binary formats hold fewer bytes per triangle).
+/// Bytes per byte of mesh file while Assimp imports it, when the meshes have
+/// not been imported yet (the scene alone: a rough figure, 5 to 15 times what
+/// OBJ and binary PLY take since issue 24's import).
 #define WX_MESH_BYTES_PER_FILE_BYTE 32.0
 /// Bytes per triangle of a mesh's smooth surface in the bake (model/mesh.h:
 /// vertices, normals, colours, indices, materials, and the renderer's copy);
 /// a mesh file holds a triangle per 16 bytes at the most.
 #define WX_SMOOTH_BYTES_PER_TRIANGLE 100.0
 
+/// With the meshes imported (info, run, bake: the check comes after the
+/// import), their peak from the file and the triangles: the file (Assimp
+/// reads it whole) and per triangle 400 bytes for an OBJ (Assimp's vertex per
+/// face corner, the joining's tables) or 300 for the indexed formats (PLY,
+/// glTF, ...: the import, then the bake's copies). Measured peaks of `run`
+/// above the same scene with 10 000 triangles (docs/reliability.md): OBJ 250
+/// to 450 bytes a triangle from 0.3 to 2 million triangles, PLY and glTF 120
+/// to 270.
+#define WX_MESH_BYTES_PER_IMPORTED_FILE_BYTE 1.0
+#define WX_MESH_BYTES_PER_OBJ_TRIANGLE 400.0
+#define WX_MESH_BYTES_PER_TRIANGLE 300.0
 /// Bytes per texel of the bake's float framebuffer (RGBA32F x 2, R32F, depth).
 #define WX_BAKE_FRAMEBUFFER_BYTES_PER_TEXEL 40.0
 /// Bytes per texel of the images of one baked camera (depth 1, normal 3, impact
@@ -107,10 +123,28 @@ typedef struct wx_memory_need {
 /// Margin over the measured sizes (allocator rounding, small buffers).
 #define WX_MEMORY_MARGIN 1.15
 
+/// The longest a particle of emitter `e` can live, in seconds: never more
+/// than the run; less when the forces take every particle down (gravity
+/// beating any upward wind and turbulence): each of its at most maxCollisions
+/// free flights then ends within the time to fall through the solver box from
+/// its top at the fastest upward speed it can have (docs/reliability.md).
+double wx_memory_particle_lifetime(const wx_scene *scene, const wx_emitter *e);
+
+/// The most particles of emitter `e` alive at once: what it emits in the
+/// busiest window of wx_memory_particle_lifetime, over all iterations; never
+/// more than all it emits.
+double wx_memory_particles_alive(const wx_scene *scene, const wx_emitter *e);
+
 /// Estimates the peak memory of running `phases` (WX_PHASE_*) of the scene: the
 /// bake counts when `phases` has it and some camera is baked, the particles when
 /// it has the simulation.
 void wx_memory_estimate(const wx_scene *scene, unsigned phases, wx_memory_need *need);
+
+/// wx_memory_estimate with the meshes imported (`geometry`, in scene order;
+/// NULL: the scene alone), whose triangles bound the import's memory better
+/// than their files' sizes.
+void wx_memory_estimate_geometry(const wx_scene *scene, unsigned phases,
+                                 const wx_geometry *geometry, wx_memory_need *need);
 
 /// Bytes this process can still use: the least of MemAvailable, the cgroup's
 /// memory.max minus memory.current and RLIMIT_AS / RLIMIT_DATA; < 0 when
@@ -119,6 +153,7 @@ double wx_memory_available(void);
 
 /// Refuses (WX_BAD_INPUT, "scene:LINE: ...") a run whose estimate exceeds the
 /// memory available, naming the numbers, before any work starts.
-wx_result wx_memory_check(const wx_scene *scene, unsigned phases, wx_error *err);
+wx_result wx_memory_check(const wx_scene *scene, unsigned phases, const wx_geometry *geometry,
+                          wx_error *err);
 
 #endif

@@ -91,7 +91,11 @@ wx_result wx_pilot_run(const wx_scene *scene, const wx_run_def *opts, wx_geometr
     double start = wx_now_s();
     double duration = wx_scene_duration(scene), total = 0.0;
     for (int e = 0; e < scene->emitter_count; ++e) {
-        total += (double)wx_emitter_count_at(&scene->emitters[e], duration);
+        // rate x time in double: the count saturates at INT64_MAX (rate="1e300"),
+        // which would thin such an emitter too little.
+        const wx_emitter *em = &scene->emitters[e];
+        double span = fmin(duration, em->end) - em->start;
+        total += span > 0.0 && em->rate > 0.0 ? em->rate * span : 0.0;
     }
     if (!(total > 0.0) || scene->input_count == 0) {
         return WX_OK;

@@ -11,7 +11,10 @@
 #include "core/limits.h"
 #include "gather/texture.h"
 #include "io/mesh_import.h"
+#include "io/scene_xml.h"
+#include "model/geometry.h"
 #include "model/mesh.h"
+#include "pipeline/bake_phase.h"
 #include "pipeline/pipeline.h"
 
 const char *const wx_preset_names[] = { "rain", "dust", "soot", "moss" };
@@ -128,8 +131,8 @@ static void camera(text *t, const char *name, const double c[3], const double ax
     int ph = out ? out_px : (int)fmin(16384.0, fmax(16.0, ceil(h / texel)));
     put(t,
         "      <Ortho cameraName=\"%s\"%s>\n"
-        "        <View eye=\"%.6g %.6g %.6g\" target=\"%.6g %.6g %.6g\" up=\"%.6g %.6g %.6g\" "
-        "width=\"%.6g\" height=\"%.6g\" resolution=\"%d %d\"/>\n",
+        "        <View eye=\"%.9g %.9g %.9g\" target=\"%.9g %.9g %.9g\" up=\"%.6g %.6g %.6g\" "
+        "width=\"%.9g\" height=\"%.9g\" resolution=\"%d %d\"/>\n",
         name, out ? " out=\"true\"" : "", c[0] + axis[0] * distance, c[1] + axis[1] * distance,
         c[2] + axis[2] * distance, c[0], c[1], c[2], up[0], up[1], up[2], w, h, pw, ph);
     if (out) {
@@ -155,19 +158,60 @@ void wx_mesh_name(const char *path, char *out, size_t cap)
     wx_default_out_name(raw, out, cap);
 }
 
-static void escape_attr(const char *in, char *out, size_t cap)
+// `in` as an XML attribute value (malloc'd; NULL when out of memory).
+static char *escape_attr(const char *in)
 {
+    char *out = malloc(6 * strlen(in) + 1);
     size_t n = 0;
-    for (; *in != '\0' && n + 7 < cap; ++in) {
+    for (; out != NULL && *in != '\0'; ++in) {
         const char *rep = *in == '&' ? "&amp;" : *in == '"' ? "&quot;" : *in == '<' ? "&lt;"
                                                : *in == '>' ? "&gt;" : NULL;
         if (rep != NULL) {
-            n += (size_t)snprintf(out + n, cap - n, "%s", rep);
+            memcpy(out + n, rep, strlen(rep));
+            n += strlen(rep);
         } else {
             out[n++] = *in;
         }
     }
-    out[n] = '\0';
+    if (out != NULL) {
+        out[n] = '\0';
+    }
+    return out;
+}
+
+// Why `path` cannot be written into a scene file as it is, or NULL: XML holds
+// UTF-8 text only, and normalises tabs and line breaks in attributes to spaces.
+static const char *unwritable_path(const char *path)
+{
+    const unsigned char *s = (const unsigned char *)path;
+    while (*s != '\0') {
+        int extra = *s < 0x80 ? 0 : (*s & 0xe0) == 0xc0 ? 1 : (*s & 0xf0) == 0xe0 ? 2
+                                 : (*s & 0xf8) == 0xf0 ? 3 : -1;
+        if (*s < 0x20 || *s == 0x7f) {
+            return "holds a control character";
+        }
+        if (extra < 0 || (extra == 1 && *s < 0xc2) || (extra == 3 && *s > 0xf4)) {
+            return "is not UTF-8 text";
+        }
+        for (int k = 1; k <= extra; ++k) {
+            if ((s[k] & 0xc0) != 0x80) {
+                return "is not UTF-8 text";
+            }
+        }
+        s += 1 + extra;
+    }
+    return NULL;
+}
+
+// The name in the scene's header comment: no "--" (which ends an XML comment).
+static void comment_name(const char *base, char *out, size_t cap)
+{
+    snprintf(out, cap, "%s", base);
+    for (char *p = out; *p != '\0'; ++p) {
+        if (*p == '-' && p > out && p[-1] == '-') {
+            *p = '_';
+        }
+    }
 }
 
 // Whether the UVs are a UDIM layout: some triangle lies wholly in a tile other
@@ -241,6 +285,9 @@ static void texture_map(text *t, const wx_init_def *def, const wx_uv_survey *s,
     put(t, "      <TextureMap file=\"%s_texture.exr\" resolution=\"%d\"/>\n", base, R);
 }
 
+static wx_result generate(const wx_init_def *def, const preset *p, int pi,
+                          const wx_mesh_data *mesh, bool uvs, char **out_text, wx_error *err);
+
 wx_result wx_scene_generate(const wx_init_def *def, char **out_text, wx_error *err)
 {
     *out_text = NULL;
@@ -250,6 +297,13 @@ wx_result wx_scene_generate(const wx_init_def *def, char **out_text, wx_error *e
                        def->preset);
     }
     const preset *p = &presets[pi];
+    const char *why = unwritable_path(def->mesh_ref);
+    if (why != NULL) {
+        return wx_fail(err, WX_CAUSE_BAD_MESH,
+                       "%s: the mesh's path %s, which a scene file cannot hold; rename the mesh "
+                       "file (or its folders)",
+                       def->mesh_path, why);
+    }
     // The mesh: its bounds, and whether it has UVs (channel 0) for a TextureMap.
     wx_mesh_data mesh;
     bool uvs = true;
@@ -261,22 +315,48 @@ wx_result wx_scene_generate(const wx_init_def *def, char **out_text, wx_error *e
     if (r != WX_OK) {
         return r;
     }
-    int64_t triangles = mesh.triangle_count;
-    double lo[3], hi[3];
-    memcpy(lo, mesh.bounds_min, sizeof lo);
-    memcpy(hi, mesh.bounds_max, sizeof hi);
-    const int R = def->resolution > 0 ? def->resolution : 1024;
-    // How the TextureMap reads the UVs, or none when they cover no texel.
-    wx_uv_survey survey;
-    memset(&survey, 0, sizeof survey);
-    if (uvs && triangles > 0) {
-        r = wx_uv_survey_build(&mesh, 0, R, R, &survey, err);
-    }
-    if (r != WX_OK) {
-        wx_mesh_data_free(&mesh);
-        return r;
-    }
+    r = generate(def, p, pi, &mesh, uvs, out_text, err);
     wx_mesh_data_free(&mesh);
+    return r;
+}
+
+// Whether a mesh of largest extent `size` around `c` fits the scene's single
+// precision: cameras whose matrices the scene check takes (a frame between
+// WX_INIT_MIN_SIZE and WX_INIT_MAX_SIZE across), and float positions that
+// resolve a quarter of the cameras' texel at the farthest point of the
+// solver's box (the largest coordinate of the centre plus three sizes). NULL
+// when it fits, else why not.
+static const char *precision_problem(const double c[3], double size, double texel, char *why,
+                                     size_t cap)
+{
+    if (size < WX_INIT_MIN_SIZE || size > WX_INIT_MAX_SIZE) {
+        snprintf(why, cap, "is %g across, %s than the %g the scene's single precision takes; "
+                 "scale it (and give --units)", size, size < WX_INIT_MIN_SIZE ? "smaller"
+                 : "larger", size < WX_INIT_MIN_SIZE ? WX_INIT_MIN_SIZE : WX_INIT_MAX_SIZE);
+        return why;
+    }
+    double far = 0.0;
+    for (int k = 0; k < 3; ++k) {
+        far = fmax(far, fabs(c[k]));
+    }
+    // The spacing of floats at the farthest point: 2^-23 of it.
+    if ((far + 3.0 * size) * 0x1p-23 > 0.25 * texel) {
+        snprintf(why, cap, "is only %g across but has coordinates up to %g: floats there are "
+                 "%g apart, more than a quarter of a camera texel (%g); move it to the origin",
+                 size, far, (far + 3.0 * size) * 0x1p-23, texel);
+        return why;
+    }
+    return NULL;
+}
+
+// The scene for an imported mesh (wx_scene_generate).
+static wx_result generate(const wx_init_def *def, const preset *p, int pi,
+                          const wx_mesh_data *mesh, bool uvs, char **out_text, wx_error *err)
+{
+    int64_t triangles = mesh->triangle_count;
+    double lo[3], hi[3];
+    memcpy(lo, mesh->bounds_min, sizeof lo);
+    memcpy(hi, mesh->bounds_max, sizeof hi);
     if (triangles == 0) {
         return wx_fail(err, WX_CAUSE_BAD_MESH, "%s: the mesh has no triangles", def->mesh_path);
     }
@@ -289,13 +369,29 @@ wx_result wx_scene_generate(const wx_init_def *def, char **out_text, wx_error *e
     if (!(size > 0.0) || !isfinite(size)) {
         return wx_fail(err, WX_CAUSE_BAD_MESH, "%s: the mesh has no extent", def->mesh_path);
     }
+    const int R = def->resolution > 0 ? def->resolution : 1024;
+    // How the TextureMap reads the UVs, or none when they cover no texel.
+    wx_uv_survey survey;
+    memset(&survey, 0, sizeof survey);
+    if (uvs) {
+        wx_result r = wx_uv_survey_build(mesh, 0, R, R, &survey, err);
+        if (r != WX_OK) {
+            return r;
+        }
+    }
     const double unit = def->unit_m > 0.0 ? def->unit_m : 1.0;
     const double margin = 0.1 * size;
     const double texel = (size + 2.0 * margin) / R;
+    char why[320];
+    if (precision_problem(c, size, texel, why, sizeof why) != NULL) {
+        return wx_fail(err, WX_CAUSE_BAD_MESH, "%s: the mesh %s", def->mesh_path, why);
+    }
 
     // The fall: from H above the top at the preset's speed under its gravity.
     const double g = 9.8 / unit * p->gravity, H = 0.75 * size, v = p->speed * size;
-    const double fall = (-v + sqrt(v * v + 2.0 * g * H)) / g;
+    // (-v + sqrt(v^2 + 2gH)) / g without the cancellation that makes it 0 when
+    // v^2 dwarfs 2gH (a mesh 1e30 across).
+    const double fall = 2.0 * H / (v + sqrt(v * v + 2.0 * g * H));
     const double dt = fall / 50.0, emit = 2.0 * fall;
     const int steps = (int)ceil((emit + 3.0 * fall) / dt);
     // The wind's drift over the fall widens the emitter upwind.
@@ -328,9 +424,13 @@ wx_result wx_scene_generate(const wx_init_def *def, char **out_text, wx_error *e
     double box = 2.0 * fmax(size, fmax(e_hi[0] - e_lo[0], e_hi[2] - e_lo[2])) + 2.0 * H;
     double rate = p->particles / p->iterations / emit;
 
-    char mesh_attr[4096 + 64], base[256], preset_line[512];
-    escape_attr(def->mesh_ref, mesh_attr, sizeof mesh_attr);
+    char base[256], header_name[256], preset_line[512];
+    char *mesh_attr = escape_attr(def->mesh_ref);
+    if (mesh_attr == NULL) {
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (scene text)");
+    }
     wx_mesh_name(def->mesh_path, base, sizeof base);
+    comment_name(base, header_name, sizeof header_name);
     snprintf(preset_line, sizeof preset_line, "%s", p->what);
 
     char iterations[48] = "";
@@ -342,10 +442,10 @@ wx_result wx_scene_generate(const wx_init_def *def, char **out_text, wx_error *e
     put(&t,
         WX_GENERATED_SCENE_MARK "%s, preset %s (docs/presets.md): %s.\n"
         "     The mesh's bounding box is %.6g x %.6g x %.6g (largest extent s = %.6g) around\n"
-        "     (%.6g, %.6g, %.6g); every size below is a multiple of s, so a model in\n"
+        "     (%.9g, %.9g, %.9g); every size below is a multiple of s, so a model in\n"
         "     centimetres weathers as one in metres; gravity is 9.8 m/s^2 in the mesh's unit\n"
         "     (%.6g m). Edit freely: `weathering info` on this file checks it. -->\n",
-        base, wx_preset_names[pi], preset_line, ext[0], ext[1], ext[2], size, c[0], c[1],
+        header_name, wx_preset_names[pi], preset_line, ext[0], ext[1], ext[2], size, c[0], c[1],
         c[2], unit);
     if (def->scene_name != NULL) {
         put(&t, "<Weathering name=\"%s\">\n", def->scene_name);
@@ -361,7 +461,7 @@ wx_result wx_scene_generate(const wx_init_def *def, char **out_text, wx_error *e
     put(&t,
         "  <Solver>\n"
         "    <!-- A cube around the mesh and the emitter: particles leaving it are gone. -->\n"
-        "    <BoundingBox size=\"%.6g\" centerX=\"%.6g\" centerY=\"%.6g\" centerZ=\"%.6g\"/>\n"
+        "    <BoundingBox size=\"%.6g\" centerX=\"%.9g\" centerY=\"%.9g\" centerZ=\"%.9g\"/>\n"
         "    <!-- A fall of 0.75 s from the emitter to the top takes %.3g s: 50 steps a fall;\n"
         "         particles are emitted over two falls and fly three more. -->\n"
         "    <Simulation timeStep=\"%.6g\" steps=\"%d\" seed=\"1\"%s/>\n"
@@ -390,8 +490,8 @@ wx_result wx_scene_generate(const wx_init_def *def, char **out_text, wx_error *e
         "    <!-- A rectangle over the footprint (plus a margin of s/10), %.3g s above the top\n"
         "         (for soot: upwind of the mesh, blowing along the wind), %.0f particles over\n"
         "         the run. -->\n"
-        "    <BoxEmitter name=\"%s\" minX=\"%.6g\" minY=\"%.6g\" minZ=\"%.6g\" maxX=\"%.6g\" "
-        "maxY=\"%.6g\" maxZ=\"%.6g\"\n"
+        "    <BoxEmitter name=\"%s\" minX=\"%.9g\" minY=\"%.9g\" minZ=\"%.9g\" maxX=\"%.9g\" "
+        "maxY=\"%.9g\" maxZ=\"%.9g\"\n"
         "                dirX=\"%.6g\" dirY=\"%.6g\" dirZ=\"%.6g\" spread=\"%.6g\" rate=\"%.6g\" "
         "start=\"0\" end=\"%.6g\"\n"
         "                speed=\"%.6g\" maxCollisions=\"60\"%s>\n",
@@ -471,10 +571,35 @@ wx_result wx_scene_generate(const wx_init_def *def, char **out_text, wx_error *e
             0.15 * size, 0.1 * rate * emit / (size * size), 1.0 / pow(0.1 * rate * emit / (size * size), 2.0));
     }
     put(&t, "</Weathering>\n");
+    free(mesh_attr);
     if (t.failed) {
         free(t.s);
         return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (scene text)");
     }
+    // The scene as a run will read it, before anyone writes it: a mesh the
+    // checks above let through but the scene check refuses is still refused
+    // here, naming the mesh, and nothing is written.
+    const char *scene_path = def->scene_path != NULL ? def->scene_path : "scene.xml";
+    wx_scene scene;
+    wx_error load_err;
+    if (wx_scene_load_text(scene_path, t.s, t.len, &scene, &load_err) != WX_OK) {
+        free(t.s);
+        if (load_err.cause == WX_CAUSE_OUT_OF_MEMORY) {
+            *err = load_err;
+            return WX_FAIL;
+        }
+        return wx_fail(err, WX_CAUSE_BAD_MESH,
+                       "%s: no valid scene can be made for this mesh (bounds (%g, %g, %g) to "
+                       "(%g, %g, %g)): %s",
+                       def->mesh_path, lo[0], lo[1], lo[2], hi[0], hi[1], hi[2],
+                       load_err.message);
+    }
+    // A mesh the generated cameras see edge-on (no thickness along an axis)
+    // gets its scene, with the warning that its run will be all zero.
+    wx_geometry_mesh one = { .data = *mesh };
+    wx_geometry geometry = { .count = 1, .meshes = &one };
+    wx_geometry_warn_blind(&scene, &geometry, def->mesh_path, def->quiet);
+    wx_scene_free(&scene);
     *out_text = t.s;
     return WX_OK;
 }

@@ -28,8 +28,20 @@ typedef struct wx_init_def {
     /// The scene's name (<Weathering name>, its default output folder), a
     /// plain name; NULL: none, the scene file's name is the scene's.
     const char *scene_name;
-    bool quiet; ///< no note on stderr (a UV layout that covers no texel)
+    /// Where the scene will be written (NULL: scene.xml in the current folder):
+    /// it is checked as that file before it is handed back.
+    const char *scene_path;
+    /// No note or warning on stderr (a UV layout that covers no texel, a mesh
+    /// the cameras see edge-on).
+    bool quiet;
 } wx_init_def;
+
+/// The smallest and the largest mesh (largest extent, in its units) a scene is
+/// generated for: the cameras' matrices of a smaller or a larger one mix
+/// numbers too different for single precision (the scene check refuses them
+/// as singular or not orthographic; the limit is about 5e5 for the largest).
+#define WX_INIT_MIN_SIZE 1e-6
+#define WX_INIT_MAX_SIZE 1e5
 
 /// The mesh's name for the files and folders made from it (the generated
 /// scene, out/NAME/, NAME_texture.exr): the file name without its folder and
@@ -43,11 +55,19 @@ int wx_preset_find(const char *name);
 /// Metres per unit of a --units name (m, cm, mm, in, ft), or 0 when unknown.
 double wx_unit_metres(const char *name);
 
-/// Imports the mesh (WX_BAD_INPUT naming it when it cannot be read or has no
-/// triangles) and writes the scene's XML into *text (malloc'd, commented).
-/// A mesh with UVs gets a <TextureMap>: tiles="udim" when its UVs lie in UDIM
-/// tiles beyond 1001, and none (with a note in the scene and on stderr) when
-/// its layout covers no texel (docs/presets.md).
+/// Imports the mesh and writes the scene's XML into *text (malloc'd,
+/// commented), checked as the scene file def->scene_path before it is handed
+/// back. WX_BAD_INPUT naming the mesh (WX_CAUSE_BAD_MESH, nothing in *text)
+/// when it cannot be read or has no triangles, when its path cannot be
+/// written in XML (not UTF-8, a control character), when it is too small or
+/// too large (WX_INIT_MIN_SIZE, WX_INIT_MAX_SIZE) or lies too far from the
+/// origin for its size (floats there more than a quarter of a camera
+/// texel apart), or when the scene check refuses the scene for any other
+/// reason. Warns (unless def->quiet) when the generated cameras would see the
+/// mesh edge-on (wx_geometry_warn_blind). A mesh with UVs gets a
+/// <TextureMap>: tiles="udim" when its UVs lie in UDIM tiles beyond 1001, and
+/// none (with a note in the scene and on stderr) when its layout covers no
+/// texel (docs/presets.md).
 wx_result wx_scene_generate(const wx_init_def *def, char **text, wx_error *err);
 
 #endif

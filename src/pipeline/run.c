@@ -94,7 +94,7 @@ wx_result wx_run_phases(wx_scene *scene, const wx_run_def *opts, unsigned phases
         r = wx_gather_check(scene, err);
     }
     if (r == WX_OK) {
-        r = wx_memory_check(scene, phases, err);
+        r = wx_memory_check(scene, phases, geometry.count > 0 ? &geometry : NULL, err);
     }
     if (r == WX_OK) {
         r = wx_check_outputs(scene, opts, phases, err);

@@ -178,10 +178,11 @@ static void report_layout(const wx_scene *scene, const wx_run_def *opts,
     }
     if (unusable > 0) {
         wx_warn(opts->quiet,
-                "%s:%d: texture %s: %lld of %lld triangles have a UV that is not a finite "
-                "number%s; they are left out",
+                "%s:%d: texture %s: %lld of %lld triangles have no usable UVs (a UV that is not "
+                "a finite number or lies beyond 65536, all three corners at one point or on one "
+                "line in UV: an OBJ face without vt%s); they cover no texel",
                 scene->path, def->line, def->file, (long long)unusable, (long long)triangles,
-                def->tiles == WX_TILES_CLIP ? "" : " or span more than 64 UV tiles");
+                def->tiles == WX_TILES_CLIP ? "" : "; or more than 64 UV tiles spanned");
     }
     if (covered == 0) {
         wx_warn(opts->quiet,

@@ -13,8 +13,11 @@ int64_t wx_emitter_count_at(const wx_emitter *e, double t)
     if (!(span > 0.0) || !(e->rate > 0.0)) {
         return 0;
     }
-    double n = e->rate * span;
-    return (int64_t)floor(n + 1e-12 * n + 1e-12);
+    double n = floor(e->rate * span * (1.0 + 1e-12) + 1e-12);
+    // Clamped in double before the cast: rate="1e300" is more than any count
+    // (the cast overflowed to a negative count, which the memory check let
+    // through).
+    return n < 9.2e18 ? (int64_t)n : INT64_MAX;
 }
 
 void wx_uniform_sphere(float u1, float u2, float d[3])

@@ -15,7 +15,8 @@
 
 /// Particles emitter `e` has emitted by time t: floor(rate * (min(t, end) - start)),
 /// 0 before start. A relative 1e-12 guards against decimal time steps landing just
-/// below an integer (1000 * (29 * 0.01) is 289.99999999999997 in binary).
+/// below an integer (1000 * (29 * 0.01) is 289.99999999999997 in binary). A
+/// count beyond int64_t (rate="1e300") is INT64_MAX.
 int64_t wx_emitter_count_at(const wx_emitter *e, double t);
 
 /// A unit direction uniform over the sphere, from two uniforms in [0, 1).

@@ -271,8 +271,9 @@ static float curvature(const job *jb, const wx_mask_def *m, int i, int j)
 {
     const wx_mask_points *g = &jb->def->points;
     double radius = m->radius > 0.0f ? m->radius : 4.0 * g->texel;
-    int reach = (int)ceil(radius / g->texel);
-    reach = reach < 1 ? 1 : (reach > CURVATURE_MAX_REACH ? CURVATURE_MAX_REACH : reach);
+    // Clamped in double before the cast: a radius of 1e30 is the most texels
+    // allowed, not an overflow (which made it one texel).
+    int reach = (int)fmin((double)CURVATURE_MAX_REACH, fmax(1.0, ceil(radius / g->texel)));
     size_t t = (size_t)j * (size_t)g->width + (size_t)i;
     const double *p = &g->position[3 * t];
     const float *n = &g->normal[3 * t];

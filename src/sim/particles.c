@@ -24,6 +24,9 @@ void wx_particles_free(wx_particles *p)
 // Grows one array to `capacity` elements of `size` bytes, zeroing the new part.
 static bool grow(void **array, int64_t old_capacity, int64_t capacity, size_t size)
 {
+    if ((uint64_t)capacity > SIZE_MAX / size) {
+        return false; // more bytes than an address holds: out of memory, not a wrap
+    }
     void *bigger = realloc(*array, (size_t)capacity * size);
     if (bigger == NULL) {
         return false;
