@@ -198,8 +198,10 @@ void wx_memory_estimate_geometry(const wx_scene *scene, unsigned phases,
             // and at most 64 times its triangles (a file holds a triangle per 16
             // bytes at the most, when it was not imported).
             double triangles = data != NULL ? (double)data->triangle_count : bytes / 16.0;
-            need->mesh_bytes += WX_SMOOTH_BYTES_PER_TRIANGLE *
-                                fmin(WX_SMOOTH_MAX_TRIANGLES, 64.0 * triangles);
+            double smooth = WX_SMOOTH_BYTES_PER_TRIANGLE *
+                            fmin(WX_SMOOTH_MAX_TRIANGLES, 64.0 * triangles);
+            need->mesh_bytes += smooth;
+            need->smooth_bytes += smooth;
             if (bytes > largest_file) {
                 largest_file = bytes;
                 need->mesh_line = scene->meshes[m].line;
@@ -305,7 +307,9 @@ void wx_memory_estimate_geometry(const wx_scene *scene, unsigned phases,
             need->texture_write_bytes;
     }
     // The renderer leaves part of its memory behind for the phases after it.
-    double residue = need->bake_bytes > 0.0 ? WX_BAKE_RESIDUE_BYTES : 0.0;
+    // What the bake leaves behind: the renderer's caches, and the heap its
+    // smooth surfaces took (freed, but still counted in the peak's pages).
+    double residue = need->bake_bytes > 0.0 ? WX_BAKE_RESIDUE_BYTES + need->smooth_bytes : 0.0;
     double sim =
         need->sim_map_bytes + need->particle_bytes + ((phases & WX_PHASE_SIMULATE) ? residue : 0.0);
     double gather = need->gather_bytes + ((phases & WX_PHASE_GATHER) ? residue : 0.0);

@@ -16,6 +16,7 @@
 typedef struct wx_memory_need {
     double baseline_bytes;     ///< the program and its libraries (WX_MEMORY_BASELINE)
     double mesh_bytes;         ///< importing the meshes (mesh_import_bytes in memory.c)
+    double smooth_bytes;       ///< the meshes' smooth surfaces (in mesh_bytes, and left behind)
     double bake_bytes;         ///< the bake: GL context, framebuffer, images being written, meshes
     double sim_map_bytes;      ///< the simulation's maps, collider and dirt (without particles)
     double frame_bytes;        ///< part of sim_map_bytes: a frame of the mask's sequence

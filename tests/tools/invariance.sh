@@ -1,0 +1,55 @@
+#!/bin/sh
+# invariance.sh BUILD MESH.obj [PARTICLES]: how much a model's TextureMap under
+# vertical rain changes when the model is turned 30 degrees about the vertical
+# in the camera grid, against how much it changes between two seeds (issue 25,
+# docs/performance.md). Both orientations run with the same cameras (those
+# init makes for the turned model, whose frames hold both) and the rain
+# preset's collider and surfaces, its wind and cone taken away, PARTICLES
+# drops (default 810000) from one box over the footprint; seeds 1 and 2 each.
+# Prints, per block size, the RMS difference over the mean between seeds, between
+# orientations, and their ratio (build/tools/texture_compare). Outputs in
+# BUILD/invariance/.
+set -eu
+build=$1
+mesh=$2
+particles=${3:-810000}
+dir=$build/invariance
+rm -rf "$dir"
+mkdir -p "$dir"
+# The mesh turned 30 degrees about +Y around its bounding box's centre.
+awk '/^v / { n++; x[n] = $2; z[n] = $4
+             if (n == 1 || $2 < x0) x0 = $2; if (n == 1 || $2 > x1) x1 = $2
+             if (n == 1 || $4 < z0) z0 = $4; if (n == 1 || $4 > z1) z1 = $4 }
+     END { printf "%.9g %.9g\n", (x0 + x1) / 2, (z0 + z1) / 2 }' "$mesh" > "$dir/centre"
+read cx cz < "$dir/centre"
+awk -v cx="$cx" -v cz="$cz" 'BEGIN { c = cos(30 * 3.14159265358979 / 180); s = sin(30 * 3.14159265358979 / 180) }
+     /^v / { x = $2 - cx; z = $4 - cz; printf "v %.9g %s %.9g\n", cx + c * x + s * z, $3, cz - s * x + c * z; next }
+     /^vn / { x = $2; z = $4; printf "vn %.9g %s %.9g\n", c * x + s * z, $3, -s * x + c * z; next }
+     { print }' "$mesh" > "$dir/turned.obj"
+cp "$mesh" "$dir/model.obj"
+(cd "$dir" && "../weathering" init turned.obj -o turned.xml -q --force)
+# Vertical rain: no wind, no cone, PARTICLES drops.
+sed -e 's/<Wind strength="[0-9.e+-]*"/<Wind strength="0"/' -e 's/spread="[0-9.]*"/spread="0"/' \
+    "$dir/turned.xml" > "$dir/turned.tmp"
+end=$(grep -o ' end="[^"]*"' "$dir/turned.tmp" | head -1 | sed 's/.*"\(.*\)"/\1/')
+rate=$(awk -v n="$particles" -v e="$end" 'BEGIN { printf "%.0f", n / e }')
+sed -e "s/rate=\"[0-9.e+-]*\"/rate=\"$rate\"/" "$dir/turned.tmp" > "$dir/turned.xml"
+sed -e 's|turned.obj|model.obj|' -e 's|turned_texture.exr|model_texture.exr|' \
+    "$dir/turned.xml" > "$dir/model.xml"
+for m in model turned; do
+    for s in 1 2; do
+        echo "invariance: $m, seed $s" >&2
+        (cd "$dir" && "../weathering" run "$m.xml" --out "$m$s" --seed "$s" -q)
+    done
+done
+c=$build/tools/texture_compare
+$c "$dir/model1/model_texture.exr" "$dir/model2/model_texture.exr" > "$dir/seeds_model"
+$c "$dir/turned1/turned_texture.exr" "$dir/turned2/turned_texture.exr" > "$dir/seeds_turned"
+$c "$dir/model1/model_texture.exr" "$dir/turned1/turned_texture.exr" > "$dir/turn_1"
+$c "$dir/model2/model_texture.exr" "$dir/turned2/turned_texture.exr" > "$dir/turn_2"
+for k in 1 2 4 8 16 32; do
+    get() { awk -v k="$k" '$1 == "block" && $2 + 0 == k { print $4 }' "$dir/$1"; }
+    awk -v k="$k" -v a="$(get seeds_model)" -v b="$(get seeds_turned)" -v c="$(get turn_1)" \
+        -v d="$(get turn_2)" 'BEGIN { s = (a + b) / 2; o = (c + d) / 2
+        printf "block %2d: seeds %.4f  orientations %.4f  ratio %.3f\n", k, s, o, o / s }'
+done
