@@ -137,6 +137,112 @@ static void camera(text *t, const char *name, const double c[3], const double ax
     put(t, "      </Ortho>\n");
 }
 
+// ---------------------------------------------------------------------------
+// What every preset holds on any model (docs/presets.md).
+
+// A particle dies at its 60th collision (the emitters' maxCollisions).
+enum { MAX_COLLISIONS = 60 };
+static const double DEG = 3.14159265358979323846 / 180.0;
+
+// Flight times: a particle without collisions and turbulence moves as
+// p(t) = p0 + v0 t + a t^2 / 2 under the preset's gravity and wind (both
+// constant accelerations, docs/physics.md); the run is sized from these times.
+static void path_at(const double p0[3], const double v0[3], const double a[3], double t,
+                    double p[3])
+{
+    for (int k = 0; k < 3; ++k) {
+        p[k] = p0[k] + v0[k] * t + 0.5 * a[k] * t * t;
+    }
+}
+
+static bool inside(const double p[3], const double lo[3], const double hi[3])
+{
+    return p[0] >= lo[0] && p[0] <= hi[0] && p[1] >= lo[1] && p[1] <= hi[1] && p[2] >= lo[2] &&
+           p[2] <= hi[2];
+}
+
+// Whether the segment a -> b meets the box [lo, hi] (slabs).
+static bool segment_meets(const double a[3], const double b[3], const double lo[3],
+                          const double hi[3])
+{
+    double t0 = 0.0, t1 = 1.0;
+    for (int k = 0; k < 3; ++k) {
+        double d = b[k] - a[k];
+        if (d == 0.0) {
+            if (a[k] < lo[k] || a[k] > hi[k]) {
+                return false;
+            }
+            continue;
+        }
+        double u = (lo[k] - a[k]) / d, w = (hi[k] - a[k]) / d;
+        t0 = fmax(t0, fmin(u, w));
+        t1 = fmin(t1, fmax(u, w));
+    }
+    return t0 <= t1;
+}
+
+// The first time within [0, t_max] at which the path meets the box [lo, hi]
+// (`to_enter`: the mesh's box, which may be flat) or is outside it (the
+// solver's); t_max when it never does. The path is followed in 4096 chords,
+// the one where it happens halved 40 times.
+static double first_time(const double p0[3], const double v0[3], const double a[3],
+                         const double lo[3], const double hi[3], bool to_enter, double t_max)
+{
+    enum { SAMPLES = 4096 };
+    double t0 = 0.0, p[3], q[3];
+    path_at(p0, v0, a, 0.0, p);
+    if (inside(p, lo, hi) == to_enter) {
+        return 0.0;
+    }
+    for (int i = 1; i <= SAMPLES; ++i) {
+        double t1 = t_max * i / SAMPLES;
+        path_at(p0, v0, a, t0, p);
+        path_at(p0, v0, a, t1, q);
+        if (to_enter ? segment_meets(p, q, lo, hi) : !inside(q, lo, hi)) {
+            for (int it = 0; it < 40; ++it) {
+                double tm = 0.5 * (t0 + t1);
+                path_at(p0, v0, a, tm, q);
+                if (to_enter ? segment_meets(p, q, lo, hi) : !inside(q, lo, hi)) {
+                    t1 = tm;
+                } else {
+                    t0 = tm;
+                    path_at(p0, v0, a, t0, p);
+                }
+            }
+            return t1;
+        }
+        t0 = t1;
+    }
+    return t_max;
+}
+
+// Unit vectors at `spread` degrees around the unit vector d (its cone's rim),
+// with d itself first: five launch directions.
+static void cone_rim(const double d[3], double spread_deg, double out[5][3])
+{
+    double u[3] = { 0.0, 0.0, 0.0 };
+    u[fabs(d[0]) < 0.9 ? 0 : 1] = 1.0; // any vector not along d
+    double e1[3] = { d[1] * u[2] - d[2] * u[1], d[2] * u[0] - d[0] * u[2],
+                     d[0] * u[1] - d[1] * u[0] };
+    double l1 = sqrt(e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]);
+    for (int k = 0; k < 3; ++k) {
+        e1[k] /= l1;
+    }
+    double e2[3] = { d[1] * e1[2] - d[2] * e1[1], d[2] * e1[0] - d[0] * e1[2],
+                     d[0] * e1[1] - d[1] * e1[0] };
+    double c = cos(spread_deg * DEG), sn = sin(spread_deg * DEG);
+    const double *side[4] = { e1, e2, e1, e2 };
+    for (int k = 0; k < 3; ++k) {
+        out[0][k] = d[k];
+    }
+    for (int r = 0; r < 4; ++r) {
+        double sign = r < 2 ? 1.0 : -1.0;
+        for (int k = 0; k < 3; ++k) {
+            out[r + 1][k] = c * d[k] + sign * sn * side[r][k];
+        }
+    }
+}
+
 void wx_mesh_name(const char *path, char *out, size_t cap)
 {
     char raw[WX_PATH_MAX];
@@ -211,17 +317,17 @@ wx_result wx_scene_generate(const wx_init_def *def, char **out_text, wx_error *e
     const double margin = 0.1 * size;
     const double texel = (size + 2.0 * margin) / R;
 
-    // The fall: from H above the top at the preset's speed under its gravity.
+    // The fall: from H above the top at the preset's speed under its gravity;
+    // the wind's drift over it widens the emitter upwind.
     const double g = 9.8 / unit * p->gravity, H = 0.75 * size, v = p->speed * size;
     const double fall = (-v + sqrt(v * v + 2.0 * g * H)) / g;
-    const double dt = fall / 50.0, emit = 2.0 * fall;
-    const int steps = (int)ceil((emit + 3.0 * fall) / dt);
-    // The wind's drift over the fall widens the emitter upwind.
     double wind_len = sqrt(p->wind_dir[0] * p->wind_dir[0] + p->wind_dir[1] * p->wind_dir[1] +
                            p->wind_dir[2] * p->wind_dir[2]);
     double wind = p->wind * 9.8 / unit, drift[3] = { 0.0, 0.0, 0.0 };
+    double accel[3] = { 0.0, -g, 0.0 }; // gravity and wind: the force on a unit mass
     for (int k = 0; k < 3 && wind_len > 0.0; ++k) {
         drift[k] = 0.5 * wind * fall * fall * p->wind_dir[k] / wind_len;
+        accel[k] += wind * p->wind_dir[k] / wind_len;
     }
     double e_lo[3] = { lo[0] - margin, hi[1] + H, lo[2] - margin };
     double e_hi[3] = { hi[0] + margin, hi[1] + H, hi[2] + margin };
@@ -243,7 +349,71 @@ wx_result wx_scene_generate(const wx_init_def *def, char **out_text, wx_error *e
             edir[k] = p->wind_dir[k] / wind_len;
         }
     }
-    double box = 2.0 * fmax(size, fmax(e_hi[0] - e_lo[0], e_hi[2] - e_lo[2])) + 2.0 * H;
+    // The solver's box: s/4 around the mesh and s/10 around the emitter, its
+    // floor s/20 below the mesh, the cube's slack above and evenly on the
+    // sides. A particle that missed or ran off then leaves soon instead of
+    // flying on; and none reaches the space under the mesh below the side
+    // cameras' frames (s/10 below it), where the top camera alone would
+    // answer and call every point under the mesh's outline a collision (the
+    // point rule, docs/physics.md) with the top of the mesh.
+    const double pad = 0.25 * size;
+    double box_lo[3], box_hi[3], bc[3], box = 0.0;
+    for (int k = 0; k < 3; ++k) {
+        box_lo[k] = fmin(k == 1 ? lo[k] - 0.5 * margin : lo[k] - pad, e_lo[k] - margin);
+        box_hi[k] = fmax(hi[k] + pad, e_hi[k] + margin);
+        box = fmax(box, box_hi[k] - box_lo[k]);
+    }
+    for (int k = 0; k < 3; ++k) {
+        bc[k] = k == 1 ? box_lo[1] + 0.5 * box : 0.5 * (box_lo[k] + box_hi[k]);
+        box_lo[k] = bc[k] - 0.5 * box;
+        box_hi[k] = bc[k] + 0.5 * box;
+    }
+    // The approach: the emitter's central path into the mesh's bounding box;
+    // 50 steps for it, emission over two approaches.
+    const double t_max = 100.0 * fall;
+    double ec[3], v0[3];
+    for (int k = 0; k < 3; ++k) {
+        ec[k] = 0.5 * (e_lo[k] + e_hi[k]);
+        v0[k] = v * edir[k];
+    }
+    double approach = first_time(ec, v0, accel, lo, hi, true, t_max);
+    if (!(approach > 0.0) || approach >= t_max) {
+        approach = fall; // a path that grazes the box: the fall's time
+    }
+    const double dt = approach / 50.0, emit = 2.0 * approach;
+    // What the last particles emitted need: a miss flies out of the box; a hit
+    // reaches the mesh, collides at most MAX_COLLISIONS times (a sliding
+    // particle collides every step, one that hops at least every other step)
+    // and falls from rest out of the box. From
+    // 3 x 3 x 3 points of the emitter along its direction and its cone's rim,
+    // from every corner of the mesh's box; a quarter more for turbulence and
+    // bounces.
+    double dirs[5][3], miss = 0.0, reach = 0.0, from_rest = 0.0;
+    cone_rim(edir, p->spread, dirs);
+    static const double zero[3] = { 0.0, 0.0, 0.0 };
+    for (int n = 0; n < 27; ++n) {
+        double ep[3];
+        for (int k = 0, m = n; k < 3; ++k, m /= 3) {
+            ep[k] = e_lo[k] + 0.5 * (m % 3) * (e_hi[k] - e_lo[k]);
+        }
+        for (int dn = 0; dn < 5; ++dn) {
+            double vd[3] = { v * dirs[dn][0], v * dirs[dn][1], v * dirs[dn][2] };
+            miss = fmax(miss, first_time(ep, vd, accel, box_lo, box_hi, false, t_max));
+            double in = first_time(ep, vd, accel, lo, hi, true, t_max);
+            if (in < t_max) {
+                reach = fmax(reach, in);
+            }
+        }
+    }
+    for (int corner = 0; corner < 8; ++corner) {
+        double mp[3];
+        for (int k = 0; k < 3; ++k) {
+            mp[k] = (corner >> k & 1) ? hi[k] : lo[k];
+        }
+        from_rest = fmax(from_rest, first_time(mp, zero, accel, box_lo, box_hi, false, t_max));
+    }
+    const double after = 1.25 * fmax(miss, reach + 2 * MAX_COLLISIONS * dt + from_rest);
+    const int steps = (int)ceil((emit + after) / dt);
     double rate = p->particles / p->iterations / emit;
 
     char mesh_attr[4096 + 64], base[256], preset_line[512];
@@ -278,13 +448,20 @@ wx_result wx_scene_generate(const wx_init_def *def, char **out_text, wx_error *e
     }
     put(&t,
         "  <Solver>\n"
-        "    <!-- A cube around the mesh and the emitter: particles leaving it are gone. -->\n"
+        "    <!-- A cube s/4 around the mesh and s/10 around the emitter, its floor s/20 below\n"
+        "         the mesh (above the side cameras' frames: below them only the top camera\n"
+        "         would see, and take everything under the mesh for its top): particles\n"
+        "         leaving it are gone, so those that missed leave soon. -->\n"
         "    <BoundingBox size=\"%.6g\" centerX=\"%.6g\" centerY=\"%.6g\" centerZ=\"%.6g\"/>\n"
-        "    <!-- A fall of 0.75 s from the emitter to the top takes %.3g s: 50 steps a fall;\n"
-        "         particles are emitted over two falls and fly three more. -->\n"
+        "    <!-- The particles reach the mesh's box %.3g s after leaving the emitter: 50 steps\n"
+        "         for that. They are emitted over twice that, then the run goes on %.3g s for\n"
+        "         the last ones to land or leave: 1.25 x the longer of a miss's flight out of\n"
+        "         the box (%.3g s) and a hit's approach (%.3g s), %d collisions (a step for\n"
+        "         a slide, two for a hop) and fall from rest out of the box (%.3g s). -->\n"
         "    <Simulation timeStep=\"%.6g\" steps=\"%d\" seed=\"1\"%s/>\n"
         "  </Solver>\n",
-        box, c[0], c[1] + 0.5 * H, c[2], fall, dt, steps, iterations);
+        box, bc[0], bc[1], bc[2], approach, after, miss, reach, MAX_COLLISIONS, from_rest, dt,
+        steps, iterations);
     put(&t, "  <ForceFields>\n");
     put(&t, "    <!-- Gravity%s, in the mesh's unit per second squared. -->\n"
             "    <Gravity acceleration=\"%.6g\"/>\n",
@@ -312,9 +489,9 @@ wx_result wx_scene_generate(const wx_init_def *def, char **out_text, wx_error *e
         "maxY=\"%.6g\" maxZ=\"%.6g\"\n"
         "                dirX=\"%.6g\" dirY=\"%.6g\" dirZ=\"%.6g\" spread=\"%.6g\" rate=\"%.6g\" "
         "start=\"0\" end=\"%.6g\"\n"
-        "                speed=\"%.6g\" maxCollisions=\"60\"%s>\n",
+        "                speed=\"%.6g\" maxCollisions=\"%d\"%s>\n",
         0.75, p->particles, wx_preset_names[pi], e_lo[0], e_lo[1], e_lo[2], e_hi[0], e_hi[1],
-        e_hi[2], edir[0], edir[1], edir[2], p->spread, rate, emit, v,
+        e_hi[2], edir[0], edir[1], edir[2], p->spread, rate, emit, v, MAX_COLLISIONS,
         pi == PRESET_MOSS ? "" : " dirt=\"1\"");
     if (pi == PRESET_MOSS) {
         put(&t, "      <Load substance=\"water\" amount=\"1\"/>\n");
