@@ -143,6 +143,8 @@ static void camera(text *t, const char *name, const double c[3], const double ax
 // A particle dies at its 60th collision (the emitters' maxCollisions).
 enum { MAX_COLLISIONS = 60 };
 static const double DEG = 3.14159265358979323846 / 180.0;
+// The output camera's elevation, degrees: between a side view and a plan.
+static const double VIEW_LOW = 20.0, VIEW_HIGH = 60.0;
 
 // Flight times: a particle without collisions and turbulence moves as
 // p(t) = p0 + v0 t + a t^2 / 2 under the preset's gravity and wind (both
@@ -515,14 +517,31 @@ wx_result wx_scene_generate(const wx_init_def *def, char **out_text, wx_error *e
     if (p->bottom) {
         camera(&t, "bottom", c, (const double[3]){ 0, -1, 0 }, PZ, d, fx, fz, texel, false, 0);
     }
-    // A three-quarter view from the front right, above; its frame holds the
+    // The output camera looks at the side the particles come at: against their
+    // velocity where they reach the mesh (the wind's side; the front right
+    // when they come straight down), from between VIEW_LOW and VIEW_HIGH
+    // degrees above the horizon, a three-quarter view; its frame holds the
     // whole box whichever way it turns.
-    double q[3] = { 1.0, 0.8, 1.2 }, ql = sqrt(1.0 + 0.64 + 1.44);
+    double q[3], arrive[3];
     for (int k = 0; k < 3; ++k) {
-        q[k] /= ql;
+        arrive[k] = v0[k] + accel[k] * approach;
     }
+    double hx = -arrive[0], hz = -arrive[2], h = sqrt(hx * hx + hz * hz);
+    double elevation = atan2(-arrive[1], h) / DEG;
+    if (!(h > 1e-3 * fabs(arrive[1]))) {
+        hx = 1.0; // straight down: the front right
+        hz = 1.2;
+        h = sqrt(hx * hx + hz * hz);
+    }
+    elevation = fmin(VIEW_HIGH, fmax(VIEW_LOW, elevation));
+    q[0] = cos(elevation * DEG) * hx / h;
+    q[1] = sin(elevation * DEG);
+    q[2] = cos(elevation * DEG) * hz / h;
     double diag = sqrt(ext[0] * ext[0] + ext[1] * ext[1] + ext[2] * ext[2]) + 2.0 * margin;
-    put(&t, "      <!-- The output camera: a three-quarter view from the front right. -->\n");
+    put(&t,
+        "      <!-- The output camera: a three-quarter view of the side the particles come at,\n"
+        "           from azimuth %.0f degrees (from +X towards +Z), %.0f degrees up. -->\n",
+        atan2(hz, hx) / DEG, elevation);
     camera(&t, "shot", c, q, Y, d, diag, diag, texel, true, R);
     put(&t, "    </ProjectedMaps>\n  </Collider>\n");
     if (pi == PRESET_MOSS) {
