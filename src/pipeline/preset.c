@@ -48,8 +48,8 @@ static const preset presets[] = {
                       "thinner on tops, some on undersides",
                       0.6, 0.02, 15.0, 0.03, { 1.0, 0.0, 0.3 }, 0.05, 300000, 1, true,
                       0.5, 0.05, 0.9, 0.01, 0.05, 0.8 },
-    [PRESET_MOSS] = { "five rainy spells: the rain's water lingers, moss grows from it where it "
-                      "stays wet, and a 'mossy' mask adds shelter and shade",
+    [PRESET_MOSS] = { "five rainy spells: the rain's water lingers, and the mask 'moss' grows "
+                      "where it stays wet in shelter and shade",
                       2.0, 1.0, 8.0, 0.3, { -1.0, 0.0, -0.4 }, 0.0, 400000, 5, false,
                       0.3, 0.1, 0.5, 0.1, 0.2, 0.9 },
 };
@@ -145,6 +145,19 @@ enum { MAX_COLLISIONS = 60 };
 static const double DEG = 3.14159265358979323846 / 180.0;
 // The output camera's elevation, degrees: between a side view and a plan.
 static const double VIEW_LOW = 20.0, VIEW_HIGH = 60.0;
+// Moss (the Combine 'moss'): the shelter's rays (most of the preset's cost:
+// docs/presets.md), and the scale that takes a wet, sheltered surface in the
+// shade to 1. A surface counts as sheltered when at least two of its rays
+// meet a surface: one alone is as often a graze.
+enum { MOSS_RAYS = 12 };
+static const double MOSS_SCALE = 1.3;
+
+// The steepness of a Combine term's sigmoid (docs/masks.md) that goes from 0.1
+// to 0.9 over its offset +- w: S(o + w) = 0.9 when w sqrt(s) = 4/3.
+static double steepness_for(double w)
+{
+    return (4.0 / 3.0) * (4.0 / 3.0) / (w * w);
+}
 
 // Flight times: a particle without collisions and turbulence moves as
 // p(t) = p0 + v0 t + a t^2 / 2 under the preset's gravity and wind (both
@@ -318,6 +331,10 @@ wx_result wx_scene_generate(const wx_init_def *def, char **out_text, wx_error *e
     const double unit = def->unit_m > 0.0 ? def->unit_m : 1.0;
     const double margin = 0.1 * size;
     const double texel = (size + 2.0 * margin) / R;
+    // The input cameras' texel: moss's at half the resolution from 1024 up
+    // (below), at least 512 texels across.
+    const double in_texel = pi == PRESET_MOSS && R > 512 ? texel * R / fmax(512.0, 0.5 * R)
+                                                         : texel;
 
     // The fall: from H above the top at the preset's speed under its gravity;
     // the wind's drift over it widens the emitter upwind.
@@ -444,9 +461,9 @@ wx_result wx_scene_generate(const wx_init_def *def, char **out_text, wx_error *e
     }
     if (pi == PRESET_MOSS) {
         put(&t,
-            "  <!-- The rain carries water; moss grows from the water that stays. -->\n"
-            "  <Substances>\n    <Substance name=\"water\"/>\n    <Substance name=\"moss\"/>\n"
-            "  </Substances>\n");
+            "  <!-- The rain carries water; the mask 'moss' below says where it lingers in\n"
+            "       shelter and shade. -->\n"
+            "  <Substances>\n    <Substance name=\"water\"/>\n  </Substances>\n");
     }
     put(&t,
         "  <Solver>\n"
@@ -505,17 +522,24 @@ wx_result wx_scene_generate(const wx_init_def *def, char **out_text, wx_error *e
         "    <ProjectedMaps>\n"
         "      <!-- The mesh from four sides and above%s, frames s/10 wider than it, %.4g a\n"
         "           texel (a resolution of %d across the largest). -->\n",
-        p->resilience, p->friction, p->bottom ? " and below" : "", texel, R);
+        p->resilience, p->friction, p->bottom ? " and below" : "", in_texel,
+        (int)ceil((size + 2.0 * margin) / in_texel - 1e-9));
+    if (in_texel > texel) {
+        put(&t,
+            "      <!-- Half the output's and the texture's resolution (at least 512 across):\n"
+            "           moss is a soft mask, and its shelter's rays, marched through these maps,\n"
+            "           cost about a third less. -->\n");
+    }
     double d = 2.0 * (size + 2.0 * margin);
     static const double Y[3] = { 0, 1, 0 }, NZ[3] = { 0, 0, -1 }, PZ[3] = { 0, 0, 1 };
     const double fx = ext[0] + 2 * margin, fy = ext[1] + 2 * margin, fz = ext[2] + 2 * margin;
-    camera(&t, "front", c, (const double[3]){ 0, 0, 1 }, Y, d, fx, fy, texel, false, 0);
-    camera(&t, "back", c, (const double[3]){ 0, 0, -1 }, Y, d, fx, fy, texel, false, 0);
-    camera(&t, "left", c, (const double[3]){ -1, 0, 0 }, Y, d, fz, fy, texel, false, 0);
-    camera(&t, "right", c, (const double[3]){ 1, 0, 0 }, Y, d, fz, fy, texel, false, 0);
-    camera(&t, "top", c, Y, NZ, d, fx, fz, texel, false, 0);
+    camera(&t, "front", c, (const double[3]){ 0, 0, 1 }, Y, d, fx, fy, in_texel, false, 0);
+    camera(&t, "back", c, (const double[3]){ 0, 0, -1 }, Y, d, fx, fy, in_texel, false, 0);
+    camera(&t, "left", c, (const double[3]){ -1, 0, 0 }, Y, d, fz, fy, in_texel, false, 0);
+    camera(&t, "right", c, (const double[3]){ 1, 0, 0 }, Y, d, fz, fy, in_texel, false, 0);
+    camera(&t, "top", c, Y, NZ, d, fx, fz, in_texel, false, 0);
     if (p->bottom) {
-        camera(&t, "bottom", c, (const double[3]){ 0, -1, 0 }, PZ, d, fx, fz, texel, false, 0);
+        camera(&t, "bottom", c, (const double[3]){ 0, -1, 0 }, PZ, d, fx, fz, in_texel, false, 0);
     }
     // The output camera looks at the side the particles come at: against their
     // velocity where they reach the mesh (the wind's side; the front right
@@ -546,10 +570,9 @@ wx_result wx_scene_generate(const wx_init_def *def, char **out_text, wx_error *e
     put(&t, "    </ProjectedMaps>\n  </Collider>\n");
     if (pi == PRESET_MOSS) {
         put(&t,
-            "  <!-- Between spells half the water evaporates and a tenth of what is left\n"
-            "       becomes moss. -->\n"
-            "  <Ageing>\n    <Transfer from=\"water\" to=\"moss\" rate=\"0.1\"/>\n"
-            "    <Decay substance=\"water\" rate=\"0.5\"/>\n  </Ageing>\n");
+            "  <!-- Between spells half the water evaporates: what is left is the recent\n"
+            "       rain's, the older spells' halved again each time. -->\n"
+            "  <Ageing>\n    <Decay substance=\"water\" rate=\"0.5\"/>\n  </Ageing>\n");
     }
     put(&t,
         "  <Geometry>\n"
@@ -572,20 +595,32 @@ wx_result wx_scene_generate(const wx_init_def *def, char **out_text, wx_error *e
     }
     put(&t, "    </Mesh>\n  </Geometry>\n");
     if (pi == PRESET_MOSS) {
+        // A tenth of a spell's rain per square unit of open ground; the sun
+        // from downwind.
+        double wet = 0.1 * rate * emit / ((e_hi[0] - e_lo[0]) * (e_hi[2] - e_lo[2]));
+        double sun_azimuth = fmod(atan2(p->wind_dir[2], p->wind_dir[0]) / DEG + 360.0, 360.0);
         put(&t,
-            "  <!-- Where moss would look right: wet, sheltered, shaded (docs/masks.md). -->\n"
+            "  <!-- Moss grows where the surface stays wet AND is sheltered, less in the sun\n"
+            "       (docs/masks.md, docs/presets.md): 'moss' = %.3g x (S(water) - S(shelter)\n"
+            "       - 0.5 sun - 0.1), clamped to [0, 1]. S(water) is past 0.9 from a tenth of a\n"
+            "       spell's rain on open ground (%.4g a square unit) up; S(shelter) is 0.9 and\n"
+            "       more from shelter %.3g up (one ray of the shelter's blocked: a graze as\n"
+            "       often as not) and 0.1 from %.3g down (two), so open ground has no moss\n"
+            "       however wet, and dry ground none however sheltered. The sun shines from\n"
+            "       downwind, so the wet windward side is the shady one. -->\n"
             "  <Masks>\n"
-            "    <Accessibility name=\"shelter\" rays=\"32\" distance=\"%.6g\"/>\n"
-            "    <Exposure name=\"sun\" elevation=\"50\" azimuth=\"200\" sideWeight=\"0.4\" "
-            "sideElevation=\"0.7\" sideSpread=\"60\"/>\n"
-            "    <Combine name=\"mossy\">\n"
-            "      <Term substance=\"water\" weight=\"0.7\" offset=\"%.6g\" steepness=\"%.6g\"/>\n"
-            "      <Term mask=\"shelter\" weight=\"-0.6\" offset=\"0.75\" steepness=\"40\"/>\n"
+            "    <Accessibility name=\"shelter\" rays=\"%d\" distance=\"%.6g\"/>\n"
+            "    <Exposure name=\"sun\" elevation=\"50\" azimuth=\"%.4g\"/>\n"
+            "    <Combine name=\"moss\" scale=\"%.3g\">\n"
+            "      <Term substance=\"water\" offset=\"%.6g\" steepness=\"%.6g\"/>\n"
+            "      <Term mask=\"shelter\" weight=\"-1\" offset=\"%.3g\" steepness=\"%.4g\"/>\n"
             "      <Term mask=\"sun\" weight=\"-0.5\"/>\n"
-            "      <Term constant=\"0.7\"/>\n"
+            "      <Term constant=\"-0.1\"/>\n"
             "    </Combine>\n"
             "  </Masks>\n",
-            0.15 * size, 0.1 * rate * emit / (size * size), 1.0 / pow(0.1 * rate * emit / (size * size), 2.0));
+            MOSS_SCALE, wet, 1.0 - 1.0 / MOSS_RAYS, 1.0 - 2.0 / MOSS_RAYS, MOSS_RAYS, 0.15 * size,
+            sun_azimuth, MOSS_SCALE, 0.5 * wet, steepness_for(0.5 * wet), 1.0 - 1.5 / MOSS_RAYS,
+            steepness_for(0.5 / MOSS_RAYS));
     }
     put(&t, "</Weathering>\n");
     if (t.failed) {
