@@ -331,9 +331,9 @@ wx_result wx_scene_generate(const wx_init_def *def, char **out_text, wx_error *e
     const double unit = def->unit_m > 0.0 ? def->unit_m : 1.0;
     const double margin = 0.1 * size;
     const double texel = (size + 2.0 * margin) / R;
-    // The input cameras' texel: moss's at half the resolution from 1024 up
-    // (below), at least 512 texels across.
-    const double in_texel = pi == PRESET_MOSS && R > 512 ? texel * R / fmax(512.0, 0.5 * R)
+    // The input cameras' texel: moss's at a quarter of the resolution, at
+    // least 256 texels across (below).
+    const double in_texel = pi == PRESET_MOSS && R > 256 ? texel * R / fmax(256.0, 0.25 * R)
                                                          : texel;
 
     // The fall: from H above the top at the preset's speed under its gravity;
@@ -526,9 +526,11 @@ wx_result wx_scene_generate(const wx_init_def *def, char **out_text, wx_error *e
         (int)ceil((size + 2.0 * margin) / in_texel - 1e-9));
     if (in_texel > texel) {
         put(&t,
-            "      <!-- Half the output's and the texture's resolution (at least 512 across):\n"
-            "           moss is a soft mask, and its shelter's rays, marched through these maps,\n"
-            "           cost about a third less. -->\n");
+            "      <!-- A quarter of the output's and the texture's resolution (at least 256\n"
+            "           across): moss is a soft mask, its water smoothed over many texels and\n"
+            "           its shelter looking s/7 around (30 texels and more); its shelter's\n"
+            "           rays, marched through these maps, cost half as much as through maps\n"
+            "           of the full resolution. -->\n");
     }
     double d = 2.0 * (size + 2.0 * margin);
     static const double Y[3] = { 0, 1, 0 }, NZ[3] = { 0, 0, -1 }, PZ[3] = { 0, 0, 1 };
