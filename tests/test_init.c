@@ -1,8 +1,7 @@
-// test_init.c: scenes generated from a mesh (docs/design.md section 13,
-// docs/presets.md): `weathering init MESH --preset P` writes a scene that the
-// schema accepts, that frames every vertex, and whose run leaves the preset's
-// substance on the upward-facing surfaces; sizes scale with the mesh; `run
-// MESH --preset P` and `split`; bad input is exit 2.
+// test_init.c: the commands around the generated scenes (docs/design.md
+// section 13, docs/presets.md): `run MESH --preset P` and `split`, the folder
+// and the scene `run MESH` writes, what `init` never overwrites; bad input is
+// exit 2. The scenes themselves are tests/test_preset.c's.
 #define _XOPEN_SOURCE 700 // realpath
 #include <limits.h>
 #include <math.h>
@@ -43,113 +42,6 @@ static bool schema_accepts(const char *path)
     xmlSchemaFree(schema);
     xmlSchemaFreeParserCtxt(pc);
     return ok;
-}
-
-// The mean of a texture's channel over an island of texture_cube.obj (first
-// covered texel (i0, j0), 224 x 224 texels at 768 x 512; tests/test_texture.c),
-// scaled to the texture's size.
-static double island_mean(const float *m, int w, int h, int i0, int j0)
-{
-    double sum = 0.0;
-    int n = 0;
-    int x0 = i0 * w / 768, y0 = j0 * h / 512, nx = 224 * w / 768, ny = 224 * h / 512;
-    for (int j = y0 + 2; j < y0 + ny - 2; ++j) {
-        for (int i = x0 + 2; i < x0 + nx - 2; ++i) {
-            sum += m[(size_t)j * (size_t)w + (size_t)i];
-            n++;
-        }
-    }
-    return n > 0 ? sum / n : 0.0;
-}
-
-// Every preset gives a scene the schema accepts and `info` reads, every vertex
-// framed; the rain on the cube leaves its dirt on the top, more than on the
-// sides, and none underneath.
-TEST(presets_make_valid_scenes_and_rain_dirties_the_top)
-{
-    const char *dir = ensure_tmpdir();
-    static const char *const presets[4] = { "rain", "dust", "soot", "moss" };
-    for (int p = 0; p < 4; ++p) {
-        char name[64], path[PATH_MAX + 64];
-        snprintf(name, sizeof name, "cube_%s.xml", presets[p]);
-        char args[256];
-        snprintf(args, sizeof args, "init '%%s' --preset %s --resolution 128 -o %%s", presets[p]);
-        ENSURE(run_in(dir, args, data_file("texture_cube.obj"), name) == 0);
-        snprintf(path, sizeof path, "%s/%s", dir, name);
-        ENSURE(schema_accepts(path));
-        ENSURE(run_in(dir, "info %s%s", name, "") == 0);
-        ENSURE(strstr(out, "every vertex lies inside an input camera's frame; all inside the "
-                           "output camera's") != NULL);
-        ENSURE(strstr(out, "texture texture_cube_texture.exr") != NULL);
-    }
-    ENSURE(run_in(dir, "run %s --out %s -q", "cube_rain.xml", "rain") == 0);
-    char path[PATH_MAX + 64];
-    snprintf(path, sizeof path, "%s/rain/texture_cube_texture.exr", dir);
-    int w, h;
-    float *y = ensure_read_channel(path, "Y", &w, &h);
-    ENSURE(y != NULL);
-    if (y != NULL) {
-        double top = island_mean(y, w, h, 16, 16), bottom = island_mean(y, w, h, 272, 16);
-        double side = 0.25 * (island_mean(y, w, h, 528, 16) + island_mean(y, w, h, 16, 272) +
-                              island_mean(y, w, h, 272, 272) + island_mean(y, w, h, 528, 272));
-        printf("        rain on the cube: top %.4g, sides %.4g, bottom %.4g per square unit\n",
-               top, side, bottom);
-        ENSURE(top > 0.0 && top > 2.0 * side && bottom == 0.0);
-        free(y);
-    }
-}
-
-// A mesh 100 times larger given in centimetres gets the same scene, every
-// length 100 times longer: the same time step, the same number of steps.
-TEST(sizes_scale_with_the_mesh)
-{
-    const char *dir = ensure_tmpdir();
-    char *cube = ensure_read_file(data_file("texture_cube.obj"));
-    ENSURE(cube != NULL);
-    if (cube == NULL) {
-        return;
-    }
-    // Scale the vertices by 100.
-    char *big = malloc(strlen(cube) * 2 + 64);
-    size_t n = 0;
-    for (char *line = strtok(cube, "\n"); line != NULL; line = strtok(NULL, "\n")) {
-        double x, yv, z;
-        if (strncmp(line, "v ", 2) == 0 && sscanf(line + 2, "%lf %lf %lf", &x, &yv, &z) == 3) {
-            n += (size_t)sprintf(big + n, "v %.9g %.9g %.9g\n", 100 * x, 100 * yv, 100 * z);
-        } else {
-            n += (size_t)sprintf(big + n, "%s\n", line);
-        }
-    }
-    ensure_write_file(dir, "big.obj", big);
-    char *small = ensure_read_file(data_file("texture_cube.obj"));
-    ensure_write_file(dir, "small.obj", small != NULL ? small : "");
-    free(small);
-    free(big);
-    free(cube);
-    ENSURE(run_in(dir, "init small.obj -o %s%s", "small.xml", "") == 0);
-    ENSURE(run_in(dir, "init big.obj --units cm -o %s%s", "big.xml", "") == 0);
-    char p1[PATH_MAX + 16], p2[PATH_MAX + 16];
-    snprintf(p1, sizeof p1, "%s/small.xml", dir);
-    snprintf(p2, sizeof p2, "%s/big.xml", dir);
-    char *a = ensure_read_file(p1), *b = ensure_read_file(p2);
-    ENSURE(a != NULL && b != NULL);
-    if (a != NULL && b != NULL) {
-        const char *ta = strstr(a, "<Simulation"), *tb = strstr(b, "<Simulation");
-        ENSURE(ta != NULL && tb != NULL && strncmp(ta, tb, strcspn(ta, "\n")) == 0);
-        const char *ba = strstr(a, "<BoundingBox size=\""), *bb = strstr(b, "<BoundingBox size=\"");
-        ENSURE(ba != NULL && bb != NULL);
-        if (ba != NULL && bb != NULL) {
-            double sa = atof(ba + 19), sb = atof(bb + 19);
-            ENSURE_NEAR(sb / sa, 100.0, 1e-3);
-        }
-        const char *ga = strstr(a, "<Gravity acceleration=\""), *gb = strstr(b, "<Gravity acceleration=\"");
-        ENSURE(ga != NULL && gb != NULL);
-        if (ga != NULL && gb != NULL) {
-            ENSURE_NEAR(atof(gb + 23) / atof(ga + 23), 100.0, 1e-3);
-        }
-    }
-    free(a);
-    free(b);
 }
 
 // `run MESH --preset P` writes the scene into the output folder and runs it;
@@ -476,8 +368,6 @@ TEST(a_mesh_without_thickness_is_warned_about)
 
 int main(void)
 {
-    RUN(presets_make_valid_scenes_and_rain_dirties_the_top);
-    RUN(sizes_scale_with_the_mesh);
     RUN(run_a_mesh_and_split_its_texture);
     RUN(init_reads_the_uv_layout);
     RUN(bad_input_is_exit_2);

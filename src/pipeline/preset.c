@@ -52,8 +52,8 @@ static const preset presets[] = {
                       "thinner on tops, some on undersides",
                       0.6, 0.02, 15.0, 0.03, { 1.0, 0.0, 0.3 }, 0.05, 300000, 1, true,
                       0.5, 0.05, 0.9, 0.01, 0.05, 0.8 },
-    [PRESET_MOSS] = { "five rainy spells: the rain's water lingers, moss grows from it where it "
-                      "stays wet, and a 'mossy' mask adds shelter and shade",
+    [PRESET_MOSS] = { "five rainy spells: the rain's water lingers, and the mask 'moss' grows "
+                      "where it stays wet in shelter and shade",
                       2.0, 1.0, 8.0, 0.3, { -1.0, 0.0, -0.4 }, 0.0, 400000, 5, false,
                       0.3, 0.1, 0.5, 0.1, 0.2, 0.9 },
 };
@@ -139,6 +139,127 @@ static void camera(text *t, const char *name, const double c[3], const double ax
         put(t, "        <OutputMap file=\"mask.exr\"/>\n");
     }
     put(t, "      </Ortho>\n");
+}
+
+// ---------------------------------------------------------------------------
+// What every preset holds on any model (docs/presets.md).
+
+// A particle dies at its 60th collision (the emitters' maxCollisions).
+enum { MAX_COLLISIONS = 60 };
+static const double DEG = 3.14159265358979323846 / 180.0;
+// The output camera's elevation, degrees: between a side view and a plan.
+static const double VIEW_LOW = 20.0, VIEW_HIGH = 60.0;
+// Moss (the Combine 'moss'): the shelter's rays (most of the preset's cost:
+// docs/presets.md), and the scale that takes a wet, sheltered surface in the
+// shade to 1. A surface counts as sheltered when at least two of its rays
+// meet a surface: one alone is as often a graze.
+enum { MOSS_RAYS = 12 };
+static const double MOSS_SCALE = 1.3;
+
+// The steepness of a Combine term's sigmoid (docs/masks.md) that goes from 0.1
+// to 0.9 over its offset +- w: S(o + w) = 0.9 when w sqrt(s) = 4/3.
+static double steepness_for(double w)
+{
+    return (4.0 / 3.0) * (4.0 / 3.0) / (w * w);
+}
+
+// Flight times: a particle without collisions and turbulence moves as
+// p(t) = p0 + v0 t + a t^2 / 2 under the preset's gravity and wind (both
+// constant accelerations, docs/physics.md); the run is sized from these times.
+static void path_at(const double p0[3], const double v0[3], const double a[3], double t,
+                    double p[3])
+{
+    for (int k = 0; k < 3; ++k) {
+        p[k] = p0[k] + v0[k] * t + 0.5 * a[k] * t * t;
+    }
+}
+
+static bool inside(const double p[3], const double lo[3], const double hi[3])
+{
+    return p[0] >= lo[0] && p[0] <= hi[0] && p[1] >= lo[1] && p[1] <= hi[1] && p[2] >= lo[2] &&
+           p[2] <= hi[2];
+}
+
+// Whether the segment a -> b meets the box [lo, hi] (slabs).
+static bool segment_meets(const double a[3], const double b[3], const double lo[3],
+                          const double hi[3])
+{
+    double t0 = 0.0, t1 = 1.0;
+    for (int k = 0; k < 3; ++k) {
+        double d = b[k] - a[k];
+        if (d == 0.0) {
+            if (a[k] < lo[k] || a[k] > hi[k]) {
+                return false;
+            }
+            continue;
+        }
+        double u = (lo[k] - a[k]) / d, w = (hi[k] - a[k]) / d;
+        t0 = fmax(t0, fmin(u, w));
+        t1 = fmin(t1, fmax(u, w));
+    }
+    return t0 <= t1;
+}
+
+// The first time within [0, t_max] at which the path meets the box [lo, hi]
+// (`to_enter`: the mesh's box, which may be flat) or is outside it (the
+// solver's); t_max when it never does. The path is followed in 4096 chords,
+// the one where it happens halved 40 times.
+static double first_time(const double p0[3], const double v0[3], const double a[3],
+                         const double lo[3], const double hi[3], bool to_enter, double t_max)
+{
+    enum { SAMPLES = 4096 };
+    double t0 = 0.0, p[3], q[3];
+    path_at(p0, v0, a, 0.0, p);
+    if (inside(p, lo, hi) == to_enter) {
+        return 0.0;
+    }
+    for (int i = 1; i <= SAMPLES; ++i) {
+        double t1 = t_max * i / SAMPLES;
+        path_at(p0, v0, a, t0, p);
+        path_at(p0, v0, a, t1, q);
+        if (to_enter ? segment_meets(p, q, lo, hi) : !inside(q, lo, hi)) {
+            for (int it = 0; it < 40; ++it) {
+                double tm = 0.5 * (t0 + t1);
+                path_at(p0, v0, a, tm, q);
+                if (to_enter ? segment_meets(p, q, lo, hi) : !inside(q, lo, hi)) {
+                    t1 = tm;
+                } else {
+                    t0 = tm;
+                    path_at(p0, v0, a, t0, p);
+                }
+            }
+            return t1;
+        }
+        t0 = t1;
+    }
+    return t_max;
+}
+
+// Unit vectors at `spread` degrees around the unit vector d (its cone's rim),
+// with d itself first: five launch directions.
+static void cone_rim(const double d[3], double spread_deg, double out[5][3])
+{
+    double u[3] = { 0.0, 0.0, 0.0 };
+    u[fabs(d[0]) < 0.9 ? 0 : 1] = 1.0; // any vector not along d
+    double e1[3] = { d[1] * u[2] - d[2] * u[1], d[2] * u[0] - d[0] * u[2],
+                     d[0] * u[1] - d[1] * u[0] };
+    double l1 = sqrt(e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]);
+    for (int k = 0; k < 3; ++k) {
+        e1[k] /= l1;
+    }
+    double e2[3] = { d[1] * e1[2] - d[2] * e1[1], d[2] * e1[0] - d[0] * e1[2],
+                     d[0] * e1[1] - d[1] * e1[0] };
+    double c = cos(spread_deg * DEG), sn = sin(spread_deg * DEG);
+    const double *side[4] = { e1, e2, e1, e2 };
+    for (int k = 0; k < 3; ++k) {
+        out[0][k] = d[k];
+    }
+    for (int r = 0; r < 4; ++r) {
+        double sign = r < 2 ? 1.0 : -1.0;
+        for (int k = 0; k < 3; ++k) {
+            out[r + 1][k] = c * d[k] + sign * sn * side[r][k];
+        }
+    }
 }
 
 void wx_mesh_name(const char *path, char *out, size_t cap)
@@ -386,20 +507,24 @@ static wx_result generate(const wx_init_def *def, const preset *p, int pi,
     if (precision_problem(c, size, texel, why, sizeof why) != NULL) {
         return wx_fail(err, WX_CAUSE_BAD_MESH, "%s: the mesh %s", def->mesh_path, why);
     }
+    // The input cameras' texel: moss's at a quarter of the resolution, at
+    // least 256 texels across (below).
+    const double in_texel = pi == PRESET_MOSS && R > 256 ? texel * R / fmax(256.0, 0.25 * R)
+                                                         : texel;
 
-    // The fall: from H above the top at the preset's speed under its gravity.
+    // The fall: from H above the top at the preset's speed under its gravity;
+    // the wind's drift over it widens the emitter upwind.
     const double g = 9.8 / unit * p->gravity, H = 0.75 * size, v = p->speed * size;
     // (-v + sqrt(v^2 + 2gH)) / g without the cancellation that makes it 0 when
     // v^2 dwarfs 2gH (a mesh 1e30 across).
     const double fall = 2.0 * H / (v + sqrt(v * v + 2.0 * g * H));
-    const double dt = fall / 50.0, emit = 2.0 * fall;
-    const int steps = (int)ceil((emit + 3.0 * fall) / dt);
-    // The wind's drift over the fall widens the emitter upwind.
     double wind_len = sqrt(p->wind_dir[0] * p->wind_dir[0] + p->wind_dir[1] * p->wind_dir[1] +
                            p->wind_dir[2] * p->wind_dir[2]);
     double wind = p->wind * 9.8 / unit, drift[3] = { 0.0, 0.0, 0.0 };
+    double accel[3] = { 0.0, -g, 0.0 }; // gravity and wind: the force on a unit mass
     for (int k = 0; k < 3 && wind_len > 0.0; ++k) {
         drift[k] = 0.5 * wind * fall * fall * p->wind_dir[k] / wind_len;
+        accel[k] += wind * p->wind_dir[k] / wind_len;
     }
     double e_lo[3] = { lo[0] - margin, hi[1] + H, lo[2] - margin };
     double e_hi[3] = { hi[0] + margin, hi[1] + H, hi[2] + margin };
@@ -421,7 +546,71 @@ static wx_result generate(const wx_init_def *def, const preset *p, int pi,
             edir[k] = p->wind_dir[k] / wind_len;
         }
     }
-    double box = 2.0 * fmax(size, fmax(e_hi[0] - e_lo[0], e_hi[2] - e_lo[2])) + 2.0 * H;
+    // The solver's box: s/4 around the mesh and s/10 around the emitter, its
+    // floor s/20 below the mesh, the cube's slack above and evenly on the
+    // sides. A particle that missed or ran off then leaves soon instead of
+    // flying on; and none reaches the space under the mesh below the side
+    // cameras' frames (s/10 below it), where the top camera alone would
+    // answer and call every point under the mesh's outline a collision (the
+    // point rule, docs/physics.md) with the top of the mesh.
+    const double pad = 0.25 * size;
+    double box_lo[3], box_hi[3], bc[3], box = 0.0;
+    for (int k = 0; k < 3; ++k) {
+        box_lo[k] = fmin(k == 1 ? lo[k] - 0.5 * margin : lo[k] - pad, e_lo[k] - margin);
+        box_hi[k] = fmax(hi[k] + pad, e_hi[k] + margin);
+        box = fmax(box, box_hi[k] - box_lo[k]);
+    }
+    for (int k = 0; k < 3; ++k) {
+        bc[k] = k == 1 ? box_lo[1] + 0.5 * box : 0.5 * (box_lo[k] + box_hi[k]);
+        box_lo[k] = bc[k] - 0.5 * box;
+        box_hi[k] = bc[k] + 0.5 * box;
+    }
+    // The approach: the emitter's central path into the mesh's bounding box;
+    // 50 steps for it, emission over two approaches.
+    const double t_max = 100.0 * fall;
+    double ec[3], v0[3];
+    for (int k = 0; k < 3; ++k) {
+        ec[k] = 0.5 * (e_lo[k] + e_hi[k]);
+        v0[k] = v * edir[k];
+    }
+    double approach = first_time(ec, v0, accel, lo, hi, true, t_max);
+    if (!(approach > 0.0) || approach >= t_max) {
+        approach = fall; // a path that grazes the box: the fall's time
+    }
+    const double dt = approach / 50.0, emit = 2.0 * approach;
+    // What the last particles emitted need: a miss flies out of the box; a hit
+    // reaches the mesh, collides at most MAX_COLLISIONS times (a sliding
+    // particle collides every step, one that hops at least every other step)
+    // and falls from rest out of the box. From
+    // 3 x 3 x 3 points of the emitter along its direction and its cone's rim,
+    // from every corner of the mesh's box; a quarter more for turbulence and
+    // bounces.
+    double dirs[5][3], miss = 0.0, reach = 0.0, from_rest = 0.0;
+    cone_rim(edir, p->spread, dirs);
+    static const double zero[3] = { 0.0, 0.0, 0.0 };
+    for (int n = 0; n < 27; ++n) {
+        double ep[3];
+        for (int k = 0, m = n; k < 3; ++k, m /= 3) {
+            ep[k] = e_lo[k] + 0.5 * (m % 3) * (e_hi[k] - e_lo[k]);
+        }
+        for (int dn = 0; dn < 5; ++dn) {
+            double vd[3] = { v * dirs[dn][0], v * dirs[dn][1], v * dirs[dn][2] };
+            miss = fmax(miss, first_time(ep, vd, accel, box_lo, box_hi, false, t_max));
+            double in = first_time(ep, vd, accel, lo, hi, true, t_max);
+            if (in < t_max) {
+                reach = fmax(reach, in);
+            }
+        }
+    }
+    for (int corner = 0; corner < 8; ++corner) {
+        double mp[3];
+        for (int k = 0; k < 3; ++k) {
+            mp[k] = (corner >> k & 1) ? hi[k] : lo[k];
+        }
+        from_rest = fmax(from_rest, first_time(mp, zero, accel, box_lo, box_hi, false, t_max));
+    }
+    const double after = 1.25 * fmax(miss, reach + 2 * MAX_COLLISIONS * dt + from_rest);
+    const int steps = (int)ceil((emit + after) / dt);
     double rate = p->particles / p->iterations / emit;
 
     char base[256], header_name[256], preset_line[512];
@@ -454,19 +643,26 @@ static wx_result generate(const wx_init_def *def, const preset *p, int pi,
     }
     if (pi == PRESET_MOSS) {
         put(&t,
-            "  <!-- The rain carries water; moss grows from the water that stays. -->\n"
-            "  <Substances>\n    <Substance name=\"water\"/>\n    <Substance name=\"moss\"/>\n"
-            "  </Substances>\n");
+            "  <!-- The rain carries water; the mask 'moss' below says where it lingers in\n"
+            "       shelter and shade. -->\n"
+            "  <Substances>\n    <Substance name=\"water\"/>\n  </Substances>\n");
     }
     put(&t,
         "  <Solver>\n"
-        "    <!-- A cube around the mesh and the emitter: particles leaving it are gone. -->\n"
+        "    <!-- A cube s/4 around the mesh and s/10 around the emitter, its floor s/20 below\n"
+        "         the mesh (above the side cameras' frames: below them only the top camera\n"
+        "         would see, and take everything under the mesh for its top): particles\n"
+        "         leaving it are gone, so those that missed leave soon. -->\n"
         "    <BoundingBox size=\"%.6g\" centerX=\"%.9g\" centerY=\"%.9g\" centerZ=\"%.9g\"/>\n"
-        "    <!-- A fall of 0.75 s from the emitter to the top takes %.3g s: 50 steps a fall;\n"
-        "         particles are emitted over two falls and fly three more. -->\n"
+        "    <!-- The particles reach the mesh's box %.3g s after leaving the emitter: 50 steps\n"
+        "         for that. They are emitted over twice that, then the run goes on %.3g s for\n"
+        "         the last ones to land or leave: 1.25 x the longer of a miss's flight out of\n"
+        "         the box (%.3g s) and a hit's approach (%.3g s), %d collisions (a step for\n"
+        "         a slide, two for a hop) and fall from rest out of the box (%.3g s). -->\n"
         "    <Simulation timeStep=\"%.6g\" steps=\"%d\" seed=\"1\"%s/>\n"
         "  </Solver>\n",
-        box, c[0], c[1] + 0.5 * H, c[2], fall, dt, steps, iterations);
+        box, bc[0], bc[1], bc[2], approach, after, miss, reach, MAX_COLLISIONS, from_rest, dt,
+        steps, iterations);
     put(&t, "  <ForceFields>\n");
     put(&t, "    <!-- Gravity%s, in the mesh's unit per second squared. -->\n"
             "    <Gravity acceleration=\"%.6g\"/>\n",
@@ -494,9 +690,9 @@ static wx_result generate(const wx_init_def *def, const preset *p, int pi,
         "maxY=\"%.9g\" maxZ=\"%.9g\"\n"
         "                dirX=\"%.6g\" dirY=\"%.6g\" dirZ=\"%.6g\" spread=\"%.6g\" rate=\"%.6g\" "
         "start=\"0\" end=\"%.6g\"\n"
-        "                speed=\"%.6g\" maxCollisions=\"60\"%s>\n",
+        "                speed=\"%.6g\" maxCollisions=\"%d\"%s>\n",
         0.75, p->particles, wx_preset_names[pi], e_lo[0], e_lo[1], e_lo[2], e_hi[0], e_hi[1],
-        e_hi[2], edir[0], edir[1], edir[2], p->spread, rate, emit, v,
+        e_hi[2], edir[0], edir[1], edir[2], p->spread, rate, emit, v, MAX_COLLISIONS,
         pi == PRESET_MOSS ? "" : " dirt=\"1\"");
     if (pi == PRESET_MOSS) {
         put(&t, "      <Load substance=\"water\" amount=\"1\"/>\n");
@@ -508,34 +704,59 @@ static wx_result generate(const wx_init_def *def, const preset *p, int pi,
         "    <ProjectedMaps>\n"
         "      <!-- The mesh from four sides and above%s, frames s/10 wider than it, %.4g a\n"
         "           texel (a resolution of %d across the largest). -->\n",
-        p->resilience, p->friction, p->bottom ? " and below" : "", texel, R);
+        p->resilience, p->friction, p->bottom ? " and below" : "", in_texel,
+        (int)ceil((size + 2.0 * margin) / in_texel - 1e-9));
+    if (in_texel > texel) {
+        put(&t,
+            "      <!-- A quarter of the output's and the texture's resolution (at least 256\n"
+            "           across): moss is a soft mask, its water smoothed over many texels and\n"
+            "           its shelter looking s/7 around (30 texels and more); its shelter's\n"
+            "           rays, marched through these maps, cost half as much as through maps\n"
+            "           of the full resolution. -->\n");
+    }
     double d = 2.0 * (size + 2.0 * margin);
     static const double Y[3] = { 0, 1, 0 }, NZ[3] = { 0, 0, -1 }, PZ[3] = { 0, 0, 1 };
     const double fx = ext[0] + 2 * margin, fy = ext[1] + 2 * margin, fz = ext[2] + 2 * margin;
-    camera(&t, "front", c, (const double[3]){ 0, 0, 1 }, Y, d, fx, fy, texel, false, 0);
-    camera(&t, "back", c, (const double[3]){ 0, 0, -1 }, Y, d, fx, fy, texel, false, 0);
-    camera(&t, "left", c, (const double[3]){ -1, 0, 0 }, Y, d, fz, fy, texel, false, 0);
-    camera(&t, "right", c, (const double[3]){ 1, 0, 0 }, Y, d, fz, fy, texel, false, 0);
-    camera(&t, "top", c, Y, NZ, d, fx, fz, texel, false, 0);
+    camera(&t, "front", c, (const double[3]){ 0, 0, 1 }, Y, d, fx, fy, in_texel, false, 0);
+    camera(&t, "back", c, (const double[3]){ 0, 0, -1 }, Y, d, fx, fy, in_texel, false, 0);
+    camera(&t, "left", c, (const double[3]){ -1, 0, 0 }, Y, d, fz, fy, in_texel, false, 0);
+    camera(&t, "right", c, (const double[3]){ 1, 0, 0 }, Y, d, fz, fy, in_texel, false, 0);
+    camera(&t, "top", c, Y, NZ, d, fx, fz, in_texel, false, 0);
     if (p->bottom) {
-        camera(&t, "bottom", c, (const double[3]){ 0, -1, 0 }, PZ, d, fx, fz, texel, false, 0);
+        camera(&t, "bottom", c, (const double[3]){ 0, -1, 0 }, PZ, d, fx, fz, in_texel, false, 0);
     }
-    // A three-quarter view from the front right, above; its frame holds the
+    // The output camera looks at the side the particles come at: against their
+    // velocity where they reach the mesh (the wind's side; the front right
+    // when they come straight down), from between VIEW_LOW and VIEW_HIGH
+    // degrees above the horizon, a three-quarter view; its frame holds the
     // whole box whichever way it turns.
-    double q[3] = { 1.0, 0.8, 1.2 }, ql = sqrt(1.0 + 0.64 + 1.44);
+    double q[3], arrive[3];
     for (int k = 0; k < 3; ++k) {
-        q[k] /= ql;
+        arrive[k] = v0[k] + accel[k] * approach;
     }
+    double hx = -arrive[0], hz = -arrive[2], h = sqrt(hx * hx + hz * hz);
+    double elevation = atan2(-arrive[1], h) / DEG;
+    if (!(h > 1e-3 * fabs(arrive[1]))) {
+        hx = 1.0; // straight down: the front right
+        hz = 1.2;
+        h = sqrt(hx * hx + hz * hz);
+    }
+    elevation = fmin(VIEW_HIGH, fmax(VIEW_LOW, elevation));
+    q[0] = cos(elevation * DEG) * hx / h;
+    q[1] = sin(elevation * DEG);
+    q[2] = cos(elevation * DEG) * hz / h;
     double diag = sqrt(ext[0] * ext[0] + ext[1] * ext[1] + ext[2] * ext[2]) + 2.0 * margin;
-    put(&t, "      <!-- The output camera: a three-quarter view from the front right. -->\n");
+    put(&t,
+        "      <!-- The output camera: a three-quarter view of the side the particles come at,\n"
+        "           from azimuth %.0f degrees (from +X towards +Z), %.0f degrees up. -->\n",
+        atan2(hz, hx) / DEG, elevation);
     camera(&t, "shot", c, q, Y, d, diag, diag, texel, true, R);
     put(&t, "    </ProjectedMaps>\n  </Collider>\n");
     if (pi == PRESET_MOSS) {
         put(&t,
-            "  <!-- Between spells half the water evaporates and a tenth of what is left\n"
-            "       becomes moss. -->\n"
-            "  <Ageing>\n    <Transfer from=\"water\" to=\"moss\" rate=\"0.1\"/>\n"
-            "    <Decay substance=\"water\" rate=\"0.5\"/>\n  </Ageing>\n");
+            "  <!-- Between spells half the water evaporates: what is left is the recent\n"
+            "       rain's, the older spells' halved again each time. -->\n"
+            "  <Ageing>\n    <Decay substance=\"water\" rate=\"0.5\"/>\n  </Ageing>\n");
     }
     put(&t,
         "  <Geometry>\n"
@@ -555,20 +776,32 @@ static wx_result generate(const wx_init_def *def, const preset *p, int pi,
     }
     put(&t, "    </Mesh>\n  </Geometry>\n");
     if (pi == PRESET_MOSS) {
+        // A tenth of a spell's rain per square unit of open ground; the sun
+        // from downwind.
+        double wet = 0.1 * rate * emit / ((e_hi[0] - e_lo[0]) * (e_hi[2] - e_lo[2]));
+        double sun_azimuth = fmod(atan2(p->wind_dir[2], p->wind_dir[0]) / DEG + 360.0, 360.0);
         put(&t,
-            "  <!-- Where moss would look right: wet, sheltered, shaded (docs/masks.md). -->\n"
+            "  <!-- Moss grows where the surface stays wet AND is sheltered, less in the sun\n"
+            "       (docs/masks.md, docs/presets.md): 'moss' = %.3g x (S(water) - S(shelter)\n"
+            "       - 0.5 sun - 0.1), clamped to [0, 1]. S(water) is past 0.9 from a tenth of a\n"
+            "       spell's rain on open ground (%.4g a square unit) up; S(shelter) is 0.9 and\n"
+            "       more from shelter %.3g up (one ray of the shelter's blocked: a graze as\n"
+            "       often as not) and 0.1 from %.3g down (two), so open ground has no moss\n"
+            "       however wet, and dry ground none however sheltered. The sun shines from\n"
+            "       downwind, so the wet windward side is the shady one. -->\n"
             "  <Masks>\n"
-            "    <Accessibility name=\"shelter\" rays=\"32\" distance=\"%.6g\"/>\n"
-            "    <Exposure name=\"sun\" elevation=\"50\" azimuth=\"200\" sideWeight=\"0.4\" "
-            "sideElevation=\"0.7\" sideSpread=\"60\"/>\n"
-            "    <Combine name=\"mossy\">\n"
-            "      <Term substance=\"water\" weight=\"0.7\" offset=\"%.6g\" steepness=\"%.6g\"/>\n"
-            "      <Term mask=\"shelter\" weight=\"-0.6\" offset=\"0.75\" steepness=\"40\"/>\n"
+            "    <Accessibility name=\"shelter\" rays=\"%d\" distance=\"%.6g\"/>\n"
+            "    <Exposure name=\"sun\" elevation=\"50\" azimuth=\"%.4g\"/>\n"
+            "    <Combine name=\"moss\" scale=\"%.3g\">\n"
+            "      <Term substance=\"water\" offset=\"%.6g\" steepness=\"%.6g\"/>\n"
+            "      <Term mask=\"shelter\" weight=\"-1\" offset=\"%.3g\" steepness=\"%.4g\"/>\n"
             "      <Term mask=\"sun\" weight=\"-0.5\"/>\n"
-            "      <Term constant=\"0.7\"/>\n"
+            "      <Term constant=\"-0.1\"/>\n"
             "    </Combine>\n"
             "  </Masks>\n",
-            0.15 * size, 0.1 * rate * emit / (size * size), 1.0 / pow(0.1 * rate * emit / (size * size), 2.0));
+            MOSS_SCALE, wet, 1.0 - 1.0 / MOSS_RAYS, 1.0 - 2.0 / MOSS_RAYS, MOSS_RAYS, 0.15 * size,
+            sun_azimuth, MOSS_SCALE, 0.5 * wet, steepness_for(0.5 * wet), 1.0 - 1.5 / MOSS_RAYS,
+            steepness_for(0.5 / MOSS_RAYS));
     }
     put(&t, "</Weathering>\n");
     free(mesh_attr);
