@@ -33,6 +33,37 @@ static void release(wx_collider *col, wx_maps *maps, int count)
 }
 
 // A drop falling through the floor's plane hits it at y = 0, in the texel below.
+// A camera with no surface on its map's border holds the whole model in its
+// frame, so outside that frame it sees free space (docs/physics.md, "Cameras
+// that frame the model"); a camera that cuts the model gives no information
+// there, as design.md section 4 says. The point below the box is outside the
+// front camera's frame and behind the box for a narrow top camera.
+TEST(a_camera_framing_the_model_vouches_outside_its_frame)
+{
+    fx_world world = { 0 };
+    fx_box(&world, -1, -1, -1, 1, 1, 1);
+    float below[3] = { 0.0f, -3.0f, 0.0f };
+    float p0[3] = { 0.0f, -3.0f, 0.3f }, p1[3] = { 0.0f, -3.0f, -0.3f };
+    for (int framing = 0; framing < 2; ++framing) {
+        float size = framing ? 4.0f : 1.5f; // the front camera holds the box, or cuts it
+        wx_camera cams[2] = { fx_camera(0, 0, 10, 0, 0, 0, 0, 1, 0, size, 64),
+                              top_camera(1.5f, 64) };
+        wx_maps maps[2];
+        wx_collider col;
+        ENSURE(build(&col, cams, maps, 2, &world, false));
+        ENSURE(col.cameras[0].frames_model == (framing != 0));
+        ENSURE(!col.cameras[1].frames_model);
+        bool collides = wx_collider_point_collides(&col, below);
+        wx_hit hit;
+        bool swept = wx_collider_sweep(&col, p0, p1, &hit);
+        bool coarse = wx_collider_coarse_clear(&col, p0, p1);
+        release(&col, maps, 2);
+        ENSURE(collides == !framing);
+        ENSURE(swept == !framing);
+        ENSURE(!framing || coarse);
+    }
+}
+
 TEST(drop_hits_the_texel_below)
 {
     fx_world world = { 0 };
@@ -332,6 +363,7 @@ int main(void)
 {
     RUN(drop_hits_the_texel_below);
     RUN(box_from_three_sides_point_rule);
+    RUN(a_camera_framing_the_model_vouches_outside_its_frame);
     RUN(fast_particle_hits_one_texel_wall);
     RUN(bilinear_depth_follows_an_incline);
     RUN(head_on_camera_gives_the_hit_on_a_steep_face);

@@ -132,6 +132,23 @@ static wx_result build_coarse(wx_collider_camera *cam, wx_error *err)
     return WX_OK;
 }
 
+// True when no texel of the map's outermost ring records a surface.
+static bool border_is_empty(const float *depth, int W, int H)
+{
+    for (int i = 0; i < W; ++i) {
+        if (isfinite(depth[i]) || isfinite(depth[(size_t)(H - 1) * (size_t)W + (size_t)i])) {
+            return false;
+        }
+    }
+    for (int j = 0; j < H; ++j) {
+        if (isfinite(depth[(size_t)j * (size_t)W]) ||
+            isfinite(depth[(size_t)j * (size_t)W + (size_t)(W - 1)])) {
+            return false;
+        }
+    }
+    return true;
+}
+
 wx_result wx_collider_init(wx_collider *collider, const wx_camera *cameras, const wx_maps *maps,
                            int count, bool nearest, wx_error *err)
 {
@@ -180,6 +197,7 @@ wx_result wx_collider_init(wx_collider *collider, const wx_camera *cameras, cons
         for (size_t t = 0; t < texels; ++t) {
             cam->depth[t] = wx_depth_is_empty(m->depth[t]) ? INFINITY : m->depth[t];
         }
+        cam->frames_model = border_is_empty(cam->depth, m->width, m->height);
         cam->normal = m->normal;
         cam->impact = m->impact;
         r = build_coarse(cam, err);
@@ -287,6 +305,9 @@ bool wx_collider_point_collides(const wx_collider *collider, const float p[3])
         double Y = p[0] * cam->my[0] + p[1] * cam->my[1] + p[2] * cam->my[2] + cam->my[3];
         double D = p[0] * cam->md[0] + p[1] * cam->md[1] + p[2] * cam->md[2] + cam->md[3];
         if (!(X >= 0.0 && X < cam->width && Y >= 0.0 && Y < cam->height)) {
+            if (cam->frames_model) {
+                return false; // the whole model is inside this frame, p is not
+            }
             continue; // no information
         }
         informed = true;
@@ -465,12 +486,21 @@ static double first_nonnegative(double A, double B, double C, double lo, double 
 }
 
 // The smallest s' >= s where this camera puts the segment's point behind its
-// surface or outside its frame (both let a collision happen); > 1 when none
-// within the segment.
+// surface or outside its frame (both let a collision happen, unless the camera
+// frames the whole model: then outside is free space); > 1 when none within the
+// segment.
 static double march_entry(const wx_collider *collider, march *m, double s)
 {
+    bool frames = m->cam->frames_model;
     if (!march_inside(m, s)) {
-        return s;
+        if (!frames) {
+            return s;
+        }
+        if (s < m->s_in && m->s_in <= 1.0 && m->s_in < m->s_out) {
+            s = m->s_in; // free space up to the frame, then the map decides
+        } else {
+            return 2.0;
+        }
     }
     if (!m->placed || s >= m->sb || s < m->sa) {
         march_place(collider, m, s);
@@ -486,10 +516,10 @@ static double march_entry(const wx_collider *collider, march *m, double s)
             }
         }
         if (m->sb >= end) {
-            return m->s_out <= 1.0 ? m->s_out : 2.0;
+            return m->s_out <= 1.0 && !frames ? m->s_out : 2.0;
         }
         if (!march_advance(collider, m)) {
-            return m->s_out <= 1.0 ? m->s_out : 2.0;
+            return m->s_out <= 1.0 && !frames ? m->s_out : 2.0;
         }
     }
     return 2.0;
@@ -823,6 +853,9 @@ WX_HOT uint32_t wx_collider_coarse_block(const wx_collider *collider, const int 
             clear_bits |= -(uint32_t)(usable[k] & (dmax[k] < least[k])) & lane_bit[k];
             out_bits |= -(uint32_t)out[k] & lane_bit[k];
         }
+        if (cam->frames_model) {
+            clear_bits |= out_bits; // wholly outside a frame that holds the model
+        }
         if (credit != NULL) {
             credit[c] += (uint32_t)__builtin_popcount(clear_bits & ~cleared);
         }
@@ -844,9 +877,10 @@ bool wx_collider_coarse_clear(const wx_collider *collider, const float p0[3], co
         coarse_geometry g = coarse_setup(cam);
         int usable, index;
         float dmax;
-        outside &= coarse_lane(&g, p0[0], p0[1], p0[2], p1[0], p1[1], p1[2], &usable, &index,
-                               &dmax) != 0;
-        if (usable && dmax < cam->coarse[index]) {
+        int out = coarse_lane(&g, p0[0], p0[1], p0[2], p1[0], p1[1], p1[2], &usable, &index,
+                              &dmax);
+        outside &= out != 0;
+        if ((usable && dmax < cam->coarse[index]) || (out && cam->frames_model)) {
             return true;
         }
     }

@@ -55,6 +55,11 @@ typedef struct wx_collider_camera {
     int level_height[WX_COARSE_LEVELS];
     int level_offset[WX_COARSE_LEVELS];
     float *coarse;
+    /// No texel on the map's border records a surface: the model lies inside
+    /// this camera's frame, so outside the frame it sees no surface, as over a
+    /// texel with none, and a point there does not collide (docs/physics.md,
+    /// "Cameras that frame the model").
+    bool frames_model;
 } wx_collider_camera;
 
 typedef struct wx_collider {
