@@ -646,6 +646,7 @@ static int command_info(const cli_args *args)
     }
     if (r != WX_OK) {
         fprintf(stderr, "weathering: %s\n", err.message);
+        wx_geometry_free(&geometry);
         wx_scene_free(&scene);
         return r;
     }

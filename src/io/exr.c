@@ -606,7 +606,8 @@ static wx_result read_channels(const char *path, const char *const *wanted, int 
     }
     read_target targets[WX_IMAGE_MAX_CHANNELS];
     for (int i = 0; i < wanted_count; i++) {
-        int length = chlist->entries[i].name.length;
+        // (entry i exists only when every channel is read, in the file's order)
+        int length = wanted == NULL ? chlist->entries[i].name.length : 0;
         if (wanted == NULL && length >= WX_NAME_MAX) {
             reader_close(&r); // frees chlist
             return wx_fail(err, WX_CAUSE_BAD_MAP,
