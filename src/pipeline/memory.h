@@ -122,8 +122,8 @@ typedef struct wx_memory_need {
 #define WX_GATHER_BYTES_PER_INPUT_TEXEL 36.0
 #define WX_GATHER_BYTES_PER_OUTPUT_TEXEL 112.0
 /// Margin over the measured sizes: allocator rounding and small buffers, and
-/// the heap the threads leave in their own allocator arenas, which varies from
-/// run to run of the same scene (the bunny's peak: 351, 353 and 420 MiB in three
+/// the peak's variation with the threads' timing from run to run of the same
+/// scene (the bunny's peak: 351, 353 and 420 MiB in three
 /// runs on two cores, 3 December 2026).
 #define WX_MEMORY_MARGIN 1.3
 
