@@ -5,6 +5,7 @@
 #                 docs/mask.md's Blender recipe, run headless in Blender
 #   make run      run the shipped default scene into out/building/
 #   make gallery  every preset on every shipped model: docs/images/gallery.png
+#   make previews the other pictures of docs/images, from today's code
 #   make bench    benchmarks (speed and memory targets)
 #   make sanitize, make tsan, make valgrind, make fuzz
 #                 the reliability checks CI runs (docs/reliability.md)
@@ -50,7 +51,7 @@ VIEWER_BIN := $(if $(VIEWER_SRC),$(BUILD)/weathering-viewer)
 # `weathering bake` in a child process when a scene's maps are still to bake.
 VIEWER_LIBS := -lglfw -lGL -lOpenEXRCore-3_1 -lxml2 -lpng -lm -lpthread
 
-.PHONY: all deps bench-deps test test-blender run bench bench-build clean sanitize tsan fuzz valgrind gallery
+.PHONY: all deps bench-deps test test-blender run bench bench-build clean sanitize tsan fuzz valgrind gallery previews
 all: $(BUILD)/weathering $(VIEWER_BIN)
 
 # Installs whatever Debian package is missing (apt-get update first), as root or
@@ -159,6 +160,12 @@ bench: $(BUILD)/weathering $(BENCH_BIN)
 # About 20 runs; GALLERY_RESOLUTION=N sets their --resolution (default 384).
 gallery: $(BUILD)/weathering $(BUILD)/tools/render_texture $(BUILD)/tools/gallery
 	sh tests/tools/gallery.sh $(BUILD) docs/images/gallery.png
+
+# make previews: the other pictures of docs/images, from today's code
+# (tests/tools/previews.sh: the shipped scenes, the house's derived masks,
+# the presets on Spot; about 3 minutes on two cores).
+previews: $(BUILD)/weathering $(BUILD)/tools/render_texture $(BUILD)/tools/gallery
+	sh tests/tools/previews.sh $(BUILD)
 
 # Bakes, simulates and gathers the default scene into out/<scene name>/ (mask.exr
 # and its preview mask.png); SCENE=file.xml runs another scene.

@@ -54,6 +54,13 @@ static bool read_png(const char *path, picture *out)
     size_t n = (size_t)image.width * image.height;
     uint8_t *bytes = malloc(3 * n);
     out->rgb = malloc(3 * n * sizeof *out->rgb);
+    if (bytes != NULL) {
+        // libpng composites a picture with alpha over what the buffer holds:
+        // the background, not whatever malloc left there.
+        for (size_t i = 0; i < 3 * n; ++i) {
+            bytes[i] = (uint8_t)(BACKGROUND[i % 3] * 255.0f + 0.5f);
+        }
+    }
     if (bytes == NULL || out->rgb == NULL ||
         !png_image_finish_read(&image, NULL, bytes, 0, NULL)) {
         fprintf(stderr, "gallery: %s: cannot read\n", path);
