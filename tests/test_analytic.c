@@ -137,21 +137,37 @@ static const char *overhang_scene =
     "  </Geometry>\n"
     "</Weathering>\n";
 
+// Writes the wall mesh and the scene, runs it into NAME/ and reads the 512 x
+// 512 mask (NULL on any failure).
+static float *run_wall(const char *dir, const char *mesh, const char *scene_text,
+                       const char *name)
+{
+    char scene[256], path[4300];
+    snprintf(scene, sizeof scene, "%s.xml", name);
+    ensure_write_file(dir, "wall.obj", mesh);
+    ensure_write_file(dir, scene, scene_text);
+    if (!run_scene(dir, scene, name)) {
+        return NULL;
+    }
+    snprintf(path, sizeof path, "%s/%s/mask.exr", dir, name);
+    int w = 0, h = 0;
+    float *mask = ensure_read_channel(path, "Y", &w, &h);
+    if (mask != NULL && (w != 512 || h != 512)) {
+        free(mask);
+        return NULL;
+    }
+    return mask;
+}
+
 // The shadow of the overhang: 2 million particles from 16 m^2 put 125000 per
 // square metre on the wall below y = 2 and none above. The edge rises from 10%
 // to 90% within 8 output texels (7.8 mm each), the sheltered band (y 2.1 to 2.95)
 // holds at most 2% of the exposed wall's mean, which is within 3% of exact.
 TEST(wall_under_an_overhang_in_slanting_rain)
 {
-    const char *dir = ensure_tmpdir();
-    ensure_write_file(dir, "wall.obj", overhang_mesh);
-    ensure_write_file(dir, "overhang.xml", overhang_scene);
-    ENSURE(run_scene(dir, "overhang.xml", "overhang"));
-    char path[4300];
-    snprintf(path, sizeof path, "%s/overhang/mask.exr", dir);
-    int w, h;
-    float *mask = ensure_read_channel(path, "Y", &w, &h);
-    ENSURE(mask != NULL && w == 512 && h == 512);
+    float *mask = run_wall(ensure_tmpdir(), overhang_mesh, overhang_scene, "overhang");
+    ENSURE(mask != NULL);
+    const int w = 512, h = 512;
     // Rows averaged over |x| < 1.5; row j at y = 3.6 - 4 (j + 0.5) / 512.
     double profile[512];
     for (int j = 0; j < h; ++j) {
@@ -279,17 +295,11 @@ static const char *rotated_overhang_scene =
 
 TEST(shelter_edge_at_30_degrees_to_the_cameras_is_straight)
 {
-    const char *dir = ensure_tmpdir();
     char obj[4096];
     rotated_overhang_mesh(obj, sizeof obj);
-    ensure_write_file(dir, "wall.obj", obj);
-    ensure_write_file(dir, "turned.xml", rotated_overhang_scene);
-    ENSURE(run_scene(dir, "turned.xml", "turned"));
-    char path[4300];
-    snprintf(path, sizeof path, "%s/turned/mask.exr", dir);
-    int w, h;
-    float *mask = ensure_read_channel(path, "Y", &w, &h);
-    ENSURE(mask != NULL && w == 512 && h == 512);
+    float *mask = run_wall(ensure_tmpdir(), obj, rotated_overhang_scene, "turned");
+    ENSURE(mask != NULL);
+    const int w = 512, h = 512;
     // Output pixel (i, j) is at x = -2 + 4 (i + 0.5) / 512 along the wall,
     // y = 3.6 - 4 (j + 0.5) / 512.
     double exposed = 0.0;
