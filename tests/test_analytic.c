@@ -7,7 +7,10 @@
 //    camera 1024 px over 2.4 m, looking down.
 //  - A wall under an overhang in rain slanting at 45 degrees towards it: the
 //    overhang's front edge (y = 3, 1 m out) casts the shadow edge y = 2 on the
-//    wall; below it the wall takes N/A per square metre, above it nothing.
+//    wall; below it the wall takes N/A per square metre, above it nothing;
+//    and the same turned 30 degrees in the camera grid (issue 25).
+//  - A coarse lumpy sphere with UVs under vertical rain, as it is and turned
+//    30 degrees: its TextureMap against the exact F max(0, N.y) (issue 25).
 #define _XOPEN_SOURCE 700 // realpath
 #include <limits.h>
 #include <math.h>
@@ -381,11 +384,190 @@ TEST(shelter_edge_at_30_degrees_to_the_cameras_is_straight)
     ENSURE(rise / np <= 8.0);
 }
 
+// --- A coarse lumpy sphere under vertical rain, turned in the camera grid ----
+//
+// Issue 25, item 1: tests/tools/lumpy_sphere.sh's model (radius 1 with lumps of
+// 0.12 and 0.08, 24 x 12 segments, equirectangular UVs), every drop absorbed at
+// its first hit, so the exact density is F max(0, N.y) (F drops per square
+// metre across the box), which the scene's <Exposure elevation="90"> mask
+// writes beside the dirt in the same TextureMap. Once as it is and once turned
+// 30 degrees about the vertical, with the same cameras and drops.
+static void lumpy_sphere(char *obj, size_t size, double turn_degrees)
+{
+    const int nu = 24, nv = 12;
+    const double c = cos(turn_degrees * M_PI / 180.0), s = sin(turn_degrees * M_PI / 180.0);
+    size_t n = 0;
+    for (int j = 0; j <= nv; ++j) {
+        double ph = M_PI * j / nv;
+        for (int i = 0; i <= nu; ++i) {
+            double th = 2.0 * M_PI * i / nu;
+            double r = 1.0 + 0.12 * sin(3.0 * th) * sin(2.0 * ph) + 0.08 * cos(5.0 * ph);
+            double x = r * sin(ph) * cos(th), y = r * cos(ph) + 1.2, z = r * sin(ph) * sin(th);
+            n += (size_t)snprintf(obj + n, size - n, "v %.6f %.6f %.6f\n", c * x + s * z, y,
+                                  -s * x + c * z);
+        }
+    }
+    for (int j = 0; j <= nv; ++j) {
+        for (int i = 0; i <= nu; ++i) {
+            n += (size_t)snprintf(obj + n, size - n, "vt %.6f %.6f\n", (double)i / nu,
+                                  1.0 - (double)j / nv);
+        }
+    }
+    for (int j = 0; j < nv; ++j) {
+        for (int i = 0; i < nu; ++i) {
+            int a = j * (nu + 1) + i + 1, b = a + 1, d = a + nu + 1, e = d + 1;
+            if (j > 0) {
+                n += (size_t)snprintf(obj + n, size - n, "f %d/%d %d/%d %d/%d\n", a, a, b, b, e, e);
+            }
+            if (j < nv - 1) {
+                n += (size_t)snprintf(obj + n, size - n, "f %d/%d %d/%d %d/%d\n", a, a, e, e, d, d);
+            }
+        }
+    }
+}
+
+// 400 000 drops over 3 x 3 m: F = 44 444 per square metre. Input cameras of
+// 384 px over 3 m, the TextureMap 512 x 512.
+static const char *lumpy_scene =
+    "<Weathering>\n"
+    "  <Solver>\n"
+    "    <BoundingBox size=\"8\" centerX=\"0\" centerY=\"1.2\" centerZ=\"0\"/>\n"
+    "    <Simulation timeStep=\"0.02\" steps=\"100\" seed=\"%d\"/>\n"
+    "  </Solver>\n"
+    "  <Emitters>\n"
+    "    <BoxEmitter minX=\"-1.5\" minY=\"3\" minZ=\"-1.5\" maxX=\"1.5\" maxY=\"3\" maxZ=\"1.5\"\n"
+    "                dirX=\"0\" dirY=\"-1\" dirZ=\"0\" rate=\"400000\" end=\"1\" speed=\"10\"/>\n"
+    "  </Emitters>\n"
+    "  <Collider>\n"
+    "    <ProjectedMaps>\n"
+    "      <Ortho cameraName=\"top\"><View eye=\"0 5 0\" target=\"0 1.2 0\" up=\"0 0 -1\"\n"
+    "        width=\"3\" height=\"3\" resolution=\"384\"/></Ortho>\n"
+    "      <Ortho cameraName=\"front\"><View eye=\"0 1.2 5\" target=\"0 1.2 0\" up=\"0 1 0\"\n"
+    "        width=\"3\" height=\"3\" resolution=\"384\"/></Ortho>\n"
+    "      <Ortho cameraName=\"back\"><View eye=\"0 1.2 -5\" target=\"0 1.2 0\" up=\"0 1 0\"\n"
+    "        width=\"3\" height=\"3\" resolution=\"384\"/></Ortho>\n"
+    "      <Ortho cameraName=\"left\"><View eye=\"-5 1.2 0\" target=\"0 1.2 0\" up=\"0 1 0\"\n"
+    "        width=\"3\" height=\"3\" resolution=\"384\"/></Ortho>\n"
+    "      <Ortho cameraName=\"right\"><View eye=\"5 1.2 0\" target=\"0 1.2 0\" up=\"0 1 0\"\n"
+    "        width=\"3\" height=\"3\" resolution=\"384\"/></Ortho>\n"
+    "    </ProjectedMaps>\n"
+    "  </Collider>\n"
+    "  <Geometry>\n"
+    "    <Mesh file=\"%s\">\n"
+    "      <Surface material=\"*\" absorption=\"1\"/>\n"
+    "      <TextureMap file=\"t.exr\" resolution=\"512\" padding=\"4\"/>\n"
+    "    </Mesh>\n"
+    "  </Geometry>\n"
+    "  <Masks><Exposure name=\"sun\" elevation=\"90\" azimuth=\"0\"/></Masks>\n"
+    "</Weathering>\n";
+
+// Runs the lumpy sphere (turned or not, seed) and reads its texture's dirt,
+// the exact shape (sun) and seen; false on failure.
+static bool run_lumpy(const char *dir, bool turned, int seed, float **dirt, float **sun,
+                      float **seen)
+{
+    char name[64], scene[8192], path[4300];
+    const char *mesh = turned ? "turned.obj" : "lumpy.obj";
+    snprintf(name, sizeof name, "%s%d", turned ? "turned" : "lumpy", seed);
+    char file[80];
+    snprintf(file, sizeof file, "%s.xml", name);
+    snprintf(scene, sizeof scene, lumpy_scene, seed, mesh);
+    ensure_write_file(dir, file, scene);
+    if (!run_scene(dir, file, name)) {
+        return false;
+    }
+    snprintf(path, sizeof path, "%s/%s/t.exr", dir, name);
+    int w[3], h[3];
+    *dirt = ensure_read_channel(path, "dirt.Y", &w[0], &h[0]);
+    *sun = ensure_read_channel(path, "sun.Y", &w[1], &h[1]);
+    *seen = ensure_read_channel(path, "seen", &w[2], &h[2]);
+    for (int k = 0; k < 3; ++k) {
+        if (w[k] != 512 || h[k] != 512) {
+            return false;
+        }
+    }
+    return *dirt != NULL && *sun != NULL && *seen != NULL;
+}
+
+// Measured (3 December 2026): each run within 1.6% RMS of the exact density
+// over 16 x 16-texel blocks, two seeds 0.67% apart, the two orientations 1.14%
+// apart. Issue 25 asks the orientations to differ at most 1.05 times as much
+// as the seeds: not met (docs/performance.md); this test holds what is.
+TEST(lumpy_sphere_turned_in_the_camera_grid_keeps_its_exact_rain)
+{
+    const char *dir = ensure_tmpdir();
+    static char obj[200000];
+    lumpy_sphere(obj, sizeof obj, 0.0);
+    ensure_write_file(dir, "lumpy.obj", obj);
+    lumpy_sphere(obj, sizeof obj, 30.0);
+    ensure_write_file(dir, "turned.obj", obj);
+    enum { RUNS = 3, W = 512, B = 16 };
+    const bool turned[RUNS] = { false, false, true };
+    const int seed[RUNS] = { 1, 2, 1 };
+    float *dirt[RUNS] = { NULL }, *sun[RUNS] = { NULL }, *seen[RUNS] = { NULL };
+    for (int r = 0; r < RUNS; ++r) {
+        ENSURE(run_lumpy(dir, turned[r], seed[r], &dirt[r], &sun[r], &seen[r]));
+    }
+    // 16 x 16 blocks of the upper sphere (N.y > 0.3 everywhere in them) below
+    // the pole's fan of thin triangles (rows 48 to 192 of 512).
+    const double F = 400000.0 / 9.0;
+    double err[RUNS] = { 0 }, seeds = 0.0, turn = 0.0;
+    int blocks = 0;
+    for (int by = 48 / B; by < 192 / B; ++by) {
+        for (int bx = 0; bx < W / B; ++bx) {
+            double d[RUNS] = { 0 }, exact = 0.0;
+            bool ok = true;
+            for (int y = by * B; y < (by + 1) * B && ok; ++y) {
+                for (int x = bx * B; x < (bx + 1) * B; ++x) {
+                    size_t i = (size_t)y * W + (size_t)x;
+                    if (!(seen[0][i] > 0.5f && seen[2][i] > 0.5f && sun[0][i] > 0.3f)) {
+                        ok = false;
+                        break;
+                    }
+                    exact += F * sun[0][i];
+                    for (int r = 0; r < RUNS; ++r) {
+                        d[r] += dirt[r][i];
+                    }
+                }
+            }
+            if (!ok) {
+                continue;
+            }
+            for (int r = 0; r < RUNS; ++r) {
+                double e = d[r] / exact - 1.0;
+                err[r] += e * e;
+            }
+            seeds += pow((d[1] - d[0]) / exact, 2.0);
+            turn += pow((d[2] - d[0]) / exact, 2.0);
+            blocks++;
+        }
+    }
+    for (int r = 0; r < RUNS; ++r) {
+        free(dirt[r]);
+        free(sun[r]);
+        free(seen[r]);
+    }
+    ENSURE(blocks >= 200);
+    for (int r = 0; r < RUNS; ++r) {
+        err[r] = sqrt(err[r] / blocks);
+    }
+    seeds = sqrt(seeds / blocks);
+    turn = sqrt(turn / blocks);
+    printf("        %d blocks of 16 x 16: against the exact density %.4f, %.4f (seeds 1, 2), "
+           "%.4f (turned); seeds differ %.4f, orientations %.4f\n",
+           blocks, err[0], err[1], err[2], seeds, turn);
+    for (int r = 0; r < RUNS; ++r) {
+        ENSURE(err[r] <= 0.02);
+    }
+    ENSURE(turn <= 0.02);
+}
+
 int main(void)
 {
     RUN(sphere_under_rain_from_a_box);
     RUN(sphere_under_a_dome_aimed_at_its_foot);
     RUN(wall_under_an_overhang_in_slanting_rain);
     RUN(shelter_edge_at_30_degrees_to_the_cameras_is_straight);
+    RUN(lumpy_sphere_turned_in_the_camera_grid_keeps_its_exact_rain);
     return ensure_summary();
 }
