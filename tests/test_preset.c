@@ -12,39 +12,10 @@
 #include <string.h>
 #include <unistd.h>
 
-#include <libxml/parser.h>
-#include <libxml/xmlschemas.h>
-
 #include "ensure.h"
 #include "run_fixture.h"
 #include "io/exr.h"
 #include "model/image.h"
-
-// `weathering` in `dir` with the arguments of `fmt` (two strings), its failures
-// expected as often as not (not shown).
-static int run_in(const char *dir, const char *fmt, const char *a, const char *b)
-{
-    char args[4 * PATH_MAX];
-    snprintf(args, sizeof args, fmt, a, b);
-    return weathering_in(dir, args, false);
-}
-
-// Validates a scene against xml_scenes/weathering.xsd.
-static bool schema_accepts(const char *path)
-{
-    char xsd[PATH_MAX + 64];
-    snprintf(xsd, sizeof xsd, "%s/../xml_scenes/weathering.xsd", ensure_tests_dir());
-    xmlSchemaParserCtxtPtr pc = xmlSchemaNewParserCtxt(xsd);
-    xmlSchemaPtr schema = pc != NULL ? xmlSchemaParse(pc) : NULL;
-    xmlSchemaValidCtxtPtr vc = schema != NULL ? xmlSchemaNewValidCtxt(schema) : NULL;
-    xmlDocPtr doc = xmlReadFile(path, NULL, XML_PARSE_NONET);
-    bool ok = vc != NULL && doc != NULL && xmlSchemaValidateDoc(vc, doc) == 0;
-    xmlFreeDoc(doc);
-    xmlSchemaFreeValidCtxt(vc);
-    xmlSchemaFree(schema);
-    xmlSchemaFreeParserCtxt(pc);
-    return ok;
-}
 
 // The mean of a texture's channel over an island of texture_cube.obj (first
 // covered texel (i0, j0), 224 x 224 texels at 768 x 512; tests/test_texture.c),
