@@ -7,7 +7,8 @@
 # build/tools/render_texture where the mesh has UVs, else the mask shaded
 # alike by build/tools/gallery (clay to dirt, white at the 99th percentile);
 # moss shows moss.Y, the others the dirt. GALLERY_RESOLUTION (default 384) sets
-# --resolution; the runs go to BUILD/gallery/MODEL-PRESET/.
+# --resolution; the runs go to BUILD/gallery/MODEL-PRESET/. Spot's row is also
+# written alone, larger, as presets-spot.png beside OUT.png (docs/presets.md).
 set -eu
 build=$1
 out=$2
@@ -42,4 +43,10 @@ for model in building teapot stanford-bunny spot tank; do
 done
 # shellcheck disable=SC2086 # the cells are words
 "$build/tools/gallery" "$out" --columns 4 --cell 320 $cells
-echo "gallery: wrote $out" >&2
+spot=""
+for preset in rain dust soot moss; do
+    spot="$spot png:$dir/spot-$preset/gallery.png"
+done
+# shellcheck disable=SC2086 # the cells are words
+"$build/tools/gallery" "$(dirname "$out")/presets-spot.png" --columns 4 --cell 384 $spot
+echo "gallery: wrote $out and $(dirname "$out")/presets-spot.png" >&2

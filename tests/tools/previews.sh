@@ -1,16 +1,15 @@
 #!/bin/sh
-# previews.sh BUILD: regenerates the pictures of docs/images (but the gallery,
-# `make gallery`, and the Blender add-on's screenshot) from today's code, so
-# that the documentation shows what the program makes now (make previews).
+# previews.sh BUILD: regenerates the pictures of docs/images (but the gallery
+# and presets-spot.png, which `make gallery` writes, and the Blender add-on's
+# screenshot) from today's code, so that the documentation shows what the
+# program makes now (make previews).
 #
 #   BUILD/previews/SCENE/          each shipped scene's run (xml_scenes/)
 #   BUILD/previews/house-masks/    the house with docs/masks.md's <Masks>
-#   BUILD/previews/spot-PRESET/    Spot under each preset (--resolution 384)
 #
 # The mask previews are the program's own PNGs (white at the larger of 1 and
 # the 99th percentile); the TextureMaps on their models are drawn by
-# build/tools/render_texture from a camera the scenes do not have; the presets
-# on Spot are four render_texture pictures side by side (build/tools/gallery).
+# build/tools/render_texture from a camera the scenes do not have.
 set -eu
 build=$1
 images=docs/images
@@ -60,22 +59,4 @@ for m in ao sun curvature height grime; do
     cp "$dir/house-masks/out/mask_$m.png" "$images/masks-house-$m.png"
 done
 
-# Each preset on Spot, from its own output camera.
-cells=""
-for preset in rain dust soot moss; do
-    echo "previews: Spot, $preset" >&2
-    o=$dir/spot-$preset
-    rm -rf "$o"
-    "$w" run xml_scenes/meshes/spot.obj --preset "$preset" --resolution 384 --out "$o" -q
-    channel=Y
-    [ "$preset" = moss ] && channel=moss
-    view=$(tr '\n' ' ' < "$o/scene.xml" | sed -e 's/.*out="true">[^<]*<View \([^/]*\)\/>.*/\1/' |
-        sed -e 's/[a-z]*="\([^"]*\)"/\1/g' |
-        awk '{ print $1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11, 640 }')
-    "$build/tools/render_texture" xml_scenes/meshes/spot.obj "$(ls "$o"/*_texture.exr | head -1)" \
-        --channel "$channel" --view "$view" --png "$o/preview.png"
-    cells="$cells png:$o/preview.png"
-done
-# shellcheck disable=SC2086 # the cells are words
-"$build/tools/gallery" "$images/presets-spot.png" --columns 4 --cell 384 $cells
 echo "previews: wrote $images" >&2
