@@ -392,7 +392,9 @@ TEST(shelter_edge_at_30_degrees_to_the_cameras_is_straight)
 // metre across the box), which the scene's <Exposure elevation="90"> mask
 // writes beside the dirt in the same TextureMap. Once as it is and once turned
 // 30 degrees about the vertical, with the same cameras and drops.
-static void lumpy_sphere(char *obj, size_t size, double turn_degrees)
+// inward: every face wound the other way, as an export with flipped normals
+// gives it.
+static void lumpy_sphere(char *obj, size_t size, double turn_degrees, bool inward)
 {
     const int nu = 24, nv = 12;
     const double c = cos(turn_degrees * M_PI / 180.0), s = sin(turn_degrees * M_PI / 180.0);
@@ -416,11 +418,16 @@ static void lumpy_sphere(char *obj, size_t size, double turn_degrees)
     for (int j = 0; j < nv; ++j) {
         for (int i = 0; i < nu; ++i) {
             int a = j * (nu + 1) + i + 1, b = a + 1, d = a + nu + 1, e = d + 1;
+            int second = inward ? e : b, third = inward ? b : e;
             if (j > 0) {
-                n += (size_t)snprintf(obj + n, size - n, "f %d/%d %d/%d %d/%d\n", a, a, b, b, e, e);
+                n += (size_t)snprintf(obj + n, size - n, "f %d/%d %d/%d %d/%d\n", a, a, second,
+                                      second, third, third);
             }
+            second = inward ? d : e;
+            third = inward ? e : d;
             if (j < nv - 1) {
-                n += (size_t)snprintf(obj + n, size - n, "f %d/%d %d/%d %d/%d\n", a, a, e, e, d, d);
+                n += (size_t)snprintf(obj + n, size - n, "f %d/%d %d/%d %d/%d\n", a, a, second,
+                                      second, third, third);
             }
         }
     }
@@ -463,12 +470,12 @@ static const char *lumpy_scene =
 
 // Runs the lumpy sphere (turned or not, seed) and reads its texture's dirt,
 // the exact shape (sun) and seen; false on failure.
-static bool run_lumpy(const char *dir, bool turned, int seed, float **dirt, float **sun,
+static bool run_lumpy(const char *dir, const char *model, int seed, float **dirt, float **sun,
                       float **seen)
 {
-    char name[64], scene[8192], path[4300];
-    const char *mesh = turned ? "turned.obj" : "lumpy.obj";
-    snprintf(name, sizeof name, "%s%d", turned ? "turned" : "lumpy", seed);
+    char name[64], scene[8192], path[4300], mesh[80];
+    snprintf(mesh, sizeof mesh, "%s.obj", model);
+    snprintf(name, sizeof name, "%s%d", model, seed);
     char file[80];
     snprintf(file, sizeof file, "%s.xml", name);
     snprintf(scene, sizeof scene, lumpy_scene, seed, mesh);
@@ -497,16 +504,17 @@ TEST(lumpy_sphere_turned_in_the_camera_grid_keeps_its_exact_rain)
 {
     const char *dir = ensure_tmpdir();
     static char obj[200000];
-    lumpy_sphere(obj, sizeof obj, 0.0);
+    lumpy_sphere(obj, sizeof obj, 0.0, false);
     ensure_write_file(dir, "lumpy.obj", obj);
-    lumpy_sphere(obj, sizeof obj, 30.0);
+    lumpy_sphere(obj, sizeof obj, 30.0, false);
     ensure_write_file(dir, "turned.obj", obj);
     enum { RUNS = 3, W = 512, B = 16 };
     const bool turned[RUNS] = { false, false, true };
     const int seed[RUNS] = { 1, 2, 1 };
     float *dirt[RUNS] = { NULL }, *sun[RUNS] = { NULL }, *seen[RUNS] = { NULL };
     for (int r = 0; r < RUNS; ++r) {
-        ENSURE(run_lumpy(dir, turned[r], seed[r], &dirt[r], &sun[r], &seen[r]));
+        ENSURE(run_lumpy(dir, turned[r] ? "turned" : "lumpy", seed[r], &dirt[r], &sun[r],
+                         &seen[r]));
     }
     // 16 x 16 blocks of the upper sphere (N.y > 0.3 everywhere in them) below
     // the pole's fan of thin triangles (rows 48 to 192 of 512).
@@ -562,6 +570,61 @@ TEST(lumpy_sphere_turned_in_the_camera_grid_keeps_its_exact_rain)
     ENSURE(turn <= 0.02);
 }
 
+// Issue 26, item 6: the same sphere with every face wound the other way (the
+// OBJ has no normals, so the generated ones point in, as an export with its
+// normals flipped gives them). Before the import turned it outwards, its
+// texture was seen on 1.2% of the texels the outward sphere's was; now the
+// same texels are seen and the same drops give the same rain.
+TEST(lumpy_sphere_wound_inwards_weathers_as_wound_outwards)
+{
+    const char *dir = ensure_tmpdir();
+    static char obj[200000];
+    lumpy_sphere(obj, sizeof obj, 0.0, false);
+    ensure_write_file(dir, "lumpy.obj", obj);
+    lumpy_sphere(obj, sizeof obj, 0.0, true);
+    ensure_write_file(dir, "inward.obj", obj);
+    float *dirt[2] = { NULL }, *sun[2] = { NULL }, *seen[2] = { NULL };
+    ENSURE(run_lumpy(dir, "lumpy", 1, &dirt[0], &sun[0], &seen[0]));
+    ENSURE(run_lumpy(dir, "inward", 1, &dirt[1], &sun[1], &seen[1]));
+    enum { W = 512, B = 16 };
+    int64_t seen_out = 0, seen_in = 0, differ = 0;
+    double sum_out = 0.0, sum_in = 0.0, diff2 = 0.0, mean2 = 0.0;
+    for (size_t i = 0; i < (size_t)W * W; ++i) {
+        seen_out += seen[0][i] > 0.5f;
+        seen_in += seen[1][i] > 0.5f;
+        differ += (seen[0][i] > 0.5f) != (seen[1][i] > 0.5f);
+        sum_out += dirt[0][i];
+        sum_in += dirt[1][i];
+        ENSURE(fabsf(sun[0][i] - sun[1][i]) <= 1e-3f);
+    }
+    for (int by = 0; by < W / B; ++by) {
+        for (int bx = 0; bx < W / B; ++bx) {
+            double a = 0.0, b = 0.0;
+            for (int y = by * B; y < (by + 1) * B; ++y) {
+                for (int x = bx * B; x < (bx + 1) * B; ++x) {
+                    a += dirt[0][(size_t)y * W + (size_t)x];
+                    b += dirt[1][(size_t)y * W + (size_t)x];
+                }
+            }
+            diff2 += (a - b) * (a - b);
+            mean2 += a * a;
+        }
+    }
+    printf("        seen: %lld texels outwards, %lld inwards (%lld differ); rain %.6g and "
+           "%.6g; 16 x 16 blocks %.4f apart\n",
+           (long long)seen_out, (long long)seen_in, (long long)differ, sum_out, sum_in,
+           sqrt(diff2 / mean2));
+    ENSURE(seen_out > W * W / 2);
+    ENSURE(differ <= seen_out / 1000);
+    ENSURE(fabs(sum_in / sum_out - 1.0) <= 0.002);
+    ENSURE(sqrt(diff2 / mean2) <= 0.005);
+    for (int r = 0; r < 2; ++r) {
+        free(dirt[r]);
+        free(sun[r]);
+        free(seen[r]);
+    }
+}
+
 int main(void)
 {
     RUN(sphere_under_rain_from_a_box);
@@ -569,5 +632,6 @@ int main(void)
     RUN(wall_under_an_overhang_in_slanting_rain);
     RUN(shelter_edge_at_30_degrees_to_the_cameras_is_straight);
     RUN(lumpy_sphere_turned_in_the_camera_grid_keeps_its_exact_rain);
+    RUN(lumpy_sphere_wound_inwards_weathers_as_wound_outwards);
     return ensure_summary();
 }

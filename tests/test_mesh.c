@@ -1049,6 +1049,138 @@ TEST(a_fan_of_many_faces_smooths_in_bounded_time)
     wx_mesh_data_free(&m);
 }
 
+// --- closed parts wound inwards (issue 26, item 6) ---------------------------
+
+// A unit cube at x offset `at` as OBJ text: faces wound outwards, or inwards;
+// normals none ('-'), outwards ('o') or inwards ('i'); `faces` of its six
+// (fewer leaves it open).
+static size_t cube_obj(char *obj, size_t size, double at, bool inward, char normals, int faces,
+                       int first_vertex, int first_normal)
+{
+    static const int quad[6][4] = { { 0, 2, 3, 1 }, { 4, 5, 7, 6 }, { 0, 1, 5, 4 },
+                                    { 2, 6, 7, 3 }, { 0, 4, 6, 2 }, { 1, 3, 7, 5 } };
+    static const double axis[6][3] = { { -1, 0, 0 }, { 1, 0, 0 }, { 0, -1, 0 },
+                                       { 0, 1, 0 },  { 0, 0, -1 }, { 0, 0, 1 } };
+    size_t n = 0;
+    for (int v = 0; v < 8; ++v) {
+        n += (size_t)snprintf(obj + n, size - n, "v %g %d %d\n", at + (v >> 2 & 1), v >> 1 & 1,
+                              v & 1);
+    }
+    for (int f = 0; normals != '-' && f < 6; ++f) {
+        double sign = normals == 'o' ? 1.0 : -1.0;
+        n += (size_t)snprintf(obj + n, size - n, "vn %g %g %g\n", sign * axis[f][0],
+                              sign * axis[f][1], sign * axis[f][2]);
+    }
+    for (int f = 0; f < faces; ++f) {
+        int c[4];
+        for (int k = 0; k < 4; ++k) {
+            c[k] = first_vertex + quad[f][inward ? k : 3 - k]; // the table's order is inwards
+        }
+        if (normals == '-') {
+            n += (size_t)snprintf(obj + n, size - n, "f %d %d %d %d\n", c[0], c[1], c[2], c[3]);
+        } else {
+            int vn = first_normal + f;
+            n += (size_t)snprintf(obj + n, size - n, "f %d//%d %d//%d %d//%d %d//%d\n", c[0], vn,
+                                  c[1], vn, c[2], vn, c[3], vn);
+        }
+    }
+    return n;
+}
+
+// Over the triangles whose centroid's x lies in [x0, x1]: the signed volume
+// of their winding, and the least (normal . (vertex - centre)) of their
+// corners, the centre (x0 + x1) / 2, 0.5, 0.5.
+static void cube_orientation(const wx_mesh_data *m, double x0, double x1, double *volume,
+                             double *least_out)
+{
+    *volume = 0.0;
+    *least_out = INFINITY;
+    for (int64_t t = 0; t < m->triangle_count; ++t) {
+        double p[3][3], cx = 0.0;
+        for (int k = 0; k < 3; ++k) {
+            world(m, m->indices[3 * t + k], p[k]);
+            cx += p[k][0] / 3.0;
+        }
+        if (cx < x0 || cx > x1) {
+            continue;
+        }
+        *volume += (p[0][0] * (p[1][1] * p[2][2] - p[1][2] * p[2][1]) -
+                    p[0][1] * (p[1][0] * p[2][2] - p[1][2] * p[2][0]) +
+                    p[0][2] * (p[1][0] * p[2][1] - p[1][1] * p[2][0])) / 6.0;
+        const double centre[3] = { 0.5 * (x0 + x1), 0.5, 0.5 };
+        for (int k = 0; k < 3; ++k) {
+            const float *n = &m->normals[3 * m->indices[3 * t + k]];
+            double d = 0.0;
+            for (int i = 0; i < 3; ++i) {
+                d += n[i] * (p[k][i] - centre[i]);
+            }
+            *least_out = fmin(*least_out, d);
+        }
+    }
+}
+
+TEST(closed_parts_wound_inwards_are_turned_outwards)
+{
+    static char obj[16384];
+    const char *dir = ensure_tmpdir();
+    wx_error err = { 0 };
+    wx_mesh_data m;
+    double volume, least;
+
+    // Four parts without normals in the file: a cube wound outwards, one wound
+    // inwards, an open box (five faces) wound inwards and a lone quad.
+    size_t n = cube_obj(obj, sizeof obj, 0.0, false, '-', 6, 1, 1);
+    n += cube_obj(obj + n, sizeof obj - n, 3.0, true, '-', 6, 9, 1);
+    n += cube_obj(obj + n, sizeof obj - n, 6.0, true, '-', 5, 17, 1);
+    snprintf(obj + n, sizeof obj - n, "v 9 0 0\nv 10 0 0\nv 10 0 1\nv 9 0 1\nf 25 26 27 28\n");
+    ENSURE(wx_mesh_import(ensure_write_file(dir, "parts.obj", obj), &m, &err) == WX_OK);
+    ENSURE(m.parts_turned == 1);
+    cube_orientation(&m, -0.5, 1.5, &volume, &least);
+    ENSURE_NEAR(volume, 1.0, 1e-9);
+    ENSURE(least > 0.49);
+    cube_orientation(&m, 2.5, 4.5, &volume, &least); // turned: winding and normals
+    ENSURE_NEAR(volume, 1.0, 1e-9);
+    ENSURE(least > 0.49);
+    // Open: as it came (its generated normals follow its winding, inwards).
+    cube_orientation(&m, 5.5, 7.5, &volume, &least);
+    ENSURE(least < -0.49);
+    for (int64_t t = 0; t < m.triangle_count; ++t) {
+        if (m.positions[3 * m.indices[3 * t]] + m.origin[0] >= 8.5) {
+            // The quad faces as its winding says: (1,0,0) x (1,0,1) points down.
+            ENSURE_NEAR(m.normals[3 * m.indices[3 * t] + 1], -1.0, 1e-6);
+        }
+    }
+    wx_mesh_data_free(&m);
+
+    // The file's normals point in, its winding out: the normals are turned,
+    // the winding stays.
+    cube_obj(obj, sizeof obj, 0.0, false, 'i', 6, 1, 1);
+    ENSURE(wx_mesh_import(ensure_write_file(dir, "normals_in.obj", obj), &m, &err) == WX_OK);
+    ENSURE(m.parts_turned == 1);
+    cube_orientation(&m, -0.5, 1.5, &volume, &least);
+    ENSURE_NEAR(volume, 1.0, 1e-9);
+    ENSURE(least > 0.49);
+    wx_mesh_data_free(&m);
+
+    // Normals out, winding in: the normals are what renderers and the bake
+    // read, so they stay; the winding is turned to agree.
+    cube_obj(obj, sizeof obj, 0.0, true, 'o', 6, 1, 1);
+    ENSURE(wx_mesh_import(ensure_write_file(dir, "winding_in.obj", obj), &m, &err) == WX_OK);
+    ENSURE(m.parts_turned == 0);
+    cube_orientation(&m, -0.5, 1.5, &volume, &least);
+    ENSURE_NEAR(volume, 1.0, 1e-9);
+    ENSURE(least > 0.49);
+    wx_mesh_data_free(&m);
+
+    // Two faces glued back to back (a closed "part" of no volume) stay.
+    ENSURE(wx_mesh_import(ensure_write_file(dir, "flat.obj",
+                                            "v 0 0 0\nv 1 0 0\nv 1 0 1\nv 0 0 1\n"
+                                            "f 1 2 3 4\nf 4 3 2 1\n"),
+                          &m, &err) == WX_OK);
+    ENSURE(m.parts_turned == 0);
+    wx_mesh_data_free(&m);
+}
+
 int main(void)
 {
     RUN(smooth_surface_of_a_coarse_sphere_is_rounder);
@@ -1077,5 +1209,6 @@ int main(void)
     RUN(faces_on_few_positions_import_in_linear_time);
     RUN(a_huge_polygon_is_refused_at_once);
     RUN(a_fan_of_many_faces_smooths_in_bounded_time);
+    RUN(closed_parts_wound_inwards_are_turned_outwards);
     return ensure_summary();
 }

@@ -1252,12 +1252,19 @@ wx_result wx_mesh_import_uvs(const char *path, unsigned uv_channels, wx_mesh_dat
     if (r == WX_OK && (r = file_unit_m(scene, path, &st.unit_m, err)) == WX_OK) {
         r = build_arrays(&st, path, err);
     }
-    free(st.material_slot);
+    // Assimp's scene is released first: the orientation's work arrays come
+    // after it (pipeline/memory.c counts the larger of the two).
     for (unsigned m = 0; st.prep != NULL && m < scene->mNumMeshes; ++m) {
         prep_free(&st.prep[m]);
     }
     free(st.prep);
+    st.prep = NULL;
     aiReleaseImport(scene);
+    scene = NULL;
+    if (r == WX_OK) {
+        r = wx_mesh_orient_outwards(out, &out->parts_turned, err);
+    }
+    free(st.material_slot);
     io_free(&io);
     if (r != WX_OK) {
         wx_mesh_data_free(out);

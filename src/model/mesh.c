@@ -310,3 +310,251 @@ wx_result wx_mesh_smooth_subdivide(wx_mesh_data *mesh, int level, wx_error *err)
     mesh->triangle_count = (int64_t)t_out;
     return WX_OK;
 }
+
+// --- parts wound inwards ---------------------------------------------------------
+
+typedef struct position_key {
+    uint32_t bits[3]; // the coordinates' bits, -0 as +0
+    uint32_t vertex;
+} position_key;
+
+typedef struct edge_key {
+    uint64_t ends;    // the smaller position id in the high half
+    uint32_t forward; // 1 when the triangle runs from the smaller id to the larger
+    uint32_t part;
+} edge_key;
+
+static uint32_t coordinate_bits(float f)
+{
+    f = f == 0.0f ? 0.0f : f;
+    uint32_t u;
+    memcpy(&u, &f, sizeof u);
+    return u;
+}
+
+static int compare_positions(const void *a, const void *b)
+{
+    const position_key *x = a, *y = b;
+    for (int k = 0; k < 3; ++k) {
+        if (x->bits[k] != y->bits[k]) {
+            return x->bits[k] < y->bits[k] ? -1 : 1;
+        }
+    }
+    return x->vertex < y->vertex ? -1 : x->vertex > y->vertex;
+}
+
+static int compare_edges(const void *a, const void *b)
+{
+    const edge_key *x = a, *y = b;
+    if (x->ends != y->ends) {
+        return x->ends < y->ends ? -1 : 1;
+    }
+    return x->forward < y->forward ? -1 : x->forward > y->forward;
+}
+
+static uint32_t find_root(uint32_t *parent, uint32_t i)
+{
+    while (parent[i] != i) {
+        parent[i] = parent[parent[i]];
+        i = parent[i];
+    }
+    return i;
+}
+
+typedef struct part_sums {
+    double volume;  // six times the signed volume of the triangles' winding
+    double flux;    // sum of area x (centroid . mean corner normal)
+    double lo[3], hi[3];
+    bool open;
+} part_sums;
+
+wx_result wx_mesh_orient_outwards(wx_mesh_data *mesh, int64_t *turned, wx_error *err)
+{
+    if (turned != NULL) {
+        *turned = 0;
+    }
+    const int64_t V = mesh->vertex_count, T = mesh->triangle_count;
+    if (V <= 0 || T <= 0 || mesh->positions == NULL || mesh->indices == NULL ||
+        V > (int64_t)UINT32_MAX || T > INT64_MAX / 48) {
+        return WX_OK;
+    }
+    // Position ids: vertices at the same position share one.
+    position_key *keys = malloc((size_t)V * sizeof *keys);
+    uint32_t *pid = malloc((size_t)V * sizeof *pid);
+    if (keys == NULL || pid == NULL) {
+        free(keys);
+        free(pid);
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (mesh orientation)");
+    }
+    for (int64_t v = 0; v < V; ++v) {
+        for (int k = 0; k < 3; ++k) {
+            keys[v].bits[k] = coordinate_bits(mesh->positions[3 * v + k]);
+        }
+        keys[v].vertex = (uint32_t)v;
+    }
+    qsort(keys, (size_t)V, sizeof *keys, compare_positions);
+    uint32_t P = 0;
+    for (int64_t i = 0; i < V; ++i) {
+        if (i > 0 && memcmp(keys[i].bits, keys[i - 1].bits, sizeof keys[i].bits) != 0) {
+            ++P;
+        }
+        pid[keys[i].vertex] = P;
+    }
+    ++P;
+    free(keys);
+
+    // Parts: positions joined by the triangles' edges.
+    uint32_t *parent = malloc((size_t)P * sizeof *parent);
+    edge_key *edges = malloc((size_t)T * 3 * sizeof *edges);
+    uint32_t *part_of = malloc((size_t)P * sizeof *part_of);
+    part_sums *parts = NULL;
+    wx_result r = WX_OK;
+    if (parent == NULL || edges == NULL || part_of == NULL) {
+        r = wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (mesh orientation)");
+        goto done;
+    }
+    for (uint32_t p = 0; p < P; ++p) {
+        parent[p] = p;
+    }
+    const uint32_t *idx = mesh->indices;
+    for (int64_t t = 0; t < T; ++t) {
+        uint32_t a = find_root(parent, pid[idx[3 * t]]);
+        for (int k = 1; k < 3; ++k) {
+            uint32_t b = find_root(parent, pid[idx[3 * t + k]]);
+            if (a != b) {
+                parent[b] = a;
+            }
+        }
+    }
+    uint32_t part_count = 0;
+    for (uint32_t p = 0; p < P; ++p) {
+        part_of[p] = UINT32_MAX;
+    }
+    for (uint32_t p = 0; p < P; ++p) {
+        uint32_t root = find_root(parent, p);
+        if (part_of[root] == UINT32_MAX) {
+            part_of[root] = part_count++;
+        }
+        part_of[p] = part_of[root];
+    }
+    parts = calloc(part_count, sizeof *parts);
+    if (parts == NULL) {
+        r = wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (mesh orientation)");
+        goto done;
+    }
+    for (uint32_t q = 0; q < part_count; ++q) {
+        for (int k = 0; k < 3; ++k) {
+            parts[q].lo[k] = INFINITY;
+            parts[q].hi[k] = -INFINITY;
+        }
+    }
+
+    // Closed: every edge shared by exactly two triangles running opposite ways.
+    for (int64_t t = 0; t < T; ++t) {
+        for (int k = 0; k < 3; ++k) {
+            uint32_t a = pid[idx[3 * t + k]], b = pid[idx[3 * t + (k + 1) % 3]];
+            edge_key *e = &edges[3 * t + k];
+            e->ends = a < b ? ((uint64_t)a << 32) | b : ((uint64_t)b << 32) | a;
+            e->forward = a < b;
+            e->part = part_of[a];
+            if (a == b) {
+                parts[e->part].open = true; // a corner repeated: no inside to speak of
+            }
+        }
+    }
+    qsort(edges, (size_t)T * 3, sizeof *edges, compare_edges);
+    for (int64_t i = 0; i < 3 * T;) {
+        int64_t j = i + 1;
+        while (j < 3 * T && edges[j].ends == edges[i].ends) {
+            ++j;
+        }
+        if (j - i != 2 || edges[i].forward == edges[i + 1].forward) {
+            parts[edges[i].part].open = true;
+        }
+        i = j;
+    }
+
+    // The sums per part.
+    for (int64_t t = 0; t < T; ++t) {
+        part_sums *s = &parts[part_of[pid[idx[3 * t]]]];
+        double p[3][3], n[3] = { 0.0, 0.0, 0.0 };
+        for (int c = 0; c < 3; ++c) {
+            uint32_t v = idx[3 * t + c];
+            for (int k = 0; k < 3; ++k) {
+                p[c][k] = mesh->positions[3 * (size_t)v + k];
+                n[k] += mesh->normals != NULL ? mesh->normals[3 * (size_t)v + k] : 0.0;
+                s->lo[k] = fmin(s->lo[k], p[c][k]);
+                s->hi[k] = fmax(s->hi[k], p[c][k]);
+            }
+        }
+        double e1[3], e2[3], cr[3];
+        for (int k = 0; k < 3; ++k) {
+            e1[k] = p[1][k] - p[0][k];
+            e2[k] = p[2][k] - p[0][k];
+        }
+        cr[0] = e1[1] * e2[2] - e1[2] * e2[1];
+        cr[1] = e1[2] * e2[0] - e1[0] * e2[2];
+        cr[2] = e1[0] * e2[1] - e1[1] * e2[0];
+        double area2 = sqrt(cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2]);
+        double nl = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        double centroid_n = 0.0, centroid_cr = 0.0;
+        for (int k = 0; k < 3; ++k) {
+            double c = (p[0][k] + p[1][k] + p[2][k]) / 3.0;
+            centroid_n += c * n[k];
+            centroid_cr += c * cr[k];
+        }
+        s->volume += centroid_cr; // 3 x (centroid . cross) / 3 = p0 . (p1 x p2) summed
+        // Without usable corner normals the renderer uses the triangle's plane.
+        s->flux += nl > 1e-12 ? area2 * centroid_n / nl : centroid_cr;
+    }
+
+    // Turn what points in.
+    bool *flip_normals = NULL, *flip_winding = NULL;
+    flip_normals = calloc(part_count, sizeof *flip_normals);
+    flip_winding = calloc(part_count, sizeof *flip_winding);
+    if (flip_normals == NULL || flip_winding == NULL) {
+        free(flip_normals);
+        free(flip_winding);
+        r = wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (mesh orientation)");
+        goto done;
+    }
+    bool any = false;
+    for (uint32_t q = 0; q < part_count; ++q) {
+        const part_sums *s = &parts[q];
+        double box = (s->hi[0] - s->lo[0]) * (s->hi[1] - s->lo[1]) * (s->hi[2] - s->lo[2]);
+        if (s->open || !(fabs(s->volume) > 6e-6 * box)) {
+            continue;
+        }
+        flip_normals[q] = s->flux < 0.0 && mesh->normals != NULL;
+        flip_winding[q] = s->volume < 0.0;
+        any |= flip_normals[q] || flip_winding[q];
+        if (turned != NULL) {
+            *turned += flip_normals[q];
+        }
+    }
+    if (any) {
+        for (int64_t v = 0; v < V; ++v) {
+            if (flip_normals[part_of[pid[v]]]) {
+                for (int k = 0; k < 3; ++k) {
+                    mesh->normals[3 * v + k] = -mesh->normals[3 * v + k];
+                }
+            }
+        }
+        for (int64_t t = 0; t < T; ++t) {
+            if (flip_winding[part_of[pid[idx[3 * t]]]]) {
+                uint32_t swap = mesh->indices[3 * t + 1];
+                mesh->indices[3 * t + 1] = mesh->indices[3 * t + 2];
+                mesh->indices[3 * t + 2] = swap;
+            }
+        }
+    }
+    free(flip_normals);
+    free(flip_winding);
+done:
+    free(parts);
+    free(part_of);
+    free(edges);
+    free(parent);
+    free(pid);
+    return r;
+}

@@ -35,6 +35,9 @@ typedef struct wx_mesh_data {
     bool *material_colored; ///< per material: all its vertices carry a colour
     double bounds_min[3];  ///< world-space bounds of the vertices
     double bounds_max[3];
+    /// Closed parts whose normals pointed into them, turned outwards by the
+    /// import (wx_mesh_orient_outwards).
+    int64_t parts_turned;
 } wx_mesh_data;
 
 /// Frees the vertex and triangle arrays only (once uploaded), keeping counts,
@@ -92,5 +95,21 @@ int64_t wx_mesh_curved_triangles(const wx_mesh_data *mesh);
 /// on both sides (no cracks). UVs are not carried (the bake does not read
 /// them). level <= 1 changes nothing.
 wx_result wx_mesh_smooth_subdivide(wx_mesh_data *mesh, int level, wx_error *err);
+
+/// Turns outwards every closed part of the mesh whose normals point into it,
+/// as a mesh exported with its normals flipped has them: the bake, the
+/// TextureMap's `seen` and the masks read the vertex normals as the outside,
+/// so such a part would be seen only from behind (docs/cameras.md, "Meshes
+/// wound inwards"). A part is a set of triangles joined through vertices at
+/// the same position; it is closed when each of its edges is shared by exactly
+/// two of its triangles, running opposite ways. Its normals point in when the
+/// flux of the position through the surface along the normals (area times
+/// centroid . mean corner normal, summed) is negative: its vertices' normals
+/// are negated. Its winding, where the signed volume of its triangles is
+/// negative, is turned too (two corners swapped). Open parts, sheets and parts
+/// whose volume is under a millionth of their bounding box's stay as they are.
+/// *turned (may be NULL) receives how many parts had their normals turned.
+/// WX_FAIL when out of memory (the mesh unchanged).
+wx_result wx_mesh_orient_outwards(wx_mesh_data *mesh, int64_t *turned, wx_error *err);
 
 #endif

@@ -208,6 +208,13 @@ wx_result wx_geometry_load(const wx_scene *scene, bool quiet, wx_geometry *out, 
             wx_warn(quiet, "%s:%d: mesh '%s' has no triangles", scene->path, mesh->line,
                     wx_mesh_display_name(scene, mesh));
         }
+        if (g->data.parts_turned > 0) {
+            wx_note(quiet,
+                    "%s:%d: mesh '%s': %lld closed part%s with normals pointing inwards "
+                    "(flipped on export?) turned outwards, as renderers show it",
+                    scene->path, mesh->line, wx_mesh_display_name(scene, mesh),
+                    (long long)g->data.parts_turned, g->data.parts_turned == 1 ? "" : "s");
+        }
         int materials = g->data.material_count;
         g->surface = calloc(materials > 0 ? (size_t)materials : 1, sizeof *g->surface);
         if (g->surface == NULL) {
