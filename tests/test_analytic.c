@@ -573,8 +573,8 @@ TEST(lumpy_sphere_turned_in_the_camera_grid_keeps_its_exact_rain)
 // Issue 26, item 6: the same sphere with every face wound the other way (the
 // OBJ has no normals, so the generated ones point in, as an export with its
 // normals flipped gives them). Before the import turned it outwards, its
-// texture was seen on 1.2% of the texels the outward sphere's was; now the
-// same texels are seen and the same drops give the same rain.
+// texture was seen on about 1% of the texels the outward sphere's was; now
+// the same texels are seen and the same drops give the same rain.
 TEST(lumpy_sphere_wound_inwards_weathers_as_wound_outwards)
 {
     const char *dir = ensure_tmpdir();
