@@ -25,6 +25,12 @@
 //     what it does not clear). Embree: rtcIntersect1 with tfar = segment length.
 //     Medians of 3 runs; BVH build time and memory; the maps' memory does not
 //     depend on the mesh.
+// (c) Where rain lands (issue 26, item 5): the shipped house's box emitter
+//     without wind or turbulence, every drop absorbed at its first hit; the
+//     collider's and Embree's first hits on the same segments counted per face
+//     (material and outward axis; the collider's point put on the nearest
+//     triangle), and how many of the collider's hits are recorded with a normal
+//     more than 45 degrees off the face they lie on.
 //
 // Figures go to $WX_BENCH_CSV (bench_report.h); exit status 1 only on errors.
 #include <embree3/rtcore.h>
@@ -43,6 +49,7 @@
 #include "sim/force_field.h"
 #include "model/maps.h"
 #include "model/mesh.h"
+#include "sim/emitter.h"
 #include "sim/particles.h"
 #include "pipeline/pipeline.h"
 #include "model/scene.h"
@@ -830,6 +837,217 @@ static bool accuracy_scene(const char *name, const char *scene_path, const char 
     return ok;
 }
 
+// --- (c) where the rain lands, per surface --------------------------------------
+
+// The outward facing of a triangle's plane (its vertex normals' side), as one of
+// +x -x +y -y +z -z: the axis of its largest component.
+static int facing_of(const float n[3])
+{
+    int axis = 0;
+    for (int k = 1; k < 3; ++k) {
+        axis = fabsf(n[k]) > fabsf(n[axis]) ? k : axis;
+    }
+    return 2 * axis + (n[axis] < 0.0f);
+}
+
+static void triangle_normal(const wx_mesh_data *m, uint32_t t, float n[3])
+{
+    const uint32_t *v = &m->indices[3 * t];
+    float e1[3], e2[3], mean[3] = { 0, 0, 0 };
+    for (int k = 0; k < 3; ++k) {
+        e1[k] = m->positions[3 * v[1] + k] - m->positions[3 * v[0] + k];
+        e2[k] = m->positions[3 * v[2] + k] - m->positions[3 * v[0] + k];
+        for (int c = 0; c < 3; ++c) {
+            mean[k] += m->normals[3 * v[c] + k];
+        }
+    }
+    n[0] = e1[1] * e2[2] - e1[2] * e2[1];
+    n[1] = e1[2] * e2[0] - e1[0] * e2[2];
+    n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+    if (n[0] * mean[0] + n[1] * mean[1] + n[2] * mean[2] < 0.0f) {
+        for (int k = 0; k < 3; ++k) {
+            n[k] = -n[k];
+        }
+    }
+}
+
+// The triangle nearest a point the collider gives (its primID) and its
+// distance: short rays along the six axes from the point (each starting 2
+// texels back); -1 when none lies within 4 texels.
+static int64_t triangle_at(const exact *e, const float point[3], float texel, float *distance)
+{
+    int64_t best = -1;
+    *distance = INFINITY;
+    for (int dir = 0; dir < 6; ++dir) {
+        float d[3] = { 0, 0, 0 };
+        d[dir / 2] = dir % 2 == 0 ? 1.0f : -1.0f;
+        struct RTCIntersectContext ctx;
+        rtcInitIntersectContext(&ctx);
+        struct RTCRayHit rh;
+        memset(&rh, 0, sizeof rh);
+        rh.ray.org_x = point[0] - 2.0f * texel * d[0];
+        rh.ray.org_y = point[1] - 2.0f * texel * d[1];
+        rh.ray.org_z = point[2] - 2.0f * texel * d[2];
+        rh.ray.dir_x = d[0];
+        rh.ray.dir_y = d[1];
+        rh.ray.dir_z = d[2];
+        rh.ray.tfar = 6.0f * texel;
+        rh.ray.mask = 0xFFFFFFFFu;
+        rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+        rtcIntersect1(e->scene, &ctx, &rh);
+        if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID &&
+            fabsf(rh.ray.tfar - 2.0f * texel) < *distance) {
+            *distance = fabsf(rh.ray.tfar - 2.0f * texel);
+            best = (int64_t)rh.hit.primID;
+        }
+    }
+    return best;
+}
+
+// docs/performance.md, "(c) Where the rain lands": the shipped house's rain
+// (its box emitter as it is, without the wind and the turbulence), every drop
+// absorbed where it first lands; the collider's and Embree's first hits on the
+// same step segments, counted per surface (material and facing).
+static bool rain_per_surface(const char *out, int n)
+{
+    maps_world w;
+    exact e;
+    memset(&e, 0, sizeof e);
+    wx_mesh_data m;
+    memset(&m, 0, sizeof m);
+    wx_error err;
+    bool ok = maps_world_load(&w, "xml_scenes/building.xml", out) && exact_init(&e);
+    if (ok && (wx_mesh_import(w.scene.meshes[0].path, &m, &err) != WX_OK)) {
+        fprintf(stderr, "bench_embree: %s\n", err.message);
+        ok = false;
+    }
+    ok = ok && exact_add(&e, m.positions, m.origin, m.vertex_count, m.indices, m.triangle_count);
+    if (!ok || w.scene.emitter_count < 1 || m.material_count > 64) {
+        exact_free(&e);
+        maps_world_free(&w);
+        wx_mesh_data_free(&m);
+        return false;
+    }
+    exact_commit(&e);
+    enum { FACINGS = 6 };
+    int64_t counts[64][FACINGS][2];
+    memset(counts, 0, sizeof counts);
+    int64_t unattributed = 0, exact_total = 0, maps_total = 0, misrecorded = 0;
+    const wx_emitter *em = &w.scene.emitters[0];
+    float dt = (float)w.scene.time_step, texel = w.texel_ws;
+    for (int i = 0; i < n; ++i) {
+        float p[3], v[3], q[3];
+        wx_emitter_sample(em, w.scene.seed, wx_particle_id(0, (uint64_t)i), p, v);
+        int64_t found[2] = { -1, -1 };
+        bool done[2] = { false, false };
+        for (int step = 0; step < w.scene.steps && !(done[0] && done[1]); ++step) {
+            for (int k = 0; k < 3; ++k) {
+                v[k] += dt * w.forces.gravity[k]; // mass 1; no wind, no turbulence
+                q[k] = p[k] + dt * v[k];
+            }
+            wx_hit hit;
+            float s;
+            if (!done[0] && maps_hit(&w, p, q, &hit)) {
+                done[0] = true;
+                float distance;
+                found[0] = triangle_at(&e, hit.point, texel, &distance);
+                maps_total++;
+                unattributed += found[0] < 0;
+                if (found[0] >= 0) {
+                    // The normal the simulation reacts with and the texel it
+                    // deposits into against the face the point lies on.
+                    float tn[3];
+                    triangle_normal(&m, (uint32_t)found[0], tn);
+                    float tl = sqrtf(tn[0] * tn[0] + tn[1] * tn[1] + tn[2] * tn[2]);
+                    float agree = (tn[0] * hit.normal[0] + tn[1] * hit.normal[1] +
+                                   tn[2] * hit.normal[2]) / tl;
+                    if (agree < 0.7f) {
+                        misrecorded++;
+                        if (getenv("WX_BENCH_EMBREE_DEBUG") != NULL) {
+                            fprintf(stderr, "recorded on another face: camera %d point (%g %g %g) "
+                                    "normal (%g %g %g), the face's (%g %g %g)\n", hit.camera,
+                                    hit.point[0], hit.point[1], hit.point[2], hit.normal[0],
+                                    hit.normal[1], hit.normal[2], tn[0] / tl, tn[1] / tl, tn[2] / tl);
+                        }
+                    }
+                }
+            }
+            if (!done[1] && exact_hit(&e, p, q, &s)) {
+                done[1] = true;
+                struct RTCIntersectContext ctx;
+                rtcInitIntersectContext(&ctx);
+                // exact_hit keeps no primID: ask again for it.
+                float d[3] = { q[0] - p[0], q[1] - p[1], q[2] - p[2] };
+                float len = sqrtf(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+                struct RTCRayHit rh;
+                memset(&rh, 0, sizeof rh);
+                rh.ray.org_x = p[0];
+                rh.ray.org_y = p[1];
+                rh.ray.org_z = p[2];
+                rh.ray.dir_x = d[0] / len;
+                rh.ray.dir_y = d[1] / len;
+                rh.ray.dir_z = d[2] / len;
+                rh.ray.tfar = len;
+                rh.ray.mask = 0xFFFFFFFFu;
+                rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+                rtcIntersect1(e.scene, &ctx, &rh);
+                found[1] = rh.hit.geomID == RTC_INVALID_GEOMETRY_ID ? -1 : (int64_t)rh.hit.primID;
+                exact_total++;
+            }
+            bool in_box = true;
+            for (int k = 0; k < 3; ++k) {
+                in_box = in_box && fabsf(q[k] - w.scene.bbox_center[k]) <= 0.5f * w.scene.bbox_size;
+            }
+            if (!in_box) {
+                break;
+            }
+            memcpy(p, q, sizeof p);
+        }
+        for (int side = 0; side < 2; ++side) {
+            if (found[side] >= 0) {
+                float tn[3];
+                triangle_normal(&m, (uint32_t)found[side], tn);
+                counts[m.materials[found[side]]][facing_of(tn)][side]++;
+            }
+        }
+    }
+    static const char *const facing_names[FACINGS] = { "+x", "-x", "+y", "-y", "+z", "-z" };
+    printf("%-10s %-6s %9s %9s %8s %8s\n", "material", "facing", "Embree", "ours", "ratio",
+           "3 sigma");
+    double worst = 0.0;
+    int surfaces = 0;
+    for (int mat = 0; mat < m.material_count; ++mat) {
+        for (int f = 0; f < FACINGS; ++f) {
+            int64_t ex = counts[mat][f][1], ours = counts[mat][f][0];
+            if (ex == 0 && ours == 0) {
+                continue;
+            }
+            double ratio = ex > 0 ? (double)ours / (double)ex : INFINITY;
+            printf("%-10s %-6s %9lld %9lld %8.3f %8.3f\n", m.material_names[mat],
+                   facing_names[f], (long long)ex, (long long)ours, ratio,
+                   ex > 0 ? 3.0 / sqrt((double)ex) : 0.0);
+            if (ex >= 100) {
+                worst = fmax(worst, fabs(ratio - 1.0));
+                surfaces++;
+            }
+        }
+    }
+    printf("drops %d: Embree hit %lld, the collider %lld (%lld of its hits on no triangle "
+           "within 4 texels; %lld recorded with a normal more than 45 degrees off the face's)\n",
+           n, (long long)exact_total, (long long)maps_total, (long long)unattributed,
+           (long long)misrecorded);
+    bench_row("embree", "rain recorded on another face", 100.0 * (double)misrecorded /
+              (double)(maps_total > 0 ? maps_total : 1), "% of hits", NULL, false,
+              "building.xml rain without wind; %d drops", n);
+    bench_row("embree", "rain per surface: worst |ours/Embree - 1|", 100.0 * worst, "%",
+              "<= 5", worst <= 0.05, "building.xml rain without wind; %d drops; %d surfaces "
+              "with 100 exact hits or more", n, surfaces);
+    exact_free(&e);
+    maps_world_free(&w);
+    wx_mesh_data_free(&m);
+    return true;
+}
+
 int main(void)
 {
     const char *build = getenv("WX_BUILD") != NULL ? getenv("WX_BUILD") : "build";
@@ -855,6 +1073,15 @@ int main(void)
     }
     snprintf(out, sizeof out, "%s/thesis_box", dir);
     if (!accuracy_scene("thesis_box", "xml_scenes/thesis_box.xml", out, (int)n)) {
+        return 1;
+    }
+
+    long drops = bench_env_long("WX_BENCH_RAIN_DROPS", 10000);
+    printf("embree (c): where the shipped house's rain lands (no wind, no turbulence, every "
+           "drop absorbed at its first hit), %ld drops\n",
+           drops);
+    snprintf(out, sizeof out, "%s/rain", dir);
+    if (!rain_per_surface(out, (int)drops)) {
         return 1;
     }
 
