@@ -1172,6 +1172,14 @@ TEST(closed_parts_wound_inwards_are_turned_outwards)
     ENSURE(least > 0.49);
     wx_mesh_data_free(&m);
 
+    // A zero-area triangle (two corners at one position, as at a UV sphere's
+    // pole) does not open the part.
+    n = cube_obj(obj, sizeof obj, 0.0, true, '-', 6, 1, 1);
+    snprintf(obj + n, sizeof obj - n, "f 1 2 1\n");
+    ENSURE(wx_mesh_import(ensure_write_file(dir, "degenerate.obj", obj), &m, &err) == WX_OK);
+    ENSURE(m.parts_turned == 1);
+    wx_mesh_data_free(&m);
+
     // Two faces glued back to back (a closed "part" of no volume) stay.
     ENSURE(wx_mesh_import(ensure_write_file(dir, "flat.obj",
                                             "v 0 0 0\nv 1 0 0\nv 1 0 1\nv 0 0 1\n"

@@ -450,22 +450,25 @@ wx_result wx_mesh_orient_outwards(wx_mesh_data *mesh, int64_t *turned, wx_error 
     }
 
     // Closed: every edge shared by exactly two triangles running opposite ways.
+    // A triangle with two corners at one position bounds nothing: left out.
+    int64_t E = 0;
     for (int64_t t = 0; t < T; ++t) {
+        uint32_t c0 = pid[idx[3 * t]], c1 = pid[idx[3 * t + 1]], c2 = pid[idx[3 * t + 2]];
+        if (c0 == c1 || c1 == c2 || c2 == c0) {
+            continue;
+        }
         for (int k = 0; k < 3; ++k) {
             uint32_t a = pid[idx[3 * t + k]], b = pid[idx[3 * t + (k + 1) % 3]];
-            edge_key *e = &edges[3 * t + k];
+            edge_key *e = &edges[E++];
             e->ends = a < b ? ((uint64_t)a << 32) | b : ((uint64_t)b << 32) | a;
             e->forward = a < b;
             e->part = part_of[a];
-            if (a == b) {
-                parts[e->part].open = true; // a corner repeated: no inside to speak of
-            }
         }
     }
-    qsort(edges, (size_t)T * 3, sizeof *edges, compare_edges);
-    for (int64_t i = 0; i < 3 * T;) {
+    qsort(edges, (size_t)E, sizeof *edges, compare_edges);
+    for (int64_t i = 0; i < E;) {
         int64_t j = i + 1;
-        while (j < 3 * T && edges[j].ends == edges[i].ends) {
+        while (j < E && edges[j].ends == edges[i].ends) {
             ++j;
         }
         if (j - i != 2 || edges[i].forward == edges[i + 1].forward) {

@@ -102,7 +102,8 @@ wx_result wx_mesh_smooth_subdivide(wx_mesh_data *mesh, int level, wx_error *err)
 /// so such a part would be seen only from behind (docs/cameras.md, "Meshes
 /// wound inwards"). A part is a set of triangles joined through vertices at
 /// the same position; it is closed when each of its edges is shared by exactly
-/// two of its triangles, running opposite ways. Its normals point in when the
+/// two of its triangles, running opposite ways (a triangle with two corners at
+/// one position bounds nothing and is left out). Its normals point in when the
 /// flux of the position through the surface along the normals (area times
 /// centroid . mean corner normal, summed) is negative: its vertices' normals
 /// are negated. Its winding, where the signed volume of its triangles is
