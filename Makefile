@@ -17,7 +17,7 @@ SCENE ?= xml_scenes/building.xml
 
 # Debian packages the build, the tests and the viewer need.
 DEB_PACKAGES := gcc make pkg-config libopenexr-dev libxml2-dev libxml2-utils \
-    libosmesa6-dev libglfw3-dev libgl-dev libassimp-dev libcglm-dev libpng-dev xvfb xauth
+    libosmesa6-dev libglfw3-dev libgl-dev libassimp-dev libcglm-dev libpng-dev xvfb xauth python3
 
 CFLAGS ?= -O2 -g
 WARN := -std=c11 -Wall -Wextra -pedantic -Wshadow -Wstrict-prototypes

@@ -16,6 +16,8 @@
 int ensure_failed_checks;
 static int passed;
 static int failed;
+static int skipped;
+static bool skipping; // the running test called SKIP
 static char tmpdir[4096];
 
 void ensure_report(const char *file, int line, const char *what)
@@ -78,8 +80,12 @@ bool ensure_read_expectation(const char *path, ensure_expectation *out)
 void ensure_run(const char *name, void (*fn)(void))
 {
     ensure_failed_checks = 0;
+    skipping = false;
     fn();
-    if (ensure_failed_checks == 0) {
+    if (ensure_failed_checks == 0 && skipping) {
+        skipped++;
+        printf("  skip  %s\n", name);
+    } else if (ensure_failed_checks == 0) {
         passed++;
         printf("  ok    %s\n", name);
     } else {
@@ -102,8 +108,14 @@ static void remove_tmpdir(void)
 
 int ensure_summary(void)
 {
-    printf("%d passed, %d failed\n", passed, failed);
+    printf("%d passed, %d failed, %d skipped\n", passed, failed, skipped);
     return failed == 0 ? 0 : 1;
+}
+
+void ensure_skip(const char *reason)
+{
+    skipping = true;
+    printf("        skipped: %s\n", reason);
 }
 
 const char *ensure_build_dir(void)

@@ -3,9 +3,12 @@
 //   TEST(exr_round_trip) { ... ENSURE(x == 1); ENSURE_NEAR(d, 2.0, 1e-6); }
 //   int main(void) { RUN(exr_round_trip); return ensure_summary(); }
 //
-// A failed ENSURE prints file:line and the condition and ends that test; the
-// summary prints "N passed, M failed" and returns the exit status. tests/run.sh
-// runs every test program and adds up their counts.
+// A failed ENSURE prints file:line and the condition and ends that test;
+// SKIP("reason") ends it as skipped, for a test that cannot run here (under a
+// sanitizer, say), never for one whose subject is missing (that is a
+// failure). The summary prints "N passed, M failed, K skipped" and returns the
+// exit status (skips do not fail it). tests/run.sh runs every test program and
+// adds up their counts.
 #ifndef WX_ENSURE_H
 #define WX_ENSURE_H
 
@@ -23,6 +26,7 @@ void ensure_report_near(const char *file, int line, const char *what, double a, 
                         double tol);
 void ensure_run(const char *name, void (*fn)(void));
 int ensure_summary(void);
+void ensure_skip(const char *reason);
 
 #define TEST(name) static void name(void)
 #define RUN(name) ensure_run(#name, name)
@@ -33,6 +37,13 @@ int ensure_summary(void);
             ensure_report(__FILE__, __LINE__, #cond);                                        \
             return;                                                                          \
         }                                                                                    \
+    } while (0)
+
+/// Ends the running test as skipped, saying why.
+#define SKIP(reason)                                                                         \
+    do {                                                                                     \
+        ensure_skip(reason);                                                                 \
+        return;                                                                              \
     } while (0)
 
 #define ENSURE_NEAR(a, b, tol)                                                               \

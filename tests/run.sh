@@ -1,11 +1,14 @@
 #!/usr/bin/env bash
 # Runs every test program in $1 (default build/tests) and adds up their counts.
-# The last line is "N passed, M failed"; the exit status is non-zero on failure.
-# A program that crashes or prints no summary counts as one failed test.
+# The last line is "N passed, M failed, K skipped" (a skip is a test that cannot
+# run here, as under a sanitizer; it does not fail the run); the exit status is
+# non-zero on failure. A program that crashes or prints no summary counts as
+# one failed test.
 set -u
 dir=${1:-build/tests}
 total_pass=0
 total_fail=0
+total_skip=0
 export GALLIUM_DRIVER=llvmpipe
 for prog in "$dir"/test_*; do
     [ -x "$prog" ] || continue
@@ -14,7 +17,7 @@ for prog in "$dir"/test_*; do
     log=$(mktemp)
     "$prog" 2>&1 | tee "$log"
     status=${PIPESTATUS[0]}
-    summary=$(grep -E '^[0-9]+ passed, [0-9]+ failed$' "$log" | tail -n 1)
+    summary=$(grep -E '^[0-9]+ passed, [0-9]+ failed(, [0-9]+ skipped)?$' "$log" | tail -n 1)
     rm -f "$log"
     if [ -z "$summary" ]; then
         echo "   $name ended without a summary (exit status $status)"
@@ -24,12 +27,15 @@ for prog in "$dir"/test_*; do
     p=${summary%% passed*}
     f=${summary#*, }
     f=${f%% failed*}
+    k=0
+    case $summary in *skipped) k=${summary##*, }; k=${k%% skipped} ;; esac
     total_pass=$((total_pass + p))
     total_fail=$((total_fail + f))
+    total_skip=$((total_skip + k))
     if [ "$status" -ne 0 ] && [ "$f" -eq 0 ]; then
         echo "   $name exited with status $status"
         total_fail=$((total_fail + 1))
     fi
 done
-echo "$total_pass passed, $total_fail failed"
+echo "$total_pass passed, $total_fail failed, $total_skip skipped"
 [ "$total_fail" -eq 0 ]

@@ -997,14 +997,11 @@ TEST(warns_about_geometry_outside_the_frame_or_behind_the_eye)
     scene_end(&s);
 }
 
-TEST(cli_bake_when_wired)
+TEST(cli_bake_writes_the_maps_and_refuses_a_bad_mesh)
 {
     char out[8192];
     const char *build = ensure_build_dir();
-    if (ensure_shell(out, sizeof out, "'%s/weathering' bake --help", build) != 0) {
-        printf("        (skipped: %s/weathering bake is not wired yet)\n", build);
-        return;
-    }
+    ENSURE(ensure_shell(out, sizeof out, "'%s/weathering' bake --help", build) == 0);
     const char *path = write_scene("cli", "box.obj");
     char dir[4200];
     snprintf(dir, sizeof dir, "%s/cli_out", ensure_tmpdir());
@@ -1052,6 +1049,6 @@ int main(void)
     RUN(maps_beyond_the_renderer_are_refused);
     RUN(scene_file_bakes_maps_the_scene_reads_back);
     RUN(warns_about_geometry_outside_the_frame_or_behind_the_eye);
-    RUN(cli_bake_when_wired);
+    RUN(cli_bake_writes_the_maps_and_refuses_a_bad_mesh);
     return ensure_summary();
 }

@@ -587,13 +587,11 @@ TEST(generated_normals_of_huge_triangles_stay_zero)
 TEST(out_of_memory_inside_assimp_is_a_failure_not_bad_input)
 {
 #ifdef WX_ASAN
-    printf("        (skipped under AddressSanitizer, which aborts when its own mappings fail)\n");
-    return;
+    SKIP("AddressSanitizer aborts when its own mappings fail");
 #endif
     const char *preload = getenv("LD_PRELOAD");
     if (preload != NULL && strstr(preload, "valgrind") != NULL) {
-        printf("        (skipped under valgrind, which aborts when operator new fails)\n");
-        return;
+        SKIP("valgrind aborts when operator new fails");
     }
     // The bunny (69,451 triangles, 2.4 MB) needs about 30 MB of address space
     // to import (Assimp's reading most of it, since the import smooths and

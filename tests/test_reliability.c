@@ -694,8 +694,7 @@ TEST(no_output_is_written_non_finite)
 TEST(out_of_memory_in_the_bake_is_exit_1)
 {
 #if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-    fprintf(stderr, "        skipped: a sanitizer's shadow memory does not fit under ulimit -v\n");
-    return;
+    SKIP("a sanitizer's shadow memory does not fit under ulimit -v");
 #endif
     const char *dir = ensure_tmpdir();
     ENSURE(

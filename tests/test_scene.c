@@ -13,6 +13,8 @@
 #include "ensure.h"
 #include "io/exr.h"
 #include "model/scene.h"
+
+static bool have_xmllint_and_schema(void);
 #include "io/scene_xml.h"
 #include "model/camera.h"
 #include "model/image.h"
@@ -703,7 +705,8 @@ TEST(substances_loads_exchanges_rules)
     ENSURE(s.cameras[0].every == 0);
     wx_scene_free(&s);
     ENSURE(s.rules == NULL && s.rule_count == 0);
-    if (ensure_shell(NULL, 0, "command -v xmllint >/dev/null") == 0) {
+    ENSURE(have_xmllint_and_schema());
+    {
         char out[8192];
         int status = ensure_shell(
             out, sizeof out, "xmllint --noout --schema xml_scenes/weathering.xsd '%s'", path);
@@ -1155,7 +1158,8 @@ TEST(masks_every_kind)
     ENSURE(s.rule_count == 0);
     wx_scene_free(&s);
     ENSURE(s.mask_count == 0);
-    if (ensure_shell(NULL, 0, "command -v xmllint >/dev/null") == 0) {
+    ENSURE(have_xmllint_and_schema());
+    {
         ENSURE(validates_text("masks_schema.xml", text));
     }
 }
@@ -1191,7 +1195,8 @@ TEST(masks_without_substances)
     ENSURE(mask_equals(&s.masks[1], &grime));
     ENSURE(!wx_scene_has_ageing(&s));
     wx_scene_free(&s);
-    if (ensure_shell(NULL, 0, "command -v xmllint >/dev/null") == 0) {
+    ENSURE(have_xmllint_and_schema());
+    {
         ENSURE(validates_text("masks_dirt_schema.xml", text));
     }
 
@@ -1256,7 +1261,8 @@ TEST(masks_limits_accepted)
         ENSURE(all->terms[t].kind == WX_TERM_MASK && all->terms[t].index == t);
     }
     wx_scene_free(&s);
-    if (ensure_shell(NULL, 0, "command -v xmllint >/dev/null") == 0) {
+    ENSURE(have_xmllint_and_schema());
+    {
         ENSURE(validates_text("masks_limits_schema.xml", text));
     }
 }
@@ -1461,16 +1467,24 @@ TEST(shipped_scenes_load)
         count++;
     }
     closedir(dir);
-    if (count == 0) {
-        printf("        (no scene in xml_scenes: skipped)\n");
-    }
+    ENSURE(count > 0); // the shipped scenes are part of the project
     ENSURE(failures == 0);
 }
 
-static bool have_xmllint(void)
+// xmllint (Debian's libxml2-utils, which `make deps` installs) and the schema
+// it validates against: both must be there, or the schema tests fail.
+static bool have_xmllint_and_schema(void)
 {
     char out[256];
-    return ensure_shell(out, sizeof out, "command -v xmllint") == 0;
+    if (ensure_shell(out, sizeof out, "command -v xmllint") != 0) {
+        fprintf(stderr, "        xmllint is not installed (make deps installs libxml2-utils)\n");
+        return false;
+    }
+    if (access("xml_scenes/weathering.xsd", R_OK) != 0) {
+        fprintf(stderr, "        xml_scenes/weathering.xsd cannot be read\n");
+        return false;
+    }
+    return true;
 }
 
 static bool validates(const char *path)
@@ -1488,10 +1502,7 @@ static bool validates(const char *path)
 // validate against the schema.
 TEST(schema_accepts_good_scenes)
 {
-    if (!have_xmllint()) {
-        printf("        (xmllint not installed: skipped)\n");
-        return;
-    }
+    ENSURE(have_xmllint_and_schema());
     char out[4096];
     ENSURE(ensure_shell(out, sizeof out, "xmllint --noout xml_scenes/weathering.xsd") == 0);
     int failures = 0;
@@ -1521,10 +1532,7 @@ TEST(schema_accepts_good_scenes)
 // The schema also describes the ranges: some bad scenes fail validation too.
 TEST(schema_rejects_bad_values)
 {
-    if (!have_xmllint()) {
-        printf("        (xmllint not installed: skipped)\n");
-        return;
-    }
+    ENSURE(have_xmllint_and_schema());
     static const char *const invalid[] = {
         "unknown_element",    "unknown_attribute",      "not_a_number",
         "nan",                "inf",                    "negative_size",
@@ -1563,8 +1571,12 @@ TEST(schema_rejects_bad_values)
         int status =
             ensure_shell(out, sizeof out, "xmllint --noout --schema %s %s/bad/%s.xml",
                          "xml_scenes/weathering.xsd", ensure_tests_dir(), invalid[i]);
-        if (status == 0) {
-            fprintf(stderr, "tests/bad/%s.xml validates against the schema\n", invalid[i]);
+        // Rejected means xmllint read the schema and the file and found the
+        // file invalid (exit status 3, "fails to validate"), not that it
+        // could not read one of them.
+        if (status != 3 || strstr(out, "fails to validate") == NULL) {
+            fprintf(stderr, "tests/bad/%s.xml: %s\n", invalid[i],
+                    status == 0 ? "validates against the schema" : out);
             failures++;
         }
     }
