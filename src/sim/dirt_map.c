@@ -142,20 +142,6 @@ static void line_next(line_walk *w)
     }
 }
 
-int wx_bresenham(int x0, int y0, int x1, int y1, int *out, int max)
-{
-    line_walk w;
-    int n = 0;
-    for (line_begin(&w, x0, y0, x1, y1); !w.done; line_next(&w)) {
-        if (out != NULL && n < max) {
-            out[2 * n] = w.x;
-            out[2 * n + 1] = w.y;
-        }
-        n++;
-    }
-    return n;
-}
-
 static bool has_surface(const wx_dirt_map *map, size_t texel)
 {
     return map->depth == NULL || isfinite(map->depth[texel]);

@@ -75,9 +75,4 @@ void wx_dirt_map_exchange_line(wx_dirt_map *map, uint32_t from, uint32_t to, dou
 /// particles), and the rest of the particle's weight.
 void wx_dirt_map_deposit_all(wx_dirt_map *map, uint32_t texel, double *load, float *weight);
 
-/// Bresenham's line from (x0, y0) to (x1, y1), both ends included (thesis 3.5):
-/// writes up to `max` texels as x, y pairs into `out` (may be NULL) and returns
-/// how many the line has.
-int wx_bresenham(int x0, int y0, int x1, int y1, int *out, int max);
-
 #endif

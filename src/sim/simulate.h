@@ -108,7 +108,7 @@ const double *wx_sim_baseline(const wx_sim *sim, int input);
 int wx_sim_input_count(const wx_sim *sim);
 const wx_dirt_map *wx_sim_dirt_map(const wx_sim *sim, int input);
 
-/// Adds one particle by hand (tests, the viewer) carrying `load` of the first
+/// Adds one particle by hand (the tests and bench_simulate) carrying `load` of the first
 /// substance: it counts as emitted. Its random stream is that of a
 /// pseudo-emitter after the scene's emitters.
 wx_result wx_sim_spawn(wx_sim *sim, const float position[3], const float velocity[3],
