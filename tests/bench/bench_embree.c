@@ -138,8 +138,10 @@ static void exact_commit(exact *e)
     rtcCommitScene(e->scene);
 }
 
-// The first hit of the segment p0 -> p1: its parameter s in [0, 1].
-static bool exact_hit(const exact *e, const float p0[3], const float p1[3], float *s)
+// The first hit of the segment p0 -> p1: its parameter s in [0, 1] and, when
+// `triangle` is not NULL, the triangle's primID.
+static bool exact_hit_triangle(const exact *e, const float p0[3], const float p1[3], float *s,
+                               int64_t *triangle)
 {
     float d[3] = { p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2] };
     float len = sqrtf(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
@@ -165,7 +167,15 @@ static bool exact_hit(const exact *e, const float p0[3], const float p1[3], floa
         return false;
     }
     *s = rh.ray.tfar / len;
+    if (triangle != NULL) {
+        *triangle = (int64_t)rh.hit.primID;
+    }
     return true;
+}
+
+static bool exact_hit(const exact *e, const float p0[3], const float p1[3], float *s)
+{
+    return exact_hit_triangle(e, p0, p1, s, NULL);
 }
 
 // --- the depth-map side ------------------------------------------------------
@@ -972,26 +982,8 @@ static bool rain_per_surface(const char *out, int n)
                     }
                 }
             }
-            if (!done[1] && exact_hit(&e, p, q, &s)) {
+            if (!done[1] && exact_hit_triangle(&e, p, q, &s, &found[1])) {
                 done[1] = true;
-                struct RTCIntersectContext ctx;
-                rtcInitIntersectContext(&ctx);
-                // exact_hit keeps no primID: ask again for it.
-                float d[3] = { q[0] - p[0], q[1] - p[1], q[2] - p[2] };
-                float len = sqrtf(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-                struct RTCRayHit rh;
-                memset(&rh, 0, sizeof rh);
-                rh.ray.org_x = p[0];
-                rh.ray.org_y = p[1];
-                rh.ray.org_z = p[2];
-                rh.ray.dir_x = d[0] / len;
-                rh.ray.dir_y = d[1] / len;
-                rh.ray.dir_z = d[2] / len;
-                rh.ray.tfar = len;
-                rh.ray.mask = 0xFFFFFFFFu;
-                rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-                rtcIntersect1(e.scene, &ctx, &rh);
-                found[1] = rh.hit.geomID == RTC_INVALID_GEOMETRY_ID ? -1 : (int64_t)rh.hit.primID;
                 exact_total++;
             }
             bool in_box = true;
