@@ -1052,8 +1052,8 @@ TEST(a_fan_of_many_faces_smooths_in_bounded_time)
 // A unit cube at x offset `at` as OBJ text: faces wound outwards, or inwards;
 // normals none ('-'), outwards ('o') or inwards ('i'); `faces` of its six
 // (fewer leaves it open).
-static size_t cube_obj(char *obj, size_t size, double at, bool inward, char normals, int faces,
-                       int first_vertex, int first_normal)
+static size_t cube_obj_sized(char *obj, size_t size, double at, double side, bool inward,
+                             char normals, int faces, int first_vertex, int first_normal)
 {
     static const int quad[6][4] = { { 0, 2, 3, 1 }, { 4, 5, 7, 6 }, { 0, 1, 5, 4 },
                                     { 2, 6, 7, 3 }, { 0, 4, 6, 2 }, { 1, 3, 7, 5 } };
@@ -1061,8 +1061,9 @@ static size_t cube_obj(char *obj, size_t size, double at, bool inward, char norm
                                        { 0, 1, 0 },  { 0, 0, -1 }, { 0, 0, 1 } };
     size_t n = 0;
     for (int v = 0; v < 8; ++v) {
-        n += (size_t)snprintf(obj + n, size - n, "v %g %d %d\n", at + (v >> 2 & 1), v >> 1 & 1,
-                              v & 1);
+        double lo = 0.5 - 0.5 * side, hi = 0.5 + 0.5 * side;
+        n += (size_t)snprintf(obj + n, size - n, "v %g %g %g\n", at + (v >> 2 & 1 ? hi : lo),
+                              v >> 1 & 1 ? hi : lo, v & 1 ? hi : lo);
     }
     for (int f = 0; normals != '-' && f < 6; ++f) {
         double sign = normals == 'o' ? 1.0 : -1.0;
@@ -1083,6 +1084,12 @@ static size_t cube_obj(char *obj, size_t size, double at, bool inward, char norm
         }
     }
     return n;
+}
+
+static size_t cube_obj(char *obj, size_t size, double at, bool inward, char normals, int faces,
+                       int first_vertex, int first_normal)
+{
+    return cube_obj_sized(obj, size, at, 1.0, inward, normals, faces, first_vertex, first_normal);
 }
 
 // Over the triangles whose centroid's x lies in [x0, x1]: the signed volume
@@ -1176,6 +1183,25 @@ TEST(closed_parts_wound_inwards_are_turned_outwards)
     snprintf(obj + n, sizeof obj - n, "f 1 2 1\n");
     ENSURE(wx_mesh_import(ensure_write_file(dir, "degenerate.obj", obj), &m, &err) == WX_OK);
     ENSURE(m.parts_turned == 1);
+    wx_mesh_data_free(&m);
+
+    // A cavity: a closed part inside another, its normals pointing into it (a
+    // room seen from inside, a hollow ball's inner shell), stays as it is.
+    n = cube_obj(obj, sizeof obj, 0.0, false, '-', 6, 1, 1);
+    cube_obj_sized(obj + n, sizeof obj - n, 0.0, 0.5, true, '-', 6, 9, 1);
+    ENSURE(wx_mesh_import(ensure_write_file(dir, "cavity.obj", obj), &m, &err) == WX_OK);
+    ENSURE(m.parts_turned == 0);
+    int64_t inward_normals = 0;
+    for (int64_t v = 0; v < m.vertex_count; ++v) {
+        double p[3], d = 0.0;
+        world(&m, v, p);
+        bool inner = fabs(p[0] - 0.5) < 0.3 && fabs(p[1] - 0.5) < 0.3 && fabs(p[2] - 0.5) < 0.3;
+        for (int i = 0; i < 3; ++i) {
+            d += m.normals[3 * v + i] * (p[i] - 0.5);
+        }
+        inward_normals += inner && d < 0.0;
+    }
+    ENSURE(inward_normals == 24); // 4 vertices on each of its 6 faces, all pointing in
     wx_mesh_data_free(&m);
 
     // Two faces glued back to back (a closed "part" of no volume) stay.

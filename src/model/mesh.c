@@ -365,8 +365,60 @@ typedef struct part_sums {
     double volume;  // six times the signed volume of the triangles' winding
     double flux;    // sum of area x (centroid . mean corner normal)
     double lo[3], hi[3];
+    int64_t first;  // its first triangle
     bool open;
 } part_sums;
+
+// Closed, and of a volume above a millionth of its bounding box's.
+static bool part_bounds_a_volume(const part_sums *s)
+{
+    double box = (s->hi[0] - s->lo[0]) * (s->hi[1] - s->lo[1]) * (s->hi[2] - s->lo[2]);
+    return !s->open && fabs(s->volume) > 6e-6 * box;
+}
+
+// Whether point x lies inside closed part `r`: a ray from x crosses its
+// triangles an odd number of times (its direction skewed off the axes, so
+// that it meets no edge of an axis-aligned model).
+static bool inside_part(const wx_mesh_data *mesh, const uint32_t *part_of_triangle, int64_t T,
+                        uint32_t r, const double x[3])
+{
+    static const double dir[3] = { 0.8017837257372732, 0.5345224838248488,
+                                   0.2672612419124244 };
+    int crossings = 0;
+    for (int64_t t = 0; t < T; ++t) {
+        if (part_of_triangle[t] != r) {
+            continue;
+        }
+        double p[3][3];
+        for (int c = 0; c < 3; ++c) {
+            for (int k = 0; k < 3; ++k) {
+                p[c][k] = mesh->positions[3 * (size_t)mesh->indices[3 * t + c] + k];
+            }
+        }
+        // Moller and Trumbore.
+        double e1[3], e2[3], h[3], s[3], q[3];
+        for (int k = 0; k < 3; ++k) {
+            e1[k] = p[1][k] - p[0][k];
+            e2[k] = p[2][k] - p[0][k];
+            s[k] = x[k] - p[0][k];
+        }
+        h[0] = dir[1] * e2[2] - dir[2] * e2[1];
+        h[1] = dir[2] * e2[0] - dir[0] * e2[2];
+        h[2] = dir[0] * e2[1] - dir[1] * e2[0];
+        double a = e1[0] * h[0] + e1[1] * h[1] + e1[2] * h[2];
+        if (fabs(a) < 1e-300) {
+            continue;
+        }
+        double u = (s[0] * h[0] + s[1] * h[1] + s[2] * h[2]) / a;
+        q[0] = s[1] * e1[2] - s[2] * e1[1];
+        q[1] = s[2] * e1[0] - s[0] * e1[2];
+        q[2] = s[0] * e1[1] - s[1] * e1[0];
+        double v = (dir[0] * q[0] + dir[1] * q[1] + dir[2] * q[2]) / a;
+        double along = (e2[0] * q[0] + e2[1] * q[1] + e2[2] * q[2]) / a;
+        crossings += u >= 0.0 && v >= 0.0 && u + v <= 1.0 && along > 0.0;
+    }
+    return crossings % 2 == 1;
+}
 
 wx_result wx_mesh_orient_outwards(wx_mesh_data *mesh, int64_t *turned, wx_error *err)
 {
@@ -478,8 +530,12 @@ wx_result wx_mesh_orient_outwards(wx_mesh_data *mesh, int64_t *turned, wx_error 
     }
 
     // The sums per part.
+    for (uint32_t q = 0; q < part_count; ++q) {
+        parts[q].first = -1;
+    }
     for (int64_t t = 0; t < T; ++t) {
         part_sums *s = &parts[part_of[pid[idx[3 * t]]]];
+        s->first = s->first < 0 ? t : s->first;
         double p[3][3], n[3] = { 0.0, 0.0, 0.0 };
         for (int c = 0; c < 3; ++c) {
             uint32_t v = idx[3 * t + c];
@@ -522,10 +578,44 @@ wx_result wx_mesh_orient_outwards(wx_mesh_data *mesh, int64_t *turned, wx_error 
         goto done;
     }
     bool any = false;
+    uint32_t *part_of_triangle = NULL;
     for (uint32_t q = 0; q < part_count; ++q) {
         const part_sums *s = &parts[q];
-        double box = (s->hi[0] - s->lo[0]) * (s->hi[1] - s->lo[1]) * (s->hi[2] - s->lo[2]);
-        if (s->open || !(fabs(s->volume) > 6e-6 * box)) {
+        if (!part_bounds_a_volume(s) || !(s->flux < 0.0 || s->volume < 0.0)) {
+            continue;
+        }
+        // A closed part inside another closed part is a cavity (a room's
+        // walls seen from inside, the inner shell of a hollow ball): its
+        // normals point into it by design.
+        bool cavity = false;
+        for (uint32_t o = 0; o < part_count && !cavity; ++o) {
+            const part_sums *so = &parts[o];
+            bool around = o != q && part_bounds_a_volume(so);
+            for (int k = 0; k < 3 && around; ++k) {
+                around = so->lo[k] <= s->lo[k] && so->hi[k] >= s->hi[k];
+            }
+            if (!around) {
+                continue;
+            }
+            if (part_of_triangle == NULL) {
+                part_of_triangle = malloc((size_t)T * sizeof *part_of_triangle);
+                if (part_of_triangle == NULL) {
+                    free(flip_normals);
+                    free(flip_winding);
+                    r = wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (mesh orientation)");
+                    goto done;
+                }
+                for (int64_t t = 0; t < T; ++t) {
+                    part_of_triangle[t] = part_of[pid[idx[3 * t]]];
+                }
+            }
+            double x[3];
+            for (int k = 0; k < 3; ++k) {
+                x[k] = mesh->positions[3 * (size_t)idx[3 * s->first] + k];
+            }
+            cavity = inside_part(mesh, part_of_triangle, T, o, x);
+        }
+        if (cavity) {
             continue;
         }
         flip_normals[q] = s->flux < 0.0 && mesh->normals != NULL;
@@ -553,6 +643,7 @@ wx_result wx_mesh_orient_outwards(wx_mesh_data *mesh, int64_t *turned, wx_error 
     }
     free(flip_normals);
     free(flip_winding);
+    free(part_of_triangle);
 done:
     free(parts);
     free(part_of);

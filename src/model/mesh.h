@@ -107,8 +107,10 @@ wx_result wx_mesh_smooth_subdivide(wx_mesh_data *mesh, int level, wx_error *err)
 /// flux of the position through the surface along the normals (area times
 /// centroid . mean corner normal, summed) is negative: its vertices' normals
 /// are negated. Its winding, where the signed volume of its triangles is
-/// negative, is turned too (two corners swapped). Open parts, sheets and parts
-/// whose volume is under a millionth of their bounding box's stay as they are.
+/// negative, is turned too (two corners swapped). Open parts, sheets, parts
+/// whose volume is under a millionth of their bounding box's and cavities (a
+/// closed part inside another closed part: a room seen from inside) stay as
+/// they are.
 /// *turned (may be NULL) receives how many parts had their normals turned.
 /// WX_FAIL when out of memory (the mesh unchanged).
 wx_result wx_mesh_orient_outwards(wx_mesh_data *mesh, int64_t *turned, wx_error *err);
