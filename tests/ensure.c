@@ -8,6 +8,7 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "io/exr.h"
@@ -81,16 +82,26 @@ void ensure_run(const char *name, void (*fn)(void))
 {
     ensure_failed_checks = 0;
     skipping = false;
+    struct timespec t0, t1;
+    clock_gettime(CLOCK_MONOTONIC, &t0);
     fn();
+    clock_gettime(CLOCK_MONOTONIC, &t1);
+    double seconds = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
+    // Tests of a second or more say how long they took (what `make test-fast`
+    // leaves out is chosen by these).
+    char took[32] = "";
+    if (seconds >= 1.0) {
+        snprintf(took, sizeof took, " (%.1f s)", seconds);
+    }
     if (ensure_failed_checks == 0 && skipping) {
         skipped++;
         printf("  skip  %s\n", name);
     } else if (ensure_failed_checks == 0) {
         passed++;
-        printf("  ok    %s\n", name);
+        printf("  ok    %s%s\n", name, took);
     } else {
         failed++;
-        printf("  FAIL  %s\n", name);
+        printf("  FAIL  %s%s\n", name, took);
     }
     fflush(stdout);
 }

@@ -15,8 +15,10 @@ for prog in "$dir"/test_*; do
     name=$(basename "$prog")
     echo "== $name"
     log=$(mktemp)
+    t0=$SECONDS
     "$prog" 2>&1 | tee "$log"
     status=${PIPESTATUS[0]}
+    echo "   $name took $((SECONDS - t0)) s"
     summary=$(grep -E '^[0-9]+ passed, [0-9]+ failed(, [0-9]+ skipped)?$' "$log" | tail -n 1)
     rm -f "$log"
     if [ -z "$summary" ]; then
