@@ -123,6 +123,12 @@ int ensure_summary(void)
     return failed == 0 ? 0 : 1;
 }
 
+bool ensure_fast(void)
+{
+    const char *fast = getenv("WX_FAST");
+    return fast != NULL && fast[0] != '\0' && strcmp(fast, "0") != 0;
+}
+
 void ensure_skip(const char *reason)
 {
     skipping = true;

@@ -27,6 +27,7 @@ void ensure_report_near(const char *file, int line, const char *what, double a, 
 void ensure_run(const char *name, void (*fn)(void));
 int ensure_summary(void);
 void ensure_skip(const char *reason);
+bool ensure_fast(void);
 
 #define TEST(name) static void name(void)
 #define RUN(name) ensure_run(#name, name)
@@ -44,6 +45,15 @@ void ensure_skip(const char *reason);
     do {                                                                                     \
         ensure_skip(reason);                                                                 \
         return;                                                                              \
+    } while (0)
+
+/// Marks a test that takes seconds (a whole scene run): `make test-fast`
+/// (WX_FAST=1) skips it; `make test` runs it.
+#define SLOW()                                                                               \
+    do {                                                                                     \
+        if (ensure_fast()) {                                                                 \
+            SKIP("make test-fast leaves out the tests that take seconds");                   \
+        }                                                                                    \
     } while (0)
 
 #define ENSURE_NEAR(a, b, tol)                                                               \

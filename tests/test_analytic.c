@@ -41,6 +41,7 @@ static bool run_scene(const char *dir, const char *scene, const char *name)
 // ring's mean within 2%; a quarter of them: at most 7% and 3%.
 TEST(sphere_under_rain_from_a_box)
 {
+    SLOW();
     const char *dir = ensure_tmpdir();
     char mesh[4200];
     snprintf(mesh, sizeof mesh, "%s/sphere.ply", dir);
@@ -77,6 +78,7 @@ TEST(sphere_under_rain_from_a_box)
 // particles are spread over the whole upper half of the sphere).
 TEST(sphere_under_a_dome_aimed_at_its_foot)
 {
+    SLOW();
     const char *dir = ensure_tmpdir();
     char mesh[4200], path[4300];
     snprintf(mesh, sizeof mesh, "%s/sphere.ply", dir);
@@ -168,6 +170,7 @@ static float *run_wall(const char *dir, const char *mesh, const char *scene_text
 // holds at most 2% of the exposed wall's mean, which is within 3% of exact.
 TEST(wall_under_an_overhang_in_slanting_rain)
 {
+    SLOW();
     float *mask = run_wall(ensure_tmpdir(), overhang_mesh, overhang_scene, "overhang");
     ENSURE(mask != NULL);
     const int w = 512, h = 512;
@@ -298,6 +301,7 @@ static const char *rotated_overhang_scene =
 
 TEST(shelter_edge_at_30_degrees_to_the_cameras_is_straight)
 {
+    SLOW();
     char obj[4096];
     rotated_overhang_mesh(obj, sizeof obj);
     float *mask = run_wall(ensure_tmpdir(), obj, rotated_overhang_scene, "turned");
@@ -502,6 +506,7 @@ static bool run_lumpy(const char *dir, const char *model, int seed, float **dirt
 // as the seeds: not met (docs/performance.md); this test holds what is.
 TEST(lumpy_sphere_turned_in_the_camera_grid_keeps_its_exact_rain)
 {
+    SLOW();
     const char *dir = ensure_tmpdir();
     static char obj[200000];
     lumpy_sphere(obj, sizeof obj, 0.0, false);
@@ -577,6 +582,7 @@ TEST(lumpy_sphere_turned_in_the_camera_grid_keeps_its_exact_rain)
 // the same texels are seen and the same drops give the same rain.
 TEST(lumpy_sphere_wound_inwards_weathers_as_wound_outwards)
 {
+    SLOW();
     const char *dir = ensure_tmpdir();
     static char obj[200000];
     lumpy_sphere(obj, sizeof obj, 0.0, false);

@@ -356,6 +356,7 @@ TEST(stats_never_overwrites_anything)
 // output names, and a scene called "...xml" still writes inside out/.
 TEST(stale_cleanup_and_default_folder_stay_in_their_place)
 {
+    SLOW();
     const char *d = teapot_copy("stale");
     ENSURE(d != NULL);
     ENSURE(ensure_shell(NULL, 0,
@@ -430,6 +431,7 @@ TEST(control_characters_from_files_are_escaped)
 // pilot's 20000 particles give a standard error of 0.2).
 TEST(info_pilot_predicts_the_particles_that_miss)
 {
+    SLOW();
     const char *d = teapot_copy("pilot");
     ENSURE(d != NULL);
     char scene[4300];

@@ -140,6 +140,7 @@ TEST(bad_input_is_exit_2)
 // folder); the scene it writes there runs into the same folder again.
 TEST(run_mesh_folder_is_plain_and_named_after_the_mesh)
 {
+    SLOW();
     char dir[PATH_MAX + 16];
     snprintf(dir, sizeof dir, "%s/dots", ensure_tmpdir());
     ENSURE(ensure_shell(NULL, 0, "mkdir -p '%s' && cp '%s' '%s/...obj'", dir,
@@ -167,6 +168,7 @@ TEST(run_mesh_folder_is_plain_and_named_after_the_mesh)
 // no `run MESH` generated), and a refusal leaves no folder and no scene.
 TEST(run_mesh_keeps_a_users_scene_and_leaves_nothing_on_refusal)
 {
+    SLOW();
     char dir[PATH_MAX + 16];
     snprintf(dir, sizeof dir, "%s/users", ensure_tmpdir());
     ENSURE(ensure_shell(NULL, 0, "mkdir -p '%s/mine'", dir) == 0);

@@ -150,6 +150,7 @@ TEST(open_plane)
 // floor is dark up to x = h / tan(e) = 1, lit beyond.
 TEST(floor_beside_a_wall)
 {
+    SLOW();
     const char *dir = ensure_tmpdir();
     static const double wall[2][6] = { { -1, -0.1, -3, 7, 0, 3 }, { -0.25, 0, -3, 0, 5, 3 } };
     write_boxes(dir, "wall.obj", wall, 2);
@@ -257,6 +258,7 @@ TEST(inside_a_closed_box)
 // (y + R) / (2R).
 TEST(sphere_curvature_and_height)
 {
+    SLOW();
     const char *dir = ensure_tmpdir();
     const double radii[3] = { 0.5, 1.0, 2.0 };
     for (int k = 0; k < 3; ++k) {

@@ -39,6 +39,7 @@ static double island_mean(const float *m, int w, int h, int i0, int j0)
 // sides, and none underneath.
 TEST(presets_make_valid_scenes_and_rain_dirties_the_top)
 {
+    SLOW();
     const char *dir = ensure_tmpdir();
     static const char *const presets[4] = { "rain", "dust", "soot", "moss" };
     for (int p = 0; p < 4; ++p) {
@@ -394,6 +395,7 @@ static bool run_preset(const char *dir, const char *mesh, const char *base, cons
 // surface's mean). For moss, the mask is `moss`.
 TEST(every_preset_lands_its_particles_and_faces_its_weathered_side)
 {
+    SLOW();
     const char *dir = ensure_tmpdir();
     write_lumpy_sphere(dir, "lumpy.obj");
     static const char *const presets[4] = { "rain", "dust", "soot", "moss" };

@@ -137,6 +137,7 @@ static int check_bad_folder(const char *folder, const char *command, int *checke
 // Every bad scene and map of tests/bad/ and tests/bad/run/ through the command line.
 TEST(bad_inputs_exit_2_with_their_message)
 {
+    SLOW();
     char folder[4096];
     int checked = 0;
     snprintf(folder, sizeof folder, "%s/bad", ensure_tests_dir());
@@ -371,6 +372,7 @@ static bool outputs_read_back(const char *folder, int *files, int *temps)
 // and nothing written in the current folder.
 TEST(sigint_stops_a_run_cleanly)
 {
+    SLOW();
     char dir[PATH_MAX];
     ENSURE(realpath(ensure_tmpdir(), dir) != NULL);
     char scene[PATH_MAX];
@@ -415,6 +417,7 @@ TEST(sigint_stops_a_run_cleanly)
 // run in that folder removes the temporaries the killed one left.
 TEST(sigkill_never_leaves_a_torn_file)
 {
+    SLOW();
     char dir[PATH_MAX];
     ENSURE(realpath(ensure_tmpdir(), dir) != NULL);
     char scene[PATH_MAX];

@@ -276,6 +276,7 @@ static bool building_regions(bool dusty_sills, double *band, double *exposed, do
 // vanish when the sills start clean).
 TEST(default_scene_has_a_clean_band_and_streaks_below_the_sills)
 {
+    SLOW();
     double band, exposed, below, band0, exposed0, below0;
     ENSURE(building_regions(true, &band, &exposed, &below));
     ENSURE(building_regions(false, &band0, &exposed0, &below0));
@@ -289,6 +290,7 @@ TEST(default_scene_has_a_clean_band_and_streaks_below_the_sills)
 
 TEST(every_shipped_scene_validates)
 {
+    SLOW();
     char dir[4200];
     snprintf(dir, sizeof dir, "%s/../xml_scenes", ensure_tests_dir());
     DIR *d = opendir(dir);
@@ -354,6 +356,7 @@ static double estimate_mib(const char *scene)
 // and not more than 3 times it (issue 13): every shipped scene, measured.
 TEST(memory_estimate_bounds_every_shipped_scene)
 {
+    SLOW();
 #if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
     SKIP("sanitizers change the memory a run takes");
 #endif
@@ -469,6 +472,7 @@ static bool write_grid_mesh(const char *dir, const char *name, const char *forma
 // alive at once (at most 0.49 s of rain), not all 2 million (5.7x before).
 TEST(memory_estimate_bounds_meshes_and_particles_alive_at_once)
 {
+    SLOW();
 #if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
     SKIP("sanitizers change the memory a run takes");
 #endif
@@ -571,6 +575,7 @@ TEST(a_run_without_a_single_hit_warns)
 // map replaced while the run flies its particles changes nothing (issue 13).
 TEST(inputs_are_read_once_per_run)
 {
+    SLOW();
     const char *dir = out_dir("read_once");
     char log[8192];
     // The thesis box (given maps) with a longer simulation, and its maps copied.

@@ -316,6 +316,7 @@ static int ledger_balances(const char *json)
 
 TEST(the_ledger_balances_on_every_shipped_scene)
 {
+    SLOW();
 #if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
     SKIP("the shipped scenes take minutes under sanitizers");
 #endif

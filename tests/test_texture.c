@@ -716,6 +716,7 @@ static double row_ny(int j, int h)
 // columns on either side of the seam agree as closely as interior neighbours.
 TEST(uv_sphere_follows_the_flux_without_a_seam)
 {
+    SLOW();
     const char *dir = sphere_run();
     ENSURE(dir != NULL);
     if (dir == NULL) {
@@ -871,6 +872,7 @@ TEST(mesh_without_uvs_is_refused)
 // -20% to +20%.
 TEST(uniform_dirt_has_no_seam_between_cameras)
 {
+    SLOW();
     char dir[PATH_MAX + 16];
     snprintf(dir, sizeof dir, "%s/uniform", ensure_tmpdir());
     ENSURE(ensure_shell(NULL, 0, "mkdir -p '%s'", dir) == 0);
