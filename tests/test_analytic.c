@@ -396,10 +396,12 @@ TEST(shelter_edge_at_30_degrees_to_the_cameras_is_straight)
 // metre across the box), which the scene's <Exposure elevation="90"> mask
 // writes beside the dirt in the same TextureMap. Once as it is and once turned
 // 30 degrees about the vertical, with the same cameras and drops.
-// inward: every face wound the other way, as an export with flipped normals
-// gives it.
-static void lumpy_sphere(char *obj, size_t size, double turn_degrees, bool inward)
+// Written as `name` in `dir`; inward: every face wound the other way, as an
+// export with flipped normals gives it.
+static void lumpy_sphere(const char *dir, const char *name, double turn_degrees, bool inward)
 {
+    static char obj[200000];
+    const size_t size = sizeof obj;
     const int nu = 24, nv = 12;
     const double c = cos(turn_degrees * M_PI / 180.0), s = sin(turn_degrees * M_PI / 180.0);
     size_t n = 0;
@@ -435,6 +437,7 @@ static void lumpy_sphere(char *obj, size_t size, double turn_degrees, bool inwar
             }
         }
     }
+    ensure_write_file(dir, name, obj);
 }
 
 // 400 000 drops over 3 x 3 m: F = 44 444 per square metre. Input cameras of
@@ -508,11 +511,8 @@ TEST(lumpy_sphere_turned_in_the_camera_grid_keeps_its_exact_rain)
 {
     SLOW();
     const char *dir = ensure_tmpdir();
-    static char obj[200000];
-    lumpy_sphere(obj, sizeof obj, 0.0, false);
-    ensure_write_file(dir, "lumpy.obj", obj);
-    lumpy_sphere(obj, sizeof obj, 30.0, false);
-    ensure_write_file(dir, "turned.obj", obj);
+    lumpy_sphere(dir, "lumpy.obj", 0.0, false);
+    lumpy_sphere(dir, "turned.obj", 30.0, false);
     enum { RUNS = 3, W = 512, B = 16 };
     const bool turned[RUNS] = { false, false, true };
     const int seed[RUNS] = { 1, 2, 1 };
@@ -584,11 +584,8 @@ TEST(lumpy_sphere_wound_inwards_weathers_as_wound_outwards)
 {
     SLOW();
     const char *dir = ensure_tmpdir();
-    static char obj[200000];
-    lumpy_sphere(obj, sizeof obj, 0.0, false);
-    ensure_write_file(dir, "lumpy.obj", obj);
-    lumpy_sphere(obj, sizeof obj, 0.0, true);
-    ensure_write_file(dir, "inward.obj", obj);
+    lumpy_sphere(dir, "lumpy.obj", 0.0, false);
+    lumpy_sphere(dir, "inward.obj", 0.0, true);
     float *dirt[2] = { NULL }, *sun[2] = { NULL }, *seen[2] = { NULL };
     ENSURE(run_lumpy(dir, "lumpy", 1, &dirt[0], &sun[0], &seen[0]));
     ENSURE(run_lumpy(dir, "inward", 1, &dirt[1], &sun[1], &seen[1]));
