@@ -459,9 +459,11 @@ wx_result wx_mesh_orient_outwards(wx_mesh_data *mesh, int64_t *turned, wx_error 
     uint32_t *parent = malloc((size_t)P * sizeof *parent);
     edge_key *edges = malloc((size_t)T * 3 * sizeof *edges);
     uint32_t *part_of = malloc((size_t)P * sizeof *part_of);
+    uint32_t *part_of_triangle = malloc((size_t)T * sizeof *part_of_triangle);
     part_sums *parts = NULL;
+    bool *flip_normals = NULL, *flip_winding = NULL;
     wx_result r = WX_OK;
-    if (parent == NULL || edges == NULL || part_of == NULL) {
+    if (parent == NULL || edges == NULL || part_of == NULL || part_of_triangle == NULL) {
         r = wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (mesh orientation)");
         goto done;
     }
@@ -489,8 +491,13 @@ wx_result wx_mesh_orient_outwards(wx_mesh_data *mesh, int64_t *turned, wx_error 
         }
         part_of[p] = part_of[root];
     }
+    for (int64_t t = 0; t < T; ++t) {
+        part_of_triangle[t] = part_of[pid[idx[3 * t]]];
+    }
     parts = calloc(part_count, sizeof *parts);
-    if (parts == NULL) {
+    flip_normals = calloc(part_count, sizeof *flip_normals);
+    flip_winding = calloc(part_count, sizeof *flip_winding);
+    if (parts == NULL || flip_normals == NULL || flip_winding == NULL) {
         r = wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (mesh orientation)");
         goto done;
     }
@@ -499,6 +506,7 @@ wx_result wx_mesh_orient_outwards(wx_mesh_data *mesh, int64_t *turned, wx_error 
             parts[q].lo[k] = INFINITY;
             parts[q].hi[k] = -INFINITY;
         }
+        parts[q].first = -1;
     }
 
     // Closed: every edge shared by exactly two triangles running opposite ways.
@@ -514,7 +522,7 @@ wx_result wx_mesh_orient_outwards(wx_mesh_data *mesh, int64_t *turned, wx_error 
             edge_key *e = &edges[E++];
             e->ends = a < b ? ((uint64_t)a << 32) | b : ((uint64_t)b << 32) | a;
             e->forward = a < b;
-            e->part = part_of[a];
+            e->part = part_of_triangle[t];
         }
     }
     qsort(edges, (size_t)E, sizeof *edges, compare_edges);
@@ -530,11 +538,8 @@ wx_result wx_mesh_orient_outwards(wx_mesh_data *mesh, int64_t *turned, wx_error 
     }
 
     // The sums per part.
-    for (uint32_t q = 0; q < part_count; ++q) {
-        parts[q].first = -1;
-    }
     for (int64_t t = 0; t < T; ++t) {
-        part_sums *s = &parts[part_of[pid[idx[3 * t]]]];
+        part_sums *s = &parts[part_of_triangle[t]];
         s->first = s->first < 0 ? t : s->first;
         double p[3][3], n[3] = { 0.0, 0.0, 0.0 };
         for (int c = 0; c < 3; ++c) {
@@ -568,17 +573,7 @@ wx_result wx_mesh_orient_outwards(wx_mesh_data *mesh, int64_t *turned, wx_error 
     }
 
     // Turn what points in.
-    bool *flip_normals = NULL, *flip_winding = NULL;
-    flip_normals = calloc(part_count, sizeof *flip_normals);
-    flip_winding = calloc(part_count, sizeof *flip_winding);
-    if (flip_normals == NULL || flip_winding == NULL) {
-        free(flip_normals);
-        free(flip_winding);
-        r = wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (mesh orientation)");
-        goto done;
-    }
     bool any = false;
-    uint32_t *part_of_triangle = NULL;
     for (uint32_t q = 0; q < part_count; ++q) {
         const part_sums *s = &parts[q];
         if (!part_bounds_a_volume(s) || !(s->flux < 0.0 || s->volume < 0.0)) {
@@ -596,18 +591,6 @@ wx_result wx_mesh_orient_outwards(wx_mesh_data *mesh, int64_t *turned, wx_error 
             }
             if (!around) {
                 continue;
-            }
-            if (part_of_triangle == NULL) {
-                part_of_triangle = malloc((size_t)T * sizeof *part_of_triangle);
-                if (part_of_triangle == NULL) {
-                    free(flip_normals);
-                    free(flip_winding);
-                    r = wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (mesh orientation)");
-                    goto done;
-                }
-                for (int64_t t = 0; t < T; ++t) {
-                    part_of_triangle[t] = part_of[pid[idx[3 * t]]];
-                }
             }
             double x[3];
             for (int k = 0; k < 3; ++k) {
@@ -634,17 +617,17 @@ wx_result wx_mesh_orient_outwards(wx_mesh_data *mesh, int64_t *turned, wx_error 
             }
         }
         for (int64_t t = 0; t < T; ++t) {
-            if (flip_winding[part_of[pid[idx[3 * t]]]]) {
+            if (flip_winding[part_of_triangle[t]]) {
                 uint32_t swap = mesh->indices[3 * t + 1];
                 mesh->indices[3 * t + 1] = mesh->indices[3 * t + 2];
                 mesh->indices[3 * t + 2] = swap;
             }
         }
     }
+done:
     free(flip_normals);
     free(flip_winding);
     free(part_of_triangle);
-done:
     free(parts);
     free(part_of);
     free(edges);
