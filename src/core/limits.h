@@ -19,9 +19,12 @@
 #define WX_MAX_SUBSTANCES 8
 #define WX_SUBSTANCE_NAME_MAX 32
 
+/// Most layers a camera records (<Ortho layers>, docs/design.md section 14).
+#define WX_MAX_LAYERS 8
+
 /// Channels and header attributes of an image: a dirt map of 8 substances holds
-/// 4 channels per substance and the surface record.
-#define WX_IMAGE_MAX_CHANNELS 40
+/// 4 channels per substance and the surface record (40), once per layer.
+#define WX_IMAGE_MAX_CHANNELS (40 * WX_MAX_LAYERS)
 #define WX_IMAGE_MAX_ATTRS 16
 /// Longest channel or attribute name, and string attribute.
 #define WX_NAME_MAX 64

@@ -53,3 +53,10 @@ int wx_dirt_channels(const wx_scene *scene, bool simulated, char names[][WX_NAME
     }
     return n;
 }
+
+bool wx_layer_channel(char out[WX_NAME_MAX], int layer, const char *channel)
+{
+    int n = layer > 0 ? snprintf(out, WX_NAME_MAX, "layer%d.%s", layer, channel)
+                      : snprintf(out, WX_NAME_MAX, "%s", channel);
+    return n > 0 && n < WX_NAME_MAX;
+}

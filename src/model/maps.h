@@ -17,6 +17,16 @@
 typedef struct wx_maps {
     int width;
     int height;
+    /// Layers (docs/design.md section 14; 0 or 1: one): every plane below
+    /// holds one block per layer, layer k after layer k-1: depth at
+    /// k*W*H, normal at 3*k*W*H, impact at 2*k*W*H, the substance planes
+    /// (dirt, deposit, erosion, initial_dirt) at k*S*W*H, the others at k*W*H.
+    /// Layer 0 is the first surface each texel's view ray meets, layer k the
+    /// (k+1)-th crossing, front- or back-facing; a layer with no crossing left
+    /// holds depth +inf. With more than one layer every normal points out of
+    /// the solid (so n.view > 0 where the ray leaves it); with one, it faces
+    /// the camera as version 2's maps do.
+    int layers;
     float *depth;   ///< width*height, d or +inf
     float *normal;  ///< 3*width*height, interleaved x y z, world space, unit
     float *impact;  ///< 2*width*height, interleaved absorption, bounce
@@ -73,6 +83,17 @@ int wx_dirt_channels(const wx_scene *scene, bool simulated, char names[][WX_NAME
 
 /// Frees every plane; the struct is zeroed.
 void wx_maps_free(wx_maps *maps);
+
+/// Layers the planes hold (at least 1).
+static inline int wx_maps_layers(const wx_maps *maps)
+{
+    return maps->layers > 1 ? maps->layers : 1;
+}
+
+/// The file channel of `channel` in layer `layer` (docs/design.md section 14):
+/// the name itself in layer 0, "layerK.NAME" in layer K >= 1. Returns false
+/// when the name does not fit WX_NAME_MAX.
+bool wx_layer_channel(char out[WX_NAME_MAX], int layer, const char *channel);
 
 /// Substances the dirt planes hold (at least 1).
 static inline int wx_maps_substances(const wx_maps *maps)

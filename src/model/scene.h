@@ -103,6 +103,10 @@ typedef struct wx_scene_camera {
     wx_second_pass second_pass;
     bool normalize;          ///< scale the final mask to [0,1]
     int every;               ///< write BASE.NNNN.exr after every k-th iteration (0: none)
+    /// <Ortho layers>: the crossings of each texel's view ray the camera
+    /// records, nearest first (docs/design.md section 14); 1 to WX_MAX_LAYERS,
+    /// default 1 (today's maps). Cameras whose maps the scene gives have 1.
+    int layers;
     int line;
 } wx_scene_camera;
 

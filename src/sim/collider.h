@@ -82,7 +82,8 @@ void wx_collider_free(wx_collider *collider);
 typedef struct wx_hit {
     float s;          ///< segment parameter of the hit, in [0, 1]
     int camera;       ///< the camera that gives the hit (smallest d - depth)
-    uint32_t texel;   ///< j*W + i in that camera's maps
+    int layer;        ///< the layer of that camera's maps that holds the surface hit
+    uint32_t texel;   ///< j*W + i in that camera's maps (of that layer)
     float point[3];   ///< world point where the segment enters the surface
     /// Where the particle is put back: on that camera's surface slightly in
     /// front of it (or, when it entered through a silhouette or frame edge, just
