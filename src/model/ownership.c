@@ -25,6 +25,7 @@ void wx_owner_view_init(wx_owner_view *view, const wx_camera *camera, const floa
 {
     view->camera = camera;
     view->depth = depth;
+    view->normal = NULL;
     view->width = width;
     view->height = height;
     wx_camera_view_dir(camera, view->view);
@@ -69,11 +70,23 @@ bool wx_owner_sees(const wx_owner_view *view, const double p[3], const float n[3
 {
     // The surface must face the view (a normal map's normals face its camera).
     float facing = n[0] * view->view[0] + n[1] * view->view[1] + n[2] * view->view[2];
-    if (!(facing < FACING_SLACK)) {
+    if (view->normal == NULL && !(facing < FACING_SLACK)) {
         return false;
     }
     double uvd[3];
     wx_matrix_apply_affine(view->camera->wtc, p, uvd);
+    if (view->normal != NULL) {
+        // A layer's normals point out of the solid, either way along the view:
+        // the point's surface must face the way the layer's texel does.
+        int i = (int)floor(uvd[0] * view->width), j = (int)floor((1.0 - uvd[1]) * view->height);
+        if (i < 0 || j < 0 || i >= view->width || j >= view->height) {
+            return false;
+        }
+        const float *m = view->normal + 3 * ((size_t)j * (size_t)view->width + (size_t)i);
+        if (!(n[0] * m[0] + n[1] * m[1] + n[2] * m[2] > 0.0f)) {
+            return false;
+        }
+    }
     double x = uvd[0] * view->width - 0.5, y = (1.0 - uvd[1]) * view->height - 0.5;
     double own, between;
     if (!depth_at(view->depth, view->width, view->height, x, y, &own, &between)) {

@@ -26,6 +26,12 @@ typedef struct wx_owner_view {
     int width, height;
     float view[3];  ///< unit viewing direction
     float texel_ws; ///< the larger side of a texel, world units
+    /// A layer of a layered camera (docs/design.md section 14): its outward
+    /// normals (3*width*height interleaved), so a surface facing away from the
+    /// camera is seen by the layer that holds it, and the side of a thin plate
+    /// is told by the normal rather than by the viewing direction. NULL (what
+    /// wx_owner_view_init sets): a one-layer map, whose surfaces face the view.
+    const float *normal;
 } wx_owner_view;
 
 /// Fills a view (the viewing direction and texel size from the camera).
@@ -33,7 +39,8 @@ void wx_owner_view_init(wx_owner_view *view, const wx_camera *camera, const floa
                         int width, int height);
 
 /// Whether `view` sees the world point p of a surface with unit normal n: the
-/// surface faces the view (n . view <= 0), p projects into its frame onto a
+/// surface faces the view (n . view <= 0; for a layer, n agrees in side with
+/// the normal the layer records at p's texel), p projects into its frame onto a
 /// texel with a surface, and both that texel's
 /// depth and the depth between texel centres (bilinear where the four texels
 /// around p hold a surface) agree with p's within half a texel plus one
