@@ -443,7 +443,8 @@ wx_gather_view wx_gather_view_from_maps(const wx_camera *camera, const wx_maps *
 {
     wx_gather_view view = { .camera = camera, .width = maps->width, .height = maps->height,
                             .depth = maps->depth, .normal = maps->normal, .dirt = maps->dirt,
-                            .initial = maps->initial_dirt, .hits = maps->hits };
+                            .initial = maps->initial_dirt, .hits = maps->hits,
+                            .outward = maps->outward };
     return view;
 }
 
@@ -700,6 +701,7 @@ wx_result wx_gather_owned(const wx_gather_view *views, int count, int threads, f
     for (int k = 0; k < count; ++k) {
         wx_owner_view_init(&owners[k], views[k].camera, views[k].depth, views[k].width,
                            views[k].height);
+        owners[k].normal = views[k].outward ? views[k].normal : NULL;
     }
     wx_result r = WX_OK;
     size_t at = 0;

@@ -53,6 +53,9 @@ typedef struct wx_gather_view {
     /// The share of each texel's surface this camera owns (model/ownership.h),
     /// input cameras only; NULL: wx_gather_compute works it out itself.
     const float *owned;
+    /// A layer of a layered camera (model/maps.h `outward`): its normals point
+    /// out of the solid, so ownership reads them (model/ownership.h).
+    bool outward;
 } wx_gather_view;
 
 /// The share of each texel's surface every input camera owns

@@ -109,10 +109,30 @@ static bool header_has(const wx_image *header, const char *name)
     return false;
 }
 
+// The channel names of layer `layer` (docs/design.md section 14): each
+// alternative of "A|B" prefixed "layerK." for K >= 1, unchanged in layer 0.
+static void layer_names(char *out, size_t size, int layer, const char *alternatives)
+{
+    if (layer == 0) {
+        snprintf(out, size, "%s", alternatives);
+        return;
+    }
+    size_t used = 0;
+    out[0] = '\0';
+    for (const char *a = alternatives; *a != '\0' && used < size;) {
+        const char *bar = strchr(a, '|');
+        size_t len = bar != NULL ? (size_t)(bar - a) : strlen(a);
+        int n = snprintf(out + used, size - used, "%slayer%d.%.*s", used > 0 ? "|" : "", layer,
+                         (int)len, a);
+        used += n > 0 ? (size_t)n : 0;
+        a += len + (bar != NULL ? 1 : 0);
+    }
+}
+
 // One plane of wx_maps the dirt map fills: a channel (or alternatives) of the
 // file, or zeros.
 typedef struct dirt_plane {
-    char channel[2 * (WX_NAME_MAX + 8) + 2]; ///< "" = zeros
+    char channel[2 * (WX_NAME_MAX + 16) + 2]; ///< "" = zeros
     float **dest;                      ///< the wx_maps plane block
     size_t offset;                     ///< plane index within it
 } dirt_plane;
@@ -120,7 +140,7 @@ typedef struct dirt_plane {
 // The dirt map of a scene with substances, or with the bake's surface and area
 // records: the planes model/maps.h lays out, from the channels the file has.
 static wx_result load_scene_dirt(wx_maps *maps, unsigned which, int threads,
-                                 const wx_scene *scene, const char *dirt_path,
+                                 const wx_scene *scene, int layer, const char *dirt_path,
                                  size_check *check, wx_error *err)
 {
     wx_image *image = calloc(2, sizeof *image); // header and planes: off the stack
@@ -196,6 +216,9 @@ static wx_result load_scene_dirt(wx_maps *maps, unsigned which, int threads,
     int read = 0;
     for (int k = 0; k < count; ++k) {
         if (planes[k].channel[0] != '\0') {
+            char plain[sizeof planes[k].channel];
+            memcpy(plain, planes[k].channel, sizeof plain);
+            layer_names(planes[k].channel, sizeof planes[k].channel, layer, plain);
             channels[read++] = planes[k].channel;
         }
     }
@@ -253,16 +276,19 @@ wx_result wx_maps_load(wx_maps *maps, unsigned which, int threads, const char *d
                               dirt_path, err);
 }
 
-wx_result wx_maps_load_scene(wx_maps *maps, unsigned which, int threads, const wx_scene *scene,
-                             const char *depth_path, const char *normal_path,
-                             const char *impact_path, const char *dirt_path, wx_error *err)
+// The planes of one layer of the maps (layer 0: the plain channels).
+static wx_result load_layer(wx_maps *maps, unsigned which, int threads, const wx_scene *scene,
+                            int layer, const char *depth_path, const char *normal_path,
+                            const char *impact_path, const char *dirt_path, wx_error *err)
 {
     memset(maps, 0, sizeof *maps);
+    char names[5][2 * (WX_NAME_MAX + 16) + 2];
     size_check check = { NULL, 0, 0, threads };
     wx_result result = WX_OK;
 
     if (wanted(which, WX_MAPS_DEPTH)) {
-        static const char *const channels[] = {"R|Z"};
+        layer_names(names[0], sizeof names[0], layer, "R|Z");
+        const char *const channels[] = { names[0] };
         result = need_path(depth_path, "depth", err);
         if (result == WX_OK) {
             result = load_interleaved(depth_path, channels, 1, &maps->depth, &check, err);
@@ -278,11 +304,16 @@ wx_result wx_maps_load_scene(wx_maps *maps, unsigned which, int threads, const w
         }
     }
     if (result == WX_OK && wanted(which, WX_MAPS_NORMAL)) {
-        static const char *const channels[] = {"R", "G", "B"};
+        layer_names(names[0], sizeof names[0], layer, "R");
+        layer_names(names[1], sizeof names[1], layer, "G");
+        layer_names(names[2], sizeof names[2], layer, "B");
+        const char *const channels[] = { names[0], names[1], names[2] };
         result = load_finite(normal_path, "normal", channels, 3, &maps->normal, &check, err);
     }
     if (result == WX_OK && wanted(which, WX_MAPS_IMPACT)) {
-        static const char *const channels[] = {"R", "G"};
+        layer_names(names[0], sizeof names[0], layer, "R");
+        layer_names(names[1], sizeof names[1], layer, "G");
+        const char *const channels[] = { names[0], names[1] };
         result = load_finite(impact_path, "impact", channels, 2, &maps->impact, &check, err);
     }
     bool scene_layout = scene != NULL && (scene->substances_declared ||
@@ -291,15 +322,18 @@ wx_result wx_maps_load_scene(wx_maps *maps, unsigned which, int threads, const w
     if (result == WX_OK && wanted(which, WX_MAPS_DIRT) && scene_layout) {
         result = need_path(dirt_path, "dirt", err);
         if (result == WX_OK) {
-            result = load_scene_dirt(maps, which, threads, scene, dirt_path, &check, err);
+            result = load_scene_dirt(maps, which, threads, scene, layer, dirt_path, &check, err);
         }
     } else if (result == WX_OK && wanted(which, WX_MAPS_DIRT)) {
         // A dirt map that `simulate` wrote keeps the dirt it started from in
         // "initialDirt": a new simulation starts from that, not from its result.
-        const char *const channels[] = {
-            wanted(which, WX_MAPS_INITIAL_DIRT) ? "initialDirt|R" : "R", "G", "B",
-            WX_INITIAL_DIRT_CHANNEL, WX_HITS_CHANNEL
-        };
+        static const char *const plain[] = { "initialDirt|R", "G", "B", WX_INITIAL_DIRT_CHANNEL,
+                                             WX_HITS_CHANNEL };
+        for (int c = 0; c < 5; ++c) {
+            bool restart = c == 0 && wanted(which, WX_MAPS_INITIAL_DIRT);
+            layer_names(names[c], sizeof names[c], layer, c == 0 && !restart ? "R" : plain[c]);
+        }
+        const char *const channels[] = { names[0], names[1], names[2], names[3], names[4] };
         const int channel_count = wanted(which, WX_MAPS_SIMULATED) ? 5 : 3;
         result = need_path(dirt_path, "dirt", err);
         wx_image *image = NULL;
@@ -350,5 +384,93 @@ wx_result wx_maps_load_scene(wx_maps *maps, unsigned which, int threads, const w
     }
     maps->width = check.width;
     maps->height = check.height;
+    return WX_OK;
+}
+
+// Appends the block of one layer to a plane of the layered maps.
+static bool append_block(float **plane, int layers, float *block, size_t block_floats, int layer)
+{
+    if (block == NULL) {
+        return *plane == NULL;
+    }
+    if (layer == 0) {
+        float *all = realloc(block, (size_t)layers * block_floats * sizeof(float) + sizeof(float));
+        if (all == NULL) {
+            return false;
+        }
+        *plane = all;
+        return true;
+    }
+    if (*plane == NULL) {
+        return false;
+    }
+    memcpy(*plane + (size_t)layer * block_floats, block, block_floats * sizeof(float));
+    return true;
+}
+
+wx_result wx_maps_load_scene(wx_maps *maps, unsigned which, int threads, const wx_scene *scene,
+                             const char *depth_path, const char *normal_path,
+                             const char *impact_path, const char *dirt_path, wx_error *err)
+{
+    return wx_maps_load_layers(maps, which, threads, scene, 1, depth_path, normal_path,
+                               impact_path, dirt_path, err);
+}
+
+wx_result wx_maps_load_layers(wx_maps *maps, unsigned which, int threads, const wx_scene *scene,
+                              int layers, const char *depth_path, const char *normal_path,
+                              const char *impact_path, const char *dirt_path, wx_error *err)
+{
+    if (layers <= 1) {
+        return load_layer(maps, which, threads, scene, 0, depth_path, normal_path, impact_path,
+                          dirt_path, err);
+    }
+    wx_maps one;
+    wx_result r = load_layer(maps, which, threads, scene, 0, depth_path, normal_path, impact_path,
+                             dirt_path, err);
+    if (r != WX_OK) {
+        return r;
+    }
+    size_t n = (size_t)maps->width * (size_t)maps->height;
+    size_t S = (size_t)wx_maps_substances(maps);
+    // Each plane with its floats per layer; layer 0 is grown to hold them all.
+    for (int layer = 0; layer < layers && r == WX_OK; ++layer) {
+        wx_maps *from = maps;
+        if (layer > 0) {
+            r = load_layer(&one, which, threads, scene, layer, depth_path, normal_path,
+                           impact_path, dirt_path, err);
+            if (r != WX_OK) {
+                break;
+            }
+            from = &one;
+            if (one.width != maps->width || one.height != maps->height) {
+                wx_maps_free(&one);
+                r = wx_fail(err, WX_CAUSE_MAP_SIZE, "layer %d of the maps of %s differs in size",
+                            layer, depth_path != NULL ? depth_path : dirt_path);
+                break;
+            }
+        }
+        float **to[] = { &maps->depth, &maps->normal, &maps->impact, &maps->dirt, &maps->deposit,
+                         &maps->erosion, &maps->initial_dirt, &maps->hits, &maps->surface,
+                         &maps->area };
+        float *block[] = { from->depth, from->normal, from->impact, from->dirt, from->deposit,
+                           from->erosion, from->initial_dirt, from->hits, from->surface,
+                           from->area };
+        size_t floats[] = { n, 3 * n, 2 * n, S * n, S * n, S * n, S * n, n, n, n };
+        for (size_t k = 0; k < sizeof floats / sizeof floats[0] && r == WX_OK; ++k) {
+            if (!append_block(to[k], layers, block[k], floats[k], layer)) {
+                r = wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory for the layers of %s",
+                            depth_path != NULL ? depth_path : dirt_path);
+            }
+        }
+        if (layer > 0) {
+            wx_maps_free(&one);
+        }
+    }
+    if (r != WX_OK) {
+        wx_maps_free(maps);
+        return r;
+    }
+    maps->layers = layers;
+    maps->outward = true;
     return WX_OK;
 }

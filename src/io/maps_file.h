@@ -32,6 +32,14 @@ wx_result wx_maps_load_scene(wx_maps *maps, unsigned which, int threads, const w
                              const char *depth_path, const char *normal_path,
                              const char *impact_path, const char *dirt_path, wx_error *err);
 
+/// wx_maps_load_scene for a camera of `layers` layers (docs/design.md section
+/// 14): layer 0 from the plain channels, layer k from "layerK." ones, into the
+/// per-layer blocks of model/maps.h. A layer the files lack is an error
+/// naming the file and channel.
+wx_result wx_maps_load_layers(wx_maps *maps, unsigned which, int threads, const wx_scene *scene,
+                              int layers, const char *depth_path, const char *normal_path,
+                              const char *impact_path, const char *dirt_path, wx_error *err);
+
 /// Loads the maps selected by `which` from the given paths (NULL or "" for a map
 /// not wanted). Depth reads channel R or Z, normal R G B, impact R G, dirt R G B.
 /// All loaded maps must have the same size; a mismatch names both files. Each

@@ -1618,12 +1618,15 @@ static const attr_spec collider_attrs[] = {
 typedef struct ortho_attrs_def {
     char name[64];
     bool out;
+    int layers;
 } ortho_attrs_def;
 
 static const attr_spec ortho_attrs[] = {
     { "cameraName", T_NAME, offsetof(ortho_attrs_def, name),
       .size = sizeof(((ortho_attrs_def *)0)->name), .required = true },
     { "out", T_BOOL, offsetof(ortho_attrs_def, out), .range = R_FINITE },
+    // docs/design.md section 14: the crossings each texel records.
+    { "layers", T_INT, offsetof(ortho_attrs_def, layers), .lo = 1, .hi = WX_MAX_LAYERS },
 };
 
 typedef struct matrix_def {
@@ -1983,11 +1986,38 @@ static wx_result camera_output(parser *p, const xmlNode *node, ortho_def *o)
     return WX_OK;
 }
 
+/// `layers` (docs/design.md section 14) is for input cameras that bake peels:
+/// the maps a scene names hold one layer, and the mask shows the first surface
+/// the output camera sees.
+static wx_result camera_layers(parser *p, const xmlNode *node, ortho_def *o)
+{
+    const wx_scene_camera *cam = o->cam;
+    if (cam->layers <= 1) {
+        return WX_OK;
+    }
+    if (cam->is_output) {
+        return fail(p, node, WX_CAUSE_BAD_SCENE,
+                    "output camera '%s' has layers=\"%d\": layers are for input cameras (the "
+                    "mask shows the first surface the output camera sees); remove it",
+                    cam->name, cam->layers);
+    }
+    for (int k = 0; k < MAP_KINDS; ++k) {
+        if (o->map_nodes[k] != NULL) {
+            return fail(p, node, WX_CAUSE_BAD_SCENE,
+                        "camera '%s' has layers=\"%d\" and names its map files: maps given as "
+                        "files hold one layer; give it a <View> without map files so that "
+                        "bake peels %d layers",
+                        cam->name, cam->layers, cam->layers);
+        }
+    }
+    return WX_OK;
+}
+
 static wx_result parse_ortho(parser *p, const xmlNode *node, void *user)
 {
     (void)user;
     wx_scene *s = p->scene;
-    ortho_attrs_def attrs = { .out = false };
+    ortho_attrs_def attrs = { .out = false, .layers = 1 };
     wx_result r = ATTRS(ortho_attrs, &attrs, NULL);
     if (r != WX_OK) {
         return r;
@@ -2021,6 +2051,7 @@ static wx_result parse_ortho(parser *p, const xmlNode *node, void *user)
     memset(cam, 0, sizeof *cam);
     memcpy(cam->name, attrs.name, sizeof attrs.name);
     cam->is_output = attrs.out;
+    cam->layers = attrs.layers;
     cam->line = line_of(node);
     if (attrs.out) {
         s->output_index = s->camera_count;
@@ -2031,7 +2062,8 @@ static wx_result parse_ortho(parser *p, const xmlNode *node, void *user)
 
     ortho_def o = { .cam = cam };
     if ((r = CHILDREN(ortho_children, &o, NULL)) == WX_OK &&
-        (r = camera_matrices(p, node, &o)) == WX_OK && (r = camera_maps(p, node, &o)) == WX_OK) {
+        (r = camera_matrices(p, node, &o)) == WX_OK && (r = camera_maps(p, node, &o)) == WX_OK &&
+        (r = camera_layers(p, node, &o)) == WX_OK) {
         r = camera_output(p, node, &o);
     }
     for (int k = 0; k < MAP_KINDS; ++k) {

@@ -60,3 +60,27 @@ bool wx_layer_channel(char out[WX_NAME_MAX], int layer, const char *channel)
                       : snprintf(out, WX_NAME_MAX, "%s", channel);
     return n > 0 && n < WX_NAME_MAX;
 }
+
+void wx_maps_layer_view(const wx_maps *maps, int layer, wx_maps *view)
+{
+    *view = *maps;
+    view->layers = 1;
+    size_t n = (size_t)maps->width * (size_t)maps->height;
+    size_t k = (size_t)(layer > 0 && layer < wx_maps_layers(maps) ? layer : 0);
+    size_t S = (size_t)wx_maps_substances(maps);
+    // Offsets of one layer's block in each plane (model/maps.h's layout).
+#define WX_LAYER_PLANE(field, per_texel)                                                        \
+    view->field = maps->field != NULL ? maps->field + k * (per_texel) * n : NULL
+    WX_LAYER_PLANE(depth, 1);
+    WX_LAYER_PLANE(normal, 3);
+    WX_LAYER_PLANE(impact, 2);
+    WX_LAYER_PLANE(dirt, S);
+    WX_LAYER_PLANE(deposit, S);
+    WX_LAYER_PLANE(erosion, S);
+    WX_LAYER_PLANE(initial_dirt, S);
+    WX_LAYER_PLANE(hits, 1);
+    WX_LAYER_PLANE(surface, 1);
+    WX_LAYER_PLANE(area, 1);
+    WX_LAYER_PLANE(owned, 1);
+#undef WX_LAYER_PLANE
+}

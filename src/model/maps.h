@@ -27,6 +27,9 @@ typedef struct wx_maps {
     /// the solid (so n.view > 0 where the ray leaves it); with one, it faces
     /// the camera as version 2's maps do.
     int layers;
+    /// The normals point out of the solid (the maps of a layered camera and
+    /// its layer views); false: they face the camera (one layer).
+    bool outward;
     float *depth;   ///< width*height, d or +inf
     float *normal;  ///< 3*width*height, interleaved x y z, world space, unit
     float *impact;  ///< 2*width*height, interleaved absorption, bounce
@@ -89,6 +92,11 @@ static inline int wx_maps_layers(const wx_maps *maps)
 {
     return maps->layers > 1 ? maps->layers : 1;
 }
+
+/// A view of layer `layer` of `maps`: a wx_maps of one layer whose planes point
+/// into that layer's blocks (borrowed: never pass it to wx_maps_free; it lives
+/// as long as `maps`). The header attributes are shared too.
+void wx_maps_layer_view(const wx_maps *maps, int layer, wx_maps *view);
 
 /// The file channel of `channel` in layer `layer` (docs/design.md section 14):
 /// the name itself in layer 0, "layerK.NAME" in layer K >= 1. Returns false

@@ -117,15 +117,25 @@ wx_result wx_gather_frame(const wx_scene *scene, const wx_run_def *opts, const w
         masks = &own;
         r = wx_mask_context_init(scene, in_maps, false, &own, err);
     }
+    // Every layer of a camera is gathered as an input camera of its own; the
+    // derived masks' collider above reads the layers together.
+    wx_layer_scene layered;
+    memset(&layered, 0, sizeof layered);
+    if (r == WX_OK) {
+        r = wx_layer_scene_init(scene, in_maps, &layered, err);
+    }
     if (r == WX_OK && has_output) {
         int every = scene->cameras[scene->output_index].every;
         if (frame == 0 || (every > 0 && frame % every == 0)) {
-            r = write_mask(scene, opts, in_maps, given_out, masks, frame, detail, err);
+            r = write_mask(&layered.scene, opts, layered.maps, given_out, masks, frame, detail,
+                           err);
         }
     }
     if (r == WX_OK) {
-        r = wx_textures_write(scene, opts, textures, in_maps, masks, frame, detail, err);
+        r = wx_textures_write(&layered.scene, opts, textures, layered.maps, masks, frame, detail,
+                              err);
     }
+    wx_layer_scene_free(&layered);
     if (masks == &own) {
         wx_mask_context_free(&own);
     }

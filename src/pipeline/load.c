@@ -32,7 +32,7 @@ wx_result wx_load_simulation_maps(const wx_scene *scene, int threads, wx_maps *m
             // started from (channel initialDirt), so running again is repeatable.
             which |= WX_MAPS_DIRT | WX_MAPS_INITIAL_DIRT;
         }
-        wx_result r = wx_maps_load_scene(&maps[k], which, threads, scene, cam->depth_path,
+        wx_result r = wx_maps_load_layers(&maps[k], which, threads, scene, cam->layers, cam->depth_path,
                                          cam->normal_path, cam->impact_path, cam->dirt_path, err);
         if (r != WX_OK) {
             wx_error_prefix(err, "camera '%s'", cam->name);
@@ -102,7 +102,8 @@ wx_result wx_load_gather_maps(const wx_scene *scene, const wx_run_def *opts, wx_
         } else {
             which |= WX_MAPS_SIMULATED;
         }
-        wx_result r = wx_maps_load_scene(&maps[k], which, opts->threads, scene, cam->depth_path,
+        wx_result r = wx_maps_load_layers(&maps[k], which, opts->threads, scene, cam->layers,
+                                          cam->depth_path,
                                          cam->normal_path, NULL, dirt_path, err);
         if (r != WX_OK) {
             wx_error_prefix(err, "camera '%s'", cam->name);
@@ -115,4 +116,57 @@ wx_result wx_load_gather_maps(const wx_scene *scene, const wx_run_def *opts, wx_
         k++;
     }
     return WX_OK;
+}
+
+wx_result wx_layer_scene_init(const wx_scene *scene, const wx_maps *maps, wx_layer_scene *out,
+                              wx_error *err)
+{
+    memset(out, 0, sizeof *out);
+    out->scene = *scene;
+    out->maps = (wx_maps *)maps;
+    int extra = 0;
+    for (int k = 0; k < scene->input_count; ++k) {
+        extra += wx_maps_layers(&maps[k]) - 1;
+    }
+    if (extra == 0) {
+        return WX_OK;
+    }
+    int count = scene->camera_count + extra;
+    wx_scene_camera *cameras = calloc((size_t)count, sizeof *cameras);
+    wx_maps *views = calloc((size_t)(scene->input_count + extra), sizeof *views);
+    if (cameras == NULL || views == NULL) {
+        free(cameras);
+        free(views);
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (layers)");
+    }
+    int n = 0, v = 0, k = 0;
+    for (int c = 0; c < scene->camera_count; ++c) {
+        const wx_scene_camera *cam = &scene->cameras[c];
+        if (cam->is_output) {
+            out->scene.output_index = n;
+            cameras[n++] = *cam;
+            continue;
+        }
+        for (int layer = 0; layer < wx_maps_layers(&maps[k]); ++layer) {
+            cameras[n] = *cam;
+            cameras[n++].layers = 1;
+            wx_maps_layer_view(&maps[k], layer, &views[v++]);
+        }
+        k++;
+    }
+    out->scene.cameras = cameras;
+    out->scene.camera_count = n;
+    out->scene.input_count = v;
+    out->maps = views;
+    out->owned = true;
+    return WX_OK;
+}
+
+void wx_layer_scene_free(wx_layer_scene *layered)
+{
+    if (layered->owned) {
+        free(layered->scene.cameras);
+        free(layered->maps);
+    }
+    memset(layered, 0, sizeof *layered);
 }

@@ -24,4 +24,20 @@ wx_result wx_load_simulation_maps(const wx_scene *scene, int threads, wx_maps *m
 wx_result wx_load_gather_maps(const wx_scene *scene, const wx_run_def *opts, wx_maps *maps,
                               wx_error *err);
 
+/// The scene and maps as the gather reads them (docs/design.md section 14):
+/// every layer of an input camera is an input camera of its own, with the
+/// camera's matrices and a view of that layer's planes (wx_maps_layer_view),
+/// in the scene's order, layer 0 first. The cameras array is new (its strings
+/// are borrowed from `scene`); everything else is shared. When no camera has
+/// more than one layer the result is `scene` and `maps` themselves.
+typedef struct wx_layer_scene {
+    wx_scene scene;
+    wx_maps *maps;
+    bool owned; ///< the cameras and maps arrays are this struct's
+} wx_layer_scene;
+
+wx_result wx_layer_scene_init(const wx_scene *scene, const wx_maps *maps, wx_layer_scene *out,
+                              wx_error *err);
+void wx_layer_scene_free(wx_layer_scene *layered);
+
 #endif

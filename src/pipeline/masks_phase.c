@@ -41,7 +41,8 @@ wx_result wx_mask_context_init(const wx_scene *scene, const wx_maps *in_maps, bo
     wx_maps *maps = calloc((size_t)n + 1, sizeof *maps);
     size_t largest = 0;
     for (int k = 0; k < n; ++k) {
-        size_t texels = (size_t)in_maps[k].width * (size_t)in_maps[k].height;
+        size_t texels = (size_t)in_maps[k].width * (size_t)in_maps[k].height *
+                        (size_t)wx_maps_layers(&in_maps[k]);
         largest = texels > largest ? texels : largest;
     }
     ctx->zero_impact = calloc(2 * largest + 1, sizeof *ctx->zero_impact);
@@ -65,6 +66,8 @@ wx_result wx_mask_context_init(const wx_scene *scene, const wx_maps *in_maps, bo
         // The maps as the collider reads them: depth and normal borrowed.
         maps[k].width = in_maps[k].width;
         maps[k].height = in_maps[k].height;
+        maps[k].layers = in_maps[k].layers;
+        maps[k].outward = in_maps[k].outward;
         maps[k].depth = in_maps[k].depth;
         maps[k].normal = in_maps[k].normal;
         maps[k].impact = ctx->zero_impact;

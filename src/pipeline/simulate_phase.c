@@ -61,17 +61,21 @@ static void gather_planes(const wx_sim *sim, const wx_maps *m, int k, float *con
     wx_parallel_for(threads, map->height, 16, planes_rows, &job);
 }
 
-// The planes of gather_planes in one block each (dirt and initial: S planes
-// one after the other, model/maps.h), for a frame's gather; the caller frees them.
-static wx_result gather_plane_blocks(const wx_sim *sim, const wx_maps *m, int k, int threads,
+// The planes of gather_planes of input camera c's every layer in one block
+// each (dirt and initial: S planes per layer, layer after layer, model/maps.h),
+// for a frame's gather; the caller frees them.
+static wx_result gather_plane_blocks(const wx_sim *sim, const wx_maps *m, int c, int threads,
                                      float **dirt, float **initial, float **hits, wx_error *err)
 {
-    const wx_dirt_map *map = wx_sim_dirt_map(sim, k);
+    int first;
+    int layers = wx_sim_camera_views(sim, c, &first);
+    const wx_dirt_map *map = wx_sim_dirt_map(sim, first);
     size_t n = (size_t)map->width * (size_t)map->height;
     int S = map->substances;
-    *dirt = malloc(n * (size_t)S * sizeof **dirt + 1);
-    *initial = malloc(n * (size_t)S * sizeof **initial + 1);
-    *hits = malloc(n * sizeof **hits + 1);
+    size_t L = (size_t)layers;
+    *dirt = malloc(L * n * (size_t)S * sizeof **dirt + 1);
+    *initial = malloc(L * n * (size_t)S * sizeof **initial + 1);
+    *hits = malloc(L * n * sizeof **hits + 1);
     if (*dirt == NULL || *initial == NULL || *hits == NULL) {
         free(*dirt);
         free(*initial);
@@ -79,12 +83,17 @@ static wx_result gather_plane_blocks(const wx_sim *sim, const wx_maps *m, int k,
         *dirt = *initial = *hits = NULL;
         return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (dirt maps)");
     }
-    float *dirt_planes[WX_MAX_SUBSTANCES], *initial_planes[WX_MAX_SUBSTANCES];
-    for (int s = 0; s < S; ++s) {
-        dirt_planes[s] = *dirt + (size_t)s * n;
-        initial_planes[s] = *initial + (size_t)s * n;
+    for (int k = 0; k < layers; ++k) {
+        wx_maps layer;
+        wx_maps_layer_view(m, k, &layer);
+        float *dirt_planes[WX_MAX_SUBSTANCES], *initial_planes[WX_MAX_SUBSTANCES];
+        for (int s = 0; s < S; ++s) {
+            dirt_planes[s] = *dirt + ((size_t)k * (size_t)S + (size_t)s) * n;
+            initial_planes[s] = *initial + ((size_t)k * (size_t)S + (size_t)s) * n;
+        }
+        gather_planes(sim, &layer, first + k, dirt_planes, initial_planes, *hits + (size_t)k * n,
+                      threads);
     }
-    gather_planes(sim, m, k, dirt_planes, initial_planes, *hits, threads);
     return WX_OK;
 }
 
@@ -92,12 +101,15 @@ static wx_result gather_plane_blocks(const wx_sim *sim, const wx_maps *m, int k,
 // layout (model/maps.h, wx_dirt_channels): per substance the simulated amount,
 // deposit, erosion; the amounts without the particles, which a later
 // `simulate` starts from; the hits, which the gather's smoothing reads; and the
-// bake's surface and area records it carries on.
+// bake's surface and area records it carries on. Layer j >= 1 repeats them
+// as "layerJ." channels (docs/design.md section 14).
 static wx_result write_one(const wx_scene *scene, const wx_run_def *opts, const wx_sim *sim,
                            const wx_maps *maps, int k, const wx_scene_camera *cam,
                            wx_image *image, wx_error *err)
 {
-    const wx_dirt_map *map = wx_sim_dirt_map(sim, k);
+    int first;
+    int layers = wx_sim_camera_views(sim, k, &first);
+    const wx_dirt_map *map = wx_sim_dirt_map(sim, first);
     char name[300];
     snprintf(name, sizeof name, "%s_dirt.exr", cam->name);
     char path[WX_PATH_MAX];
@@ -108,41 +120,51 @@ static wx_result write_one(const wx_scene *scene, const wx_run_def *opts, const 
     char names[WX_IMAGE_MAX_CHANNELS][WX_NAME_MAX];
     const char *channels[WX_IMAGE_MAX_CHANNELS];
     int count = wx_dirt_channels(scene, true, names);
-    for (int c = 0; c < count; ++c) {
+    for (int j = 1; j < layers; ++j) {
+        for (int c = 0; c < count; ++c) {
+            wx_layer_channel(names[j * count + c], j, names[c]);
+        }
+    }
+    for (int c = 0; c < count * layers; ++c) {
         channels[c] = names[c];
     }
-    r = wx_image_alloc(image, map->width, map->height, count, channels, err);
+    r = wx_image_alloc(image, map->width, map->height, count * layers, channels, err);
     if (r != WX_OK) {
         wx_image_free(image);
         return r;
     }
     size_t n = (size_t)map->width * (size_t)map->height;
     int S = map->substances;
-    // The simulated planes straight into the image's channels.
-    float *dirt[WX_MAX_SUBSTANCES], *initial[WX_MAX_SUBSTANCES];
-    for (int s = 0; s < S; ++s) {
-        dirt[s] = image->channels[3 * s];
-        initial[s] = image->channels[3 * S + s];
-    }
-    gather_planes(sim, maps, k, dirt, initial, image->channels[4 * S], opts->threads);
-    for (int s = 0; s < S; ++s) {
-        size_t plane = (size_t)s * n;
-        if (maps->deposit != NULL) {
-            memcpy(image->channels[3 * s + 1], maps->deposit + plane, n * sizeof(float));
+    for (int j = 0; j < layers; ++j) {
+        wx_maps layer;
+        wx_maps_layer_view(maps, j, &layer);
+        float *const *ch = image->channels + (size_t)j * (size_t)count;
+        // The simulated planes straight into the image's channels.
+        float *dirt[WX_MAX_SUBSTANCES], *initial[WX_MAX_SUBSTANCES];
+        for (int s = 0; s < S; ++s) {
+            dirt[s] = ch[3 * s];
+            initial[s] = ch[3 * S + s];
         }
-        if (maps->erosion != NULL) {
-            memcpy(image->channels[3 * s + 2], maps->erosion + plane, n * sizeof(float));
+        gather_planes(sim, &layer, first + j, dirt, initial, ch[4 * S], opts->threads);
+        for (int s = 0; s < S; ++s) {
+            size_t plane = (size_t)s * n;
+            if (layer.deposit != NULL) {
+                memcpy(ch[3 * s + 1], layer.deposit + plane, n * sizeof(float));
+            }
+            if (layer.erosion != NULL) {
+                memcpy(ch[3 * s + 2], layer.erosion + plane, n * sizeof(float));
+            }
         }
-    }
-    int next = 4 * S + 1;
-    if (next < count && strcmp(names[next], WX_SURFACE_CHANNEL) == 0) {
-        if (maps->surface != NULL) {
-            memcpy(image->channels[next], maps->surface, n * sizeof(float));
+        int next = 4 * S + 1;
+        if (next < count && strcmp(names[next], WX_SURFACE_CHANNEL) == 0) {
+            if (layer.surface != NULL) {
+                memcpy(ch[next], layer.surface, n * sizeof(float));
+            }
+            next++;
         }
-        next++;
-    }
-    if (next < count && strcmp(names[next], WX_AREA_CHANNEL) == 0 && maps->area != NULL) {
-        memcpy(image->channels[next], maps->area, n * sizeof(float));
+        if (next < count && strcmp(names[next], WX_AREA_CHANNEL) == 0 && layer.area != NULL) {
+            memcpy(ch[next], layer.area, n * sizeof(float));
+        }
     }
     // The input dirt map's header travels with it (kept when the map was read).
     for (int a = 0; a < maps->dirt_attr_count && image->attr_count < WX_IMAGE_MAX_ATTRS; ++a) {
@@ -174,7 +196,7 @@ static wx_result write_frame(const wx_scene *scene, const wx_run_def *opts, cons
                              const wx_textures *textures, wx_mask_context *masks, int frame,
                              wx_error *err)
 {
-    int n = wx_sim_input_count(sim);
+    int n = scene->input_count;
     wx_maps *view = calloc((size_t)n + 1, sizeof *view);
     if (view == NULL) {
         return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (frame)");
@@ -184,6 +206,7 @@ static wx_result write_frame(const wx_scene *scene, const wx_run_def *opts, cons
         view[c].width = maps[c].width;
         view[c].height = maps[c].height;
         view[c].substances = maps[c].substances;
+        view[c].layers = maps[c].layers;
         view[c].depth = maps[c].depth;
         view[c].normal = maps[c].normal;
         r = gather_plane_blocks(sim, &maps[c], c, opts->threads, &view[c].dirt,
@@ -285,7 +308,7 @@ wx_result wx_simulate_maps(const wx_scene *scene, const wx_run_def *opts, wx_map
     // What the gather reads, as the written maps hold it (float): the dirt, the
     // amounts without the particles and the hits; the planes only the
     // simulation needed released.
-    for (int c = 0; c < wx_sim_input_count(sim) && r == WX_OK; ++c) {
+    for (int c = 0; c < scene->input_count && r == WX_OK; ++c) {
         wx_maps *m = &maps[c];
         float *dirt = NULL, *initial = NULL, *hits = NULL;
         r = gather_plane_blocks(sim, m, c, opts->threads, &dirt, &initial, &hits, err);

@@ -54,7 +54,7 @@ typedef struct sim_event {
     uint32_t texel; ///< hit texel
     uint32_t from;  ///< previous slide texel (EVENT_LINE)
     float point[3];
-    uint8_t camera;
+    uint16_t camera; ///< the view (camera and layer) whose dirt map holds the texel
     uint8_t flags;
 } sim_event;
 
@@ -114,8 +114,15 @@ struct wx_sim {
     wx_collider collider;
     int input_count;
     int *input_camera; ///< scene camera index of each input camera
-    const wx_maps *maps;
-    wx_dirt_map *dirt;
+    const wx_maps *maps; ///< per input camera, every layer (the collider's)
+    /// Views: one per layer of each input camera, camera by camera (layer k of
+    /// input camera c is view view_base[c] + k; docs/design.md section 14).
+    /// Every array below that is "per view" is indexed by them; with one layer
+    /// a camera's view is the camera.
+    int view_count;
+    int view_base[WX_MAX_INPUT_CAMERAS + 1];
+    wx_maps *views; ///< borrowed layer views of `maps` (wx_maps_layer_view)
+    wx_dirt_map *dirt; ///< per view
     int substances;     ///< loads per particle, substances per texel
     /// Ageing (docs/design.md section 9): per input camera, the amounts the
     /// surface would hold without the particles, aged like the real ones
@@ -127,9 +134,9 @@ struct wx_sim {
     const wx_surface **surfaces; ///< the scene's <Surface>s by global index (the rules')
     int64_t iterations_done;
     int camera_order[WX_MAX_INPUT_CAMERAS]; ///< coarse test order (speed only)
-    /// Texel numbering for the particles' last slide: input camera c's texel t
-    /// is slide_base[c] + t; slide_base[input_count] is the total.
-    uint32_t slide_base[WX_MAX_INPUT_CAMERAS + 1];
+    /// Texel numbering for the particles' last slide: view v's texel t is
+    /// slide_base[v] + t; slide_base[view_count] is the total.
+    uint32_t slide_base[WX_MAX_INPUT_CAMERAS * WX_MAX_LAYERS + 1];
     // State.
     int64_t step;
     wx_particles particles;
@@ -225,6 +232,7 @@ static void collide_one(wx_sim *sim, sim_worker *w, int64_t i, const float p0[3]
 {
     wx_particles *P = &sim->particles;
     wx_hit hit;
+    hit.layer = 0;
     if (!wx_collider_sweep(&sim->collider, p0, p1, &hit)) {
         // The Euler step stands (already stored); a step without a hit ends a streak.
         P->last_slide[i] = WX_NO_SLIDE;
@@ -248,15 +256,16 @@ static void collide_one(wx_sim *sim, sim_worker *w, int64_t i, const float p0[3]
     sim_event e = { 0 };
     e.index = i;
     e.texel = hit.texel;
-    e.camera = (uint8_t)hit.camera;
+    int view = sim->view_base[hit.camera] + hit.layer;
+    e.camera = (uint16_t)view;
     e.flags = (uint8_t)kind;
     memcpy(e.point, hit.point, sizeof e.point);
     // Streaks: a slide that follows a slide of the previous step on the same map
     // (last_slide is reset in every step without a hit; unsigned arithmetic puts
     // another map's texels and WX_NO_SLIDE out of range).
-    uint32_t base = sim->slide_base[hit.camera];
+    uint32_t base = sim->slide_base[view];
     uint32_t from = P->last_slide[i] - base;
-    if (kind == WX_IMPACT_SLIDE && from < sim->slide_base[hit.camera + 1] - base) {
+    if (kind == WX_IMPACT_SLIDE && from < sim->slide_base[view + 1] - base) {
         e.flags |= EVENT_LINE;
         e.from = from;
     }
@@ -757,7 +766,7 @@ static void age(wx_sim *sim)
     const wx_surface **by_index = sim->surfaces;
     const int known = wx_scene_surface_count(scene);
     int S = sim->substances;
-    for (int c = 0; c < sim->input_count; ++c) {
+    for (int c = 0; c < sim->view_count; ++c) {
         wx_dirt_map *map = &sim->dirt[c];
         size_t n = (size_t)map->width * (size_t)map->height;
         const float *depth = map->depth;
@@ -846,14 +855,24 @@ static wx_result start_pool(wx_sim *sim, wx_error *err)
     return WX_OK;
 }
 
-// Input camera c's ageing state: the baseline (amounts without the particles)
+// The input camera of view v.
+static int view_camera(const wx_sim *sim, int v)
+{
+    int c = 0;
+    while (c + 1 < sim->input_count && sim->view_base[c + 1] <= v) {
+        c++;
+    }
+    return c;
+}
+
+// View c's ageing state: the baseline (amounts without the particles)
 // when the scene has rules, and the area Grow multiplies: the bake's record of
 // the area the camera owns or, for maps the bake did not write, the area every
 // surface texel covers (texel area / |N.view|, clamped as the bake clamps it).
 static wx_result setup_ageing(wx_sim *sim, int c, wx_error *err)
 {
     const wx_scene *scene = sim->scene;
-    const wx_maps *m = &sim->maps[c];
+    const wx_maps *m = &sim->views[c];
     size_t n = (size_t)m->width * (size_t)m->height;
     int S = sim->substances;
     sim->surface_of[c] = m->surface;
@@ -878,7 +897,7 @@ static wx_result setup_ageing(wx_sim *sim, int c, wx_error *err)
     if (area == NULL) {
         return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (ageing)");
     }
-    const wx_camera *cam = &scene->cameras[sim->input_camera[c]].camera;
+    const wx_camera *cam = &scene->cameras[sim->input_camera[view_camera(sim, c)]].camera;
     float view[3], fw, fh;
     wx_camera_view_dir(cam, view);
     wx_camera_frame_size(cam, &fw, &fh);
@@ -952,13 +971,25 @@ wx_result wx_sim_create(const wx_scene *scene, const wx_sim_def *config, wx_sim 
     sim->maps = config->maps;
     wx_camera *cameras = NULL;
     if (r == WX_OK) {
+        for (int c = 0; c < sim->input_count; ++c) {
+            sim->view_base[c] = sim->view_count;
+            sim->view_count += wx_maps_layers(&sim->maps[c]);
+        }
+        sim->view_base[sim->input_count] = sim->view_count;
+        int V = sim->view_count;
         cameras = calloc((size_t)(sim->input_count + 1), sizeof *cameras);
-        sim->dirt = calloc((size_t)(sim->input_count + 1), sizeof *sim->dirt);
-        sim->baseline = calloc((size_t)(sim->input_count + 1), sizeof *sim->baseline);
-        sim->grow_area = calloc((size_t)(sim->input_count + 1), sizeof *sim->grow_area);
-        sim->surface_of = calloc((size_t)(sim->input_count + 1), sizeof *sim->surface_of);
+        sim->views = calloc((size_t)(V + 1), sizeof *sim->views);
+        sim->dirt = calloc((size_t)(V + 1), sizeof *sim->dirt);
+        sim->baseline = calloc((size_t)(V + 1), sizeof *sim->baseline);
+        sim->grow_area = calloc((size_t)(V + 1), sizeof *sim->grow_area);
+        sim->surface_of = calloc((size_t)(V + 1), sizeof *sim->surface_of);
         sim->surfaces = wx_scene_surfaces_by_index(scene);
-        if (cameras == NULL || sim->dirt == NULL || sim->baseline == NULL ||
+        for (int c = 0; sim->views != NULL && c < sim->input_count; ++c) {
+            for (int k = 0; k < wx_maps_layers(&sim->maps[c]); ++k) {
+                wx_maps_layer_view(&sim->maps[c], k, &sim->views[sim->view_base[c] + k]);
+            }
+        }
+        if (cameras == NULL || sim->views == NULL || sim->dirt == NULL || sim->baseline == NULL ||
             sim->grow_area == NULL || sim->surface_of == NULL || sim->surfaces == NULL) {
             r = wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (simulation)");
         }
@@ -973,9 +1004,9 @@ wx_result wx_sim_create(const wx_scene *scene, const wx_sim_def *config, wx_sim 
     free(cameras);
     if (r == WX_OK) {
         uint64_t total = 0;
-        for (int c = 0; c < sim->input_count; ++c) {
+        for (int c = 0; c < sim->view_count; ++c) {
             sim->slide_base[c] = (uint32_t)total;
-            total += (uint64_t)sim->maps[c].width * (uint64_t)sim->maps[c].height;
+            total += (uint64_t)sim->views[c].width * (uint64_t)sim->views[c].height;
             if (total >= WX_NO_SLIDE) {
                 r = wx_fail(err, WX_CAUSE_MAP_SIZE,
                             "the input maps hold %llu texels or more in all (the "
@@ -984,20 +1015,25 @@ wx_result wx_sim_create(const wx_scene *scene, const wx_sim_def *config, wx_sim 
                 break;
             }
         }
-        sim->slide_base[sim->input_count] = (uint32_t)total;
+        sim->slide_base[sim->view_count] = (uint32_t)total;
     }
-    for (int c = 0; r == WX_OK && c < sim->input_count; ++c) {
-        const wx_maps *m = &sim->maps[c];
+    for (int c = 0; r == WX_OK && c < sim->view_count; ++c) {
+        const wx_maps *m = &sim->views[c];
         if (wx_maps_substances(m) != sim->substances) {
             r = wx_fail(err, WX_CAUSE_BAD_ARGUMENT,
                         "simulation: the maps of camera '%s' hold %d substances, the scene %d",
-                        scene->cameras[sim->input_camera[c]].name, wx_maps_substances(m),
+                        scene->cameras[sim->input_camera[view_camera(sim, c)]].name,
+                        wx_maps_substances(m),
                         sim->substances);
             break;
         }
         r = wx_dirt_map_init(&sim->dirt[c], m->width, m->height, sim->substances, m->dirt,
                              m->deposit, m->erosion, scene->collider.deposit,
-                             scene->collider.erosion, sim->collider.cameras[c].depth, err);
+                             scene->collider.erosion,
+                             sim->views[c].layers == 1 && sim->maps[view_camera(sim, c)].layers <= 1
+                                 ? sim->collider.cameras[view_camera(sim, c)].depth
+                                 : m->depth,
+                             err);
         if (r == WX_OK) {
             for (int s = 0; s < sim->substances; ++s) {
                 sim->stats.substance[s].initial_surface += wx_dirt_map_total(&sim->dirt[c], s);
@@ -1034,20 +1070,21 @@ void wx_sim_destroy(wx_sim *sim)
     }
     free(sim->chunks);
     if (sim->dirt != NULL) {
-        for (int c = 0; c < sim->input_count; ++c) {
+        for (int c = 0; c < sim->view_count; ++c) {
             wx_dirt_map_free(&sim->dirt[c]);
         }
         free(sim->dirt);
     }
-    for (int c = 0; c < sim->input_count; ++c) {
+    for (int c = 0; c < sim->view_count; ++c) {
         if (sim->baseline != NULL) {
             free(sim->baseline[c]);
         }
         if (sim->grow_area != NULL && sim->grow_area[c] != NULL &&
-            sim->grow_area[c] != sim->maps[c].area) {
+            (sim->views == NULL || sim->grow_area[c] != sim->views[c].area)) {
             free(sim->grow_area[c]);
         }
     }
+    free(sim->views);
     free(sim->baseline);
     free(sim->grow_area);
     free(sim->surface_of);
@@ -1117,7 +1154,7 @@ void wx_sim_get_stats(const wx_sim *sim, wx_sim_stats *stats)
     for (int s = 0; s < S; ++s) {
         wx_substance_ledger *l = &stats->substance[s];
         l->final_surface = 0.0;
-        for (int c = 0; c < sim->input_count; ++c) {
+        for (int c = 0; c < sim->view_count; ++c) {
             l->final_surface += wx_dirt_map_total(&sim->dirt[c], s);
         }
         l->in_flight = 0.0;
@@ -1146,7 +1183,22 @@ const double *wx_sim_baseline(const wx_sim *sim, int input)
 
 int wx_sim_input_count(const wx_sim *sim)
 {
-    return sim->input_count;
+    return sim->view_count;
+}
+
+int wx_sim_camera_views(const wx_sim *sim, int camera, int *first)
+{
+    *first = sim->view_base[camera];
+    return sim->view_base[camera + 1] - sim->view_base[camera];
+}
+
+int wx_sim_view_camera(const wx_sim *sim, int view, int *layer)
+{
+    int c = view_camera(sim, view);
+    if (layer != NULL) {
+        *layer = view - sim->view_base[c];
+    }
+    return c;
 }
 
 const wx_dirt_map *wx_sim_dirt_map(const wx_sim *sim, int input)

@@ -83,7 +83,7 @@ typedef enum wx_impact {
 /// A recent collision, for drawing.
 typedef struct wx_hit_sample {
     float position[3]; ///< where the particle entered the surface
-    int camera;        ///< input camera index (0 = first input camera of the scene)
+    int camera;        ///< view index (wx_sim_view_camera: input camera and layer)
     wx_impact impact;
 } wx_hit_sample;
 
@@ -104,9 +104,18 @@ int64_t wx_sim_iterations_done(const wx_sim *sim);
 /// initial amounts are that).
 const double *wx_sim_baseline(const wx_sim *sim, int input);
 
-/// Input cameras and their dirt (index 0 = the scene's first input camera).
+/// The views and their dirt: one view per layer of each input camera, camera
+/// by camera, layer 0 first (docs/design.md section 14); with one layer per
+/// camera, view k is the scene's k-th input camera.
 int wx_sim_input_count(const wx_sim *sim);
 const wx_dirt_map *wx_sim_dirt_map(const wx_sim *sim, int input);
+
+/// The views of input camera `camera` (0 = the scene's first): how many (its
+/// layers), the first in *first.
+int wx_sim_camera_views(const wx_sim *sim, int camera, int *first);
+
+/// The input camera (0 = the scene's first) of view `view`, and its layer.
+int wx_sim_view_camera(const wx_sim *sim, int view, int *layer);
 
 /// Adds one particle by hand (the tests and bench_simulate) carrying `load` of the first
 /// substance: it counts as emitted. Its random stream is that of a
