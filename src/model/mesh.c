@@ -635,3 +635,78 @@ done:
     free(pid);
     return r;
 }
+
+int wx_mesh_depth_complexity(const wx_mesh_data *mesh, const double axis[3], int grid)
+{
+    if (mesh->triangle_count <= 0 || mesh->positions == NULL || grid < 1) {
+        return 0;
+    }
+    // A basis (a, b) of the plane across the axis.
+    double helper[3] = { 1.0, 0.0, 0.0 };
+    if (fabs(axis[0]) > 0.9) {
+        helper[0] = 0.0;
+        helper[1] = 1.0;
+    }
+    double a[3] = { axis[1] * helper[2] - axis[2] * helper[1],
+                    axis[2] * helper[0] - axis[0] * helper[2],
+                    axis[0] * helper[1] - axis[1] * helper[0] };
+    double al = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+    for (int k = 0; k < 3; ++k) {
+        a[k] /= al;
+    }
+    double b[3] = { axis[1] * a[2] - axis[2] * a[1], axis[2] * a[0] - axis[0] * a[2],
+                    axis[0] * a[1] - axis[1] * a[0] };
+    double lo[2] = { INFINITY, INFINITY }, hi[2] = { -INFINITY, -INFINITY };
+    for (int64_t v = 0; v < mesh->vertex_count; ++v) {
+        const float *p = &mesh->positions[3 * v];
+        double x = p[0] * a[0] + p[1] * a[1] + p[2] * a[2];
+        double y = p[0] * b[0] + p[1] * b[1] + p[2] * b[2];
+        lo[0] = fmin(lo[0], x);
+        hi[0] = fmax(hi[0], x);
+        lo[1] = fmin(lo[1], y);
+        hi[1] = fmax(hi[1], y);
+    }
+    double cell[2] = { (hi[0] - lo[0]) / grid, (hi[1] - lo[1]) / grid };
+    if (!(cell[0] > 0.0) || !(cell[1] > 0.0)) {
+        return 1; // a flat mesh seen edge-on, or a single point
+    }
+    uint16_t *count = calloc((size_t)grid * (size_t)grid, sizeof *count);
+    if (count == NULL) {
+        return -1;
+    }
+    // Ray (i, j) passes through lo + (i + f, j + f) * cell; f off one half so
+    // that the rays miss the edges a regular mesh puts on the cells' centres.
+    const double f = 0.5 + 0.0137;
+    int most = 0;
+    for (int64_t t = 0; t < mesh->triangle_count; ++t) {
+        double x[3], y[3];
+        for (int k = 0; k < 3; ++k) {
+            const float *p = &mesh->positions[3 * (size_t)mesh->indices[3 * t + k]];
+            x[k] = (p[0] * a[0] + p[1] * a[1] + p[2] * a[2] - lo[0]) / cell[0] - f;
+            y[k] = (p[0] * b[0] + p[1] * b[1] + p[2] * b[2] - lo[1]) / cell[1] - f;
+        }
+        double area = (x[1] - x[0]) * (y[2] - y[0]) - (x[2] - x[0]) * (y[1] - y[0]);
+        if (!(fabs(area) > 0.0)) {
+            continue; // edge-on: no ray crosses it
+        }
+        int i0 = (int)fmax(0.0, ceil(fmin(x[0], fmin(x[1], x[2]))));
+        int i1 = (int)fmin(grid - 1.0, floor(fmax(x[0], fmax(x[1], x[2]))));
+        int j0 = (int)fmax(0.0, ceil(fmin(y[0], fmin(y[1], y[2]))));
+        int j1 = (int)fmin(grid - 1.0, floor(fmax(y[0], fmax(y[1], y[2]))));
+        double s = area > 0.0 ? 1.0 : -1.0;
+        for (int j = j0; j <= j1; ++j) {
+            for (int i = i0; i <= i1; ++i) {
+                double e0 = s * ((x[1] - x[0]) * (j - y[0]) - (i - x[0]) * (y[1] - y[0]));
+                double e1 = s * ((x[2] - x[1]) * (j - y[1]) - (i - x[1]) * (y[2] - y[1]));
+                double e2 = s * ((x[0] - x[2]) * (j - y[2]) - (i - x[2]) * (y[0] - y[2]));
+                if (e0 >= 0.0 && e1 >= 0.0 && e2 >= 0.0) {
+                    uint16_t *c = &count[(size_t)j * (size_t)grid + (size_t)i];
+                    *c = *c < UINT16_MAX ? (uint16_t)(*c + 1) : *c;
+                    most = *c > most ? *c : most;
+                }
+            }
+        }
+    }
+    free(count);
+    return most;
+}

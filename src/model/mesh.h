@@ -47,6 +47,12 @@ void wx_mesh_data_release_arrays(wx_mesh_data *mesh);
 /// Frees everything; the struct is zeroed.
 void wx_mesh_data_free(wx_mesh_data *mesh);
 
+/// The depth complexity of the mesh seen along `axis` (a unit vector): the
+/// most triangles any ray parallel to it crosses, over a grid x grid lattice
+/// of rays spanning the mesh's outline (docs/cameras.md, "Layers"). 0 for no
+/// triangles; -1 when out of memory. What `init` sizes its cameras' layers by.
+int wx_mesh_depth_complexity(const wx_mesh_data *mesh, const double axis[3], int grid);
+
 /// Phong tessellation's shape factor: 1/2 makes the curve along an edge leave
 /// each end in the tangent plane its vertex normal gives (for a circle's chord
 /// the exact quadratic; 3/4, the paper's choice for looks, leaves half the

@@ -169,21 +169,27 @@ void wx_memory_estimate_geometry(const wx_scene *scene, unsigned phases,
     for (int c = 0; c < scene->camera_count; ++c) {
         const wx_scene_camera *sc = &scene->cameras[c];
         double texels = (double)sc->camera.width * (double)sc->camera.height;
+        // Every layer of an input camera (docs/design.md section 14) is a map
+        // of its own for the bake's images, the simulation and the gather.
+        double layers = !sc->is_output && sc->layers > 1 ? (double)sc->layers : 1.0;
         if (sc->is_output) {
             output_texels = texels;
         } else {
-            input_texels += texels;
-            largest_input = fmax(largest_input, texels);
+            input_texels += layers * texels;
+            largest_input = fmax(largest_input, layers * texels);
         }
         if (texels > largest) {
             largest = texels;
             need->camera_line = sc->line;
         }
         if (bake && sc->has_view && !wx_has_path(sc->depth_path)) {
-            framebuffer = fmax(framebuffer, WX_BAKE_FRAMEBUFFER_BYTES_PER_TEXEL * texels);
-            images = fmax(images, texels * (sc->is_output ? WX_BAKE_OUTPUT_IMAGE_BYTES_PER_TEXEL
-                                                          : input_image));
-            baked_inputs += sc->is_output ? 0.0 : texels;
+            // Peeling reads the previous layer's depth from a texture.
+            framebuffer = fmax(framebuffer, (WX_BAKE_FRAMEBUFFER_BYTES_PER_TEXEL +
+                                             (layers > 1.0 ? 8.0 : 0.0)) * texels);
+            images = fmax(images, layers * texels *
+                                      (sc->is_output ? WX_BAKE_OUTPUT_IMAGE_BYTES_PER_TEXEL
+                                                     : input_image));
+            baked_inputs += sc->is_output ? 0.0 : layers * texels;
         }
     }
     if (bake) {

@@ -125,20 +125,39 @@ static void put(text *t, const char *fmt, ...)
 // a frame of `w` x `h` at `texel` world units a texel.
 static void camera(text *t, const char *name, const double c[3], const double axis[3],
                    const double up[3], double distance, double w, double h, double texel,
-                   bool out, int out_px)
+                   bool out, int out_px, int layers)
 {
     int pw = out ? out_px : (int)fmin(16384.0, fmax(16.0, ceil(w / texel)));
     int ph = out ? out_px : (int)fmin(16384.0, fmax(16.0, ceil(h / texel)));
+    char extra[32] = "";
+    if (out) {
+        snprintf(extra, sizeof extra, " out=\"true\"");
+    } else if (layers > 1) {
+        snprintf(extra, sizeof extra, " layers=\"%d\"", layers);
+    }
     put(t,
         "      <Ortho cameraName=\"%s\"%s>\n"
         "        <View eye=\"%.9g %.9g %.9g\" target=\"%.9g %.9g %.9g\" up=\"%.6g %.6g %.6g\" "
         "width=\"%.9g\" height=\"%.9g\" resolution=\"%d %d\"/>\n",
-        name, out ? " out=\"true\"" : "", c[0] + axis[0] * distance, c[1] + axis[1] * distance,
+        name, extra, c[0] + axis[0] * distance, c[1] + axis[1] * distance,
         c[2] + axis[2] * distance, c[0], c[1], c[2], up[0], up[1], up[2], w, h, pw, ph);
     if (out) {
         put(t, "        <OutputMap file=\"mask.exr\"/>\n");
     }
     put(t, "      </Ortho>\n");
+}
+
+// The layers init gives a camera looking along `axis`: the mesh's depth
+// complexity along it (wx_mesh_depth_complexity over a LAYER_GRID lattice),
+// at least 1 and at most INIT_LAYERS. A convex closed mesh needs 2 (its front
+// and its back, so the space behind it is free); a house with a roof overhang
+// and sills 4 or more.
+enum { INIT_LAYERS = 4, LAYER_GRID = 128 };
+
+static int init_layers(const wx_mesh_data *mesh, const double axis[3])
+{
+    int k = wx_mesh_depth_complexity(mesh, axis, LAYER_GRID);
+    return k < 1 ? (k < 0 ? INIT_LAYERS : 1) : k > INIT_LAYERS ? INIT_LAYERS : k;
 }
 
 // ---------------------------------------------------------------------------
@@ -717,13 +736,22 @@ static wx_result generate(const wx_init_def *def, const preset *p, int pi,
     double d = 2.0 * (size + 2.0 * margin);
     static const double Y[3] = { 0, 1, 0 }, NZ[3] = { 0, 0, -1 }, PZ[3] = { 0, 0, 1 };
     const double fx = ext[0] + 2 * margin, fy = ext[1] + 2 * margin, fz = ext[2] + 2 * margin;
-    camera(&t, "front", c, (const double[3]){ 0, 0, 1 }, Y, d, fx, fy, in_texel, false, 0);
-    camera(&t, "back", c, (const double[3]){ 0, 0, -1 }, Y, d, fx, fy, in_texel, false, 0);
-    camera(&t, "left", c, (const double[3]){ -1, 0, 0 }, Y, d, fz, fy, in_texel, false, 0);
-    camera(&t, "right", c, (const double[3]){ 1, 0, 0 }, Y, d, fz, fy, in_texel, false, 0);
-    camera(&t, "top", c, Y, NZ, d, fx, fz, in_texel, false, 0);
+    // Layers (docs/cameras.md, "Layers"): as many as the rays along each
+    // axis cross surfaces, at most INIT_LAYERS.
+    static const double X[3] = { 1, 0, 0 }, Z[3] = { 0, 0, 1 };
+    const int lz = init_layers(mesh, Z), lx = init_layers(mesh, X), ly = init_layers(mesh, Y);
+    put(&t,
+        "      <!-- Layers: the surfaces a ray along the camera's axis crosses, at most %d\n"
+        "           (the mesh's depth complexity along z, x, y: %d, %d, %d). -->\n",
+        INIT_LAYERS, lz, lx, ly);
+    camera(&t, "front", c, (const double[3]){ 0, 0, 1 }, Y, d, fx, fy, in_texel, false, 0, lz);
+    camera(&t, "back", c, (const double[3]){ 0, 0, -1 }, Y, d, fx, fy, in_texel, false, 0, lz);
+    camera(&t, "left", c, (const double[3]){ -1, 0, 0 }, Y, d, fz, fy, in_texel, false, 0, lx);
+    camera(&t, "right", c, (const double[3]){ 1, 0, 0 }, Y, d, fz, fy, in_texel, false, 0, lx);
+    camera(&t, "top", c, Y, NZ, d, fx, fz, in_texel, false, 0, ly);
     if (p->bottom) {
-        camera(&t, "bottom", c, (const double[3]){ 0, -1, 0 }, PZ, d, fx, fz, in_texel, false, 0);
+        camera(&t, "bottom", c, (const double[3]){ 0, -1, 0 }, PZ, d, fx, fz, in_texel, false, 0,
+               ly);
     }
     // The output camera looks at the side the particles come at: against their
     // velocity where they reach the mesh (the wind's side; the front right
@@ -750,7 +778,7 @@ static wx_result generate(const wx_init_def *def, const preset *p, int pi,
         "      <!-- The output camera: a three-quarter view of the side the particles come at,\n"
         "           from azimuth %.0f degrees (from +X towards +Z), %.0f degrees up. -->\n",
         atan2(hz, hx) / DEG, elevation);
-    camera(&t, "shot", c, q, Y, d, diag, diag, texel, true, R);
+    camera(&t, "shot", c, q, Y, d, diag, diag, texel, true, R, 1);
     put(&t, "    </ProjectedMaps>\n  </Collider>\n");
     if (pi == PRESET_MOSS) {
         put(&t,
