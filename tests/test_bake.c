@@ -1382,6 +1382,79 @@ TEST(layers_share_initial_dirt_with_other_cameras)
     scene_end(&s);
 }
 
+TEST(layers_hold_every_substance_the_surface_and_the_area)
+{
+    // Two substances, a <Surface> with rules of its own (so the surface record)
+    // and a Grow (so Grow's area): each layer of the box carries them all,
+    // named "layer1.water.amount"... .
+    char dir[4200];
+    snprintf(dir, sizeof dir, "%s/layers_substances", ensure_tmpdir());
+    mkdir(dir, 0777);
+    char *box = ensure_read_file(data_path("bake_box.obj"));
+    ensure_write_file(dir, "box.obj", box != NULL ? box : "");
+    free(box);
+    const char *path = ensure_write_file(
+        dir, "scene.xml",
+        "<?xml version=\"1.0\"?>\n<Weathering>\n"
+        "  <Substances><Substance name=\"water\"/><Substance name=\"dirt\"/></Substances>\n"
+        "  <Collider><ProjectedMaps>\n"
+        "    <Ortho cameraName=\"front\"><View eye=\"0 0 5\" target=\"0 0 0\" up=\"0 1 0\" "
+        "width=\"4\" height=\"4\" resolution=\"64\"/></Ortho>\n"
+        "    <Ortho cameraName=\"shot\" out=\"true\"><View eye=\"0 0 5\" target=\"0 0 0\" "
+        "up=\"0 1 0\" width=\"4\" height=\"4\" resolution=\"32\"/>\n"
+        "      <OutputMap file=\"mask.exr\" width=\"32\" height=\"32\"/></Ortho>\n"
+        "  </ProjectedMaps></Collider>\n"
+        "  <Geometry><Mesh file=\"box.obj\">\n"
+        "    <Surface material=\"*\" absorption=\"0.25\" bounce=\"0.5\" dirt=\"2\" deposit=\"0.75\" "
+        "erosion=\"0.125\">\n"
+        "      <Exchange substance=\"water\" initial=\"3\" deposit=\"0.5\" erosion=\"0.25\"/>\n"
+        "      <Grow substance=\"water\" amount=\"0.1\"/>\n"
+        "    </Surface>\n"
+        "  </Mesh></Geometry>\n</Weathering>\n");
+    wx_scene s;
+    wx_error err = { 0 };
+    wx_result r = wx_scene_load(path, &s, &err);
+    if (r != WX_OK) {
+        fprintf(stderr, "%s\n", err.message);
+    }
+    ENSURE(r == WX_OK);
+    s.cameras[0].layers = 2; // the scene file's attribute is not read yet
+    wx_run_def o;
+    options_for(&o, "layers_substances");
+    r = wx_bake_scene(&s, &o, &err);
+    if (r != WX_OK) {
+        fprintf(stderr, "%s\n", err.message);
+    }
+    ENSURE(r == WX_OK);
+    static const char *const names[] = { "water.amount", "water.deposit", "water.erosion",
+                                         "dirt.amount",  "dirt.deposit",  "dirt.erosion",
+                                         "surface",      "area" };
+    const double texel_area = (4.0 / 64) * (4.0 / 64);
+    const double want[] = { 3 * texel_area, 0.5, 0.25, 2 * texel_area, 0.75, 0.125, 1,
+                            texel_area };
+    for (int l = 0; l < 2; ++l) {
+        char layered[8][WX_NAME_MAX];
+        const char *wanted[8];
+        for (int k = 0; k < 8; ++k) {
+            ENSURE(wx_layer_channel(layered[k], l, names[k]));
+            wanted[k] = layered[k];
+        }
+        wx_image dirt;
+        r = wx_exr_read(s.cameras[0].dirt_path, wanted, 8, &dirt, &err);
+        if (r != WX_OK) {
+            fprintf(stderr, "%s\n", err.message);
+        }
+        ENSURE(r == WX_OK);
+        for (int k = 0; k < 8; ++k) {
+            ENSURE_NEAR(at(&dirt, k, 32, 32), want[k], 1e-6);
+            ENSURE(at(&dirt, k, 5, 32) == 0.0f); // background
+        }
+        ENSURE_NEAR(plane_sum(&dirt, 0), 3 * 4.0, 1e-4);
+        wx_image_free(&dirt);
+    }
+    scene_end(&s);
+}
+
 int main(void)
 {
     RUN(sphere_depth_and_normal);
@@ -1409,5 +1482,6 @@ int main(void)
     RUN(layers_sill_underside_points_down);
     RUN(layers_one_is_today_and_layer_zero_of_four_matches_it);
     RUN(layers_share_initial_dirt_with_other_cameras);
+    RUN(layers_hold_every_substance_the_surface_and_the_area);
     return ensure_summary();
 }
