@@ -1,9 +1,16 @@
 // bake_frag.glsl: the four maps of docs/design.md section 2 in one pass (src/raster/bake.c).
-//   attachment 0 (RGBA32F): d, world normal x y z (unit, facing the camera)
+//   attachment 0 (RGBA32F): d, world normal x y z (unit, facing the camera; for
+//                           a layered camera the mesh's own, out of the solid)
 //   attachment 1 (RGBA32F): absorption, bounce, deposit, erosion
 //   attachment 2 (RG32F):   initial dirt density per square metre, <Surface> index + 1
 // d is computed here from the interpolated position, in float, not read back
 // from the depth buffer.
+//
+// Depth peeling (docs/design.md section 14): for layer k >= 1 of a layered
+// camera, u_previous holds layer k-1's attachment 0, and a fragment no farther
+// than that layer's d (plus a rounding margin) at its texel is discarded, so
+// the depth test keeps the next crossing behind it. A texel with no crossing
+// left keeps the background.
 #version 450 core
 
 in vec3 v_position;
@@ -14,6 +21,9 @@ flat in vec3 v_material_b; // erosion, vertex colour use, surface index + 1
 
 uniform vec4 u_depth_row;  // d = dot(position, xyz) + w
 uniform vec3 u_view_dir;   // unit viewing direction (towards larger d)
+uniform bool u_outward;    // a layered camera: keep the mesh's normal, never flip it
+uniform bool u_peel;       // layer k >= 1: only crossings behind u_previous's d
+uniform sampler2D u_previous; // the layer before's attachment 0 (d in .r)
 
 layout(location = 0) out vec4 o_depth_normal;
 layout(location = 1) out vec4 o_impact_dirt;
@@ -25,15 +35,28 @@ const float COLORS_DIRT = 2.0;
 void main()
 {
     float d = dot(v_position, u_depth_row.xyz) + u_depth_row.w;
+    if (u_peel) {
+        // Two surfaces 1 mm apart at d = 50 are still two layers; the same
+        // surface met again (rounding between two triangles) is not.
+        float previous = texelFetch(u_previous, ivec2(gl_FragCoord.xy), 0).r;
+        if (!(d > previous + 1e-5 * (1.0 + abs(previous)))) {
+            discard;
+        }
+    }
     vec3 n = v_normal;
     float len = length(n);
     if (!(len > 1e-6)) {
-        // No usable vertex normal: the triangle's own plane.
+        // No usable vertex normal: the triangle's own plane. cross(dFdx, dFdy)
+        // points along right x up, the way a triangle drawn counter-clockwise
+        // on the map faces: for a layered camera, the winding's side.
         n = cross(dFdx(v_position), dFdy(v_position));
         len = length(n);
+        if (u_outward && !gl_FrontFacing) {
+            n = -n;
+        }
     }
     n = len > 0.0 ? n / len : -u_view_dir;
-    if (dot(n, u_view_dir) > 0.0) {
+    if (!u_outward && dot(n, u_view_dir) > 0.0) {
         n = -n;
     }
     o_depth_normal = vec4(d, n);

@@ -1029,6 +1029,432 @@ TEST(cli_bake_writes_the_maps_and_refuses_a_bad_mesh)
     ENSURE(ensure_contains(out, "notamesh.obj"));
 }
 
+// ---------------------------------------------------------------------------
+// Layers: depth peeling (docs/design.md section 14).
+
+// Reads layer `layer` of a camera's maps (layer 0's channel names, prefixed
+// "layerK." from layer 1 on: wx_layer_channel), as read_maps does.
+static bool read_layer_maps(const wx_scene_camera *c, int layer, maps4 *m)
+{
+    static const char *const rgb[3] = { "R", "G", "B" };
+    char names[3][WX_NAME_MAX];
+    const char *wanted[3];
+    for (int k = 0; k < 3; ++k) {
+        if (!wx_layer_channel(names[k], layer, rgb[k])) {
+            return false;
+        }
+        wanted[k] = names[k];
+    }
+    wx_error err;
+    memset(m, 0, sizeof *m);
+    if (wx_exr_read(c->depth_path, wanted, 1, &m->depth, &err) != WX_OK ||
+        wx_exr_read(c->normal_path, wanted, 3, &m->normal, &err) != WX_OK ||
+        (!c->is_output && (wx_exr_read(c->impact_path, wanted, 3, &m->impact, &err) != WX_OK ||
+                           wx_exr_read(c->dirt_path, wanted, 3, &m->dirt, &err) != WX_OK))) {
+        fprintf(stderr, "layer %d: %s\n", layer, err.message);
+        return false;
+    }
+    return true;
+}
+
+// Whether the layer holds no crossing at texel (i, j): the background's values.
+static bool layer_empty_at(const maps4 *m, int i, int j)
+{
+    bool empty = isinf(at(&m->depth, 0, i, j)) && at(&m->depth, 0, i, j) > 0;
+    for (int q = 0; q < 3; ++q) {
+        empty = empty && at(&m->normal, q, i, j) == 0.0f && at(&m->impact, q, i, j) == 0.0f &&
+                at(&m->dirt, q, i, j) == 0.0f;
+    }
+    return empty;
+}
+
+static void ensure_normal(const maps4 *m, int i, int j, float x, float y, float z)
+{
+    ENSURE_NEAR(at(&m->normal, 0, i, j), x, 1e-3);
+    ENSURE_NEAR(at(&m->normal, 1, i, j), y, 1e-3);
+    ENSURE_NEAR(at(&m->normal, 2, i, j), z, 1e-3);
+}
+
+// Box [-1,1]^3 seen from (0,0,5) with 4 layers: layer 0 the front face (d 4,
+// normal +z, towards the camera), layer 1 the back face (d 6, normal -z: out
+// of the box, away from the camera), layers 2 and 3 nothing. Each face's
+// initial dirt is stored once, in the layer that holds it.
+static void check_box_layers(const char *file, const char *test)
+{
+    const float density = 2.0f;
+    wx_scene s;
+    scene_begin(&s);
+    const float eye[3] = { 0, 0, 5 };
+    add_camera(&s, "front", eye, ORIGIN, UP_Y, 4, 4, 64, 64, false)->layers = 4;
+    add_surface(add_mesh(&s, data_path(file), 30), "*", 0.5f, 0.25f, density, 0.75f, 0.125f);
+    wx_run_def o;
+    options_for(&o, test);
+    wx_error err = { 0 };
+    wx_result r = wx_bake_scene(&s, &o, &err);
+    if (r != WX_OK) {
+        fprintf(stderr, "%s\n", err.message);
+    }
+    ENSURE(r == WX_OK);
+    maps4 m[4];
+    for (int l = 0; l < 4; ++l) {
+        ENSURE(read_layer_maps(&s.cameras[0], l, &m[l]));
+    }
+    const double texel_area = (4.0 / 64) * (4.0 / 64);
+    const int texels[][2] = { { 32, 32 }, { 16, 16 }, { 47, 47 }, { 16, 40 }, { 47, 20 } };
+    for (size_t k = 0; k < sizeof texels / sizeof texels[0]; ++k) {
+        int i = texels[k][0], j = texels[k][1];
+        ENSURE_NEAR(at(&m[0].depth, 0, i, j), 4.0, 1e-4);
+        ensure_normal(&m[0], i, j, 0, 0, 1);
+        ENSURE_NEAR(at(&m[1].depth, 0, i, j), 6.0, 1e-4);
+        ensure_normal(&m[1], i, j, 0, 0, -1);
+        for (int l = 0; l < 2; ++l) {
+            ENSURE_NEAR(at(&m[l].impact, 0, i, j), 0.5, 1e-6);
+            ENSURE_NEAR(at(&m[l].impact, 1, i, j), 0.25, 1e-6);
+            ENSURE_NEAR(at(&m[l].dirt, 0, i, j), density * texel_area, 1e-7);
+            ENSURE_NEAR(at(&m[l].dirt, 1, i, j), 0.75, 1e-6);
+            ENSURE_NEAR(at(&m[l].dirt, 2, i, j), 0.125, 1e-6);
+        }
+        ENSURE(layer_empty_at(&m[2], i, j));
+        ENSURE(layer_empty_at(&m[3], i, j));
+    }
+    for (int l = 0; l < 4; ++l) {
+        ENSURE(layer_empty_at(&m[l], 15, 32));
+        ENSURE(layer_empty_at(&m[l], 32, 48));
+    }
+    // Each face's dirt, stored once: density x area 4 (the side faces are seen edge-on).
+    ENSURE_NEAR(plane_sum(&m[0].dirt, 0), density * 4.0, 1e-4);
+    ENSURE_NEAR(plane_sum(&m[1].dirt, 0), density * 4.0, 1e-4);
+    for (int l = 0; l < 4; ++l) {
+        free_maps(&m[l]);
+    }
+    scene_end(&s);
+}
+
+TEST(layers_box_back_face_points_out)
+{
+    check_box_layers("bake_box.obj", "layers_box");
+}
+
+TEST(layers_box_wound_inwards_points_out)
+{
+    // The import turns a closed mesh wound inwards outwards: the same layers.
+    check_box_layers("bake_box_flipped.obj", "layers_box_flipped");
+}
+
+// The box [x0,x1] x [y0,y1] x [z0,z1] as an OBJ in the test folder, faces
+// counter-clockwise seen from outside.
+static const char *write_box(const char *name, float x0, float x1, float y0, float y1, float z0,
+                             float z1)
+{
+    char text[1024];
+    snprintf(text, sizeof text,
+             "v %g %g %g\nv %g %g %g\nv %g %g %g\nv %g %g %g\n"
+             "v %g %g %g\nv %g %g %g\nv %g %g %g\nv %g %g %g\n"
+             "f 5 6 7 8\nf 2 1 4 3\nf 6 2 3 7\nf 1 5 8 4\nf 8 7 3 4\nf 1 2 6 5\n",
+             x0, y0, z0, x1, y0, z0, x1, y1, z0, x0, y1, z0, x0, y0, z1, x1, y0, z1, x1, y1, z1,
+             x0, y1, z1);
+    return ensure_write_file(ensure_tmpdir(), name, text);
+}
+
+TEST(layers_pane_one_millimetre_before_a_wall)
+{
+    // A pane (one quad, absorption 0.9) at z = 0.001 over x, y in [-0.5, 0.5],
+    // before a wall box (absorption 0.1) x, y in [-1, 1], z in [-0.2, 0], seen
+    // from 30 m: behind the pane, layer 0 is the pane, layer 1 the wall 1 mm
+    // farther, layer 2 the wall's back face (normal -z).
+    wx_scene s;
+    scene_begin(&s);
+    const float eye[3] = { 0, 0, 30 };
+    add_camera(&s, "front", eye, ORIGIN, UP_Y, 4, 4, 64, 64, false)->layers = 4;
+    const char *pane = ensure_write_file(
+        ensure_tmpdir(), "pane.obj",
+        "v -0.5 -0.5 0.001\nv 0.5 -0.5 0.001\nv 0.5 0.5 0.001\nv -0.5 0.5 0.001\nf 1 2 3 4\n");
+    add_surface(add_mesh(&s, pane, 30), "*", 0.9f, 0, 0, 0, 0);
+    add_surface(add_mesh(&s, write_box("wall.obj", -1, 1, -1, 1, -0.2f, 0), 40), "*", 0.1f, 0, 0,
+                0, 0);
+    wx_run_def o;
+    options_for(&o, "layers_pane");
+    wx_error err = { 0 };
+    ENSURE(wx_bake_scene(&s, &o, &err) == WX_OK);
+    maps4 m[4];
+    for (int l = 0; l < 4; ++l) {
+        ENSURE(read_layer_maps(&s.cameras[0], l, &m[l]));
+    }
+    // The pane covers texels 24..39, the wall 16..47.
+    const int behind_pane[][2] = { { 32, 32 }, { 24, 24 }, { 39, 39 }, { 25, 38 } };
+    for (size_t k = 0; k < sizeof behind_pane / sizeof behind_pane[0]; ++k) {
+        int i = behind_pane[k][0], j = behind_pane[k][1];
+        ENSURE_NEAR(at(&m[0].depth, 0, i, j), 29.999, 1e-4);
+        ENSURE_NEAR(at(&m[0].impact, 0, i, j), 0.9, 1e-6);
+        ensure_normal(&m[0], i, j, 0, 0, 1);
+        ENSURE_NEAR(at(&m[1].depth, 0, i, j), 30.0, 1e-4);
+        ENSURE_NEAR(at(&m[1].depth, 0, i, j) - at(&m[0].depth, 0, i, j), 0.001, 1e-4);
+        ENSURE_NEAR(at(&m[1].impact, 0, i, j), 0.1, 1e-6);
+        ensure_normal(&m[1], i, j, 0, 0, 1);
+        ENSURE_NEAR(at(&m[2].depth, 0, i, j), 30.2, 1e-4);
+        ensure_normal(&m[2], i, j, 0, 0, -1);
+        ENSURE(layer_empty_at(&m[3], i, j));
+    }
+    // Beside the pane: the wall's two faces.
+    ENSURE_NEAR(at(&m[0].depth, 0, 20, 32), 30.0, 1e-4);
+    ENSURE_NEAR(at(&m[0].impact, 0, 20, 32), 0.1, 1e-6);
+    ENSURE_NEAR(at(&m[1].depth, 0, 20, 32), 30.2, 1e-4);
+    ensure_normal(&m[1], 20, 32, 0, 0, -1);
+    ENSURE(layer_empty_at(&m[2], 20, 32));
+    for (int l = 0; l < 4; ++l) {
+        free_maps(&m[l]);
+    }
+    scene_end(&s);
+}
+
+TEST(layers_sill_underside_points_down)
+{
+    // A sill-like slab x in [-1, 1], y in [0.9, 1], z in [-0.25, 0.25] seen from
+    // above: layer 0 its top (d 4, normal +y), layer 1 its underside (d 4.1,
+    // normal -y), which holds the underside's initial dirt.
+    const float density = 1.0f;
+    wx_scene s;
+    scene_begin(&s);
+    const float eye[3] = { 0, 5, 0 }, up[3] = { 0, 0, -1 };
+    add_camera(&s, "top", eye, ORIGIN, up, 4, 4, 64, 64, false)->layers = 2;
+    add_surface(add_mesh(&s, write_box("sill.obj", -1, 1, 0.9f, 1, -0.25f, 0.25f), 30), "*", 0, 0,
+                density, 0, 0);
+    wx_run_def o;
+    options_for(&o, "layers_sill");
+    wx_error err = { 0 };
+    ENSURE(wx_bake_scene(&s, &o, &err) == WX_OK);
+    maps4 top, under;
+    ENSURE(read_layer_maps(&s.cameras[0], 0, &top));
+    ENSURE(read_layer_maps(&s.cameras[0], 1, &under));
+    const double texel_area = (4.0 / 64) * (4.0 / 64);
+    ENSURE_NEAR(at(&top.depth, 0, 32, 32), 4.0, 1e-4);
+    ensure_normal(&top, 32, 32, 0, 1, 0);
+    ENSURE_NEAR(at(&under.depth, 0, 32, 32), 4.1, 1e-4);
+    ensure_normal(&under, 32, 32, 0, -1, 0);
+    ENSURE_NEAR(at(&under.dirt, 0, 32, 32), density * texel_area, 1e-7);
+    // Top and underside each 2 x 0.5 (edges on texel borders).
+    ENSURE_NEAR(plane_sum(&top.dirt, 0), density * 1.0, 1e-4);
+    ENSURE_NEAR(plane_sum(&under.dirt, 0), density * 1.0, 1e-4);
+    free_maps(&top);
+    free_maps(&under);
+    scene_end(&s);
+}
+
+// Whether two files hold the same bytes.
+static bool same_file(const char *a, const char *b)
+{
+    FILE *fa = fopen(a, "rb"), *fb = fopen(b, "rb");
+    bool same = fa != NULL && fb != NULL;
+    while (same) {
+        int ca = getc(fa), cb = getc(fb);
+        same = ca == cb;
+        if (ca == EOF) {
+            break;
+        }
+    }
+    if (fa != NULL) {
+        fclose(fa);
+    }
+    if (fb != NULL) {
+        fclose(fb);
+    }
+    return same;
+}
+
+// The box seen from (0,0,5), and a quad at z = 2 facing away from the camera
+// (-z) before its left part: where the quad is, the first crossing is
+// back-facing. An output camera asks for layers too. Baked with `layers` on
+// the input camera into out/TEST.
+static void bake_mixed(wx_scene *s, wx_run_def *o, const char *test, int layers)
+{
+    scene_begin(s);
+    const float eye[3] = { 0, 0, 5 };
+    add_camera(s, "front", eye, ORIGIN, UP_Y, 4, 4, 64, 64, false)->layers = layers;
+    add_camera(s, "shot", eye, ORIGIN, UP_Y, 4, 4, 32, 32, true)->layers = layers;
+    add_surface(add_mesh(s, data_path("bake_box.obj"), 30), "*", 0.5f, 0.25f, 2.0f, 0.75f, 0.5f);
+    const char *away = ensure_write_file(ensure_tmpdir(), "away.obj",
+                                         "v -1.8 -0.5 2\nv -0.6 -0.5 2\nv -0.6 0.5 2\n"
+                                         "v -1.8 0.5 2\nf 4 3 2 1\n");
+    add_surface(add_mesh(s, away, 40), "*", 0.125f, 0.5f, 3.0f, 0.25f, 0.25f);
+    options_for(o, test);
+    wx_error err = { 0 };
+    wx_result r = wx_bake_scene(s, o, &err);
+    if (r != WX_OK) {
+        fprintf(stderr, "%s\n", err.message);
+    }
+    ENSURE(r == WX_OK);
+}
+
+TEST(layers_one_is_today_and_layer_zero_of_four_matches_it)
+{
+    wx_scene zero, one, four;
+    wx_run_def o0, o1, o4;
+    bake_mixed(&zero, &o0, "layers_0", 0);
+    bake_mixed(&one, &o1, "layers_1", 1);
+    bake_mixed(&four, &o4, "layers_4", 4);
+    // layers="1" is the default's bytes, file by file.
+    for (int c = 0; c < 2; ++c) {
+        const wx_scene_camera *a = &zero.cameras[c], *b = &one.cameras[c];
+        ENSURE(same_file(a->depth_path, b->depth_path));
+        ENSURE(same_file(a->normal_path, b->normal_path));
+        if (c == 0) {
+            ENSURE(same_file(a->impact_path, b->impact_path));
+            ENSURE(same_file(a->dirt_path, b->dirt_path));
+        }
+    }
+    // The files name every layer's channels; the output camera has one layer.
+    wx_image h;
+    wx_error err;
+    ENSURE(wx_exr_read_header(four.cameras[0].depth_path, &h, &err) == WX_OK);
+    ENSURE(h.channel_count == 4);
+    ENSURE(wx_exr_read_header(four.cameras[0].dirt_path, &h, &err) == WX_OK);
+    ENSURE(h.channel_count == 12);
+    int found = 0;
+    for (int k = 0; k < h.channel_count; ++k) {
+        found += strcmp(h.channel_names[k], "layer1.R") == 0 ||
+                 strcmp(h.channel_names[k], "layer3.B") == 0;
+    }
+    ENSURE(found == 2);
+    ENSURE(wx_exr_read_header(four.cameras[0].normal_path, &h, &err) == WX_OK);
+    ENSURE(h.channel_count == 12);
+    ENSURE(wx_exr_read_header(four.cameras[1].depth_path, &h, &err) == WX_OK);
+    ENSURE(h.channel_count == 1);
+    ENSURE(same_file(four.cameras[1].depth_path, one.cameras[1].depth_path));
+    ENSURE(same_file(four.cameras[1].normal_path, one.cameras[1].normal_path));
+    // Layer 0 of four layers is the one-layer bake but for the sign of the
+    // normals where the first crossing faces away from the camera (the quad).
+    maps4 a, b;
+    ENSURE(read_maps(&one.cameras[0], &a));
+    ENSURE(read_layer_maps(&four.cameras[0], 0, &b));
+    size_t texels = (size_t)a.depth.width * (size_t)a.depth.height, away = 0, mismatch = 0;
+    for (size_t t = 0; t < texels; ++t) {
+        mismatch += memcmp(&a.depth.channels[0][t], &b.depth.channels[0][t], sizeof(float)) != 0;
+        for (int q = 0; q < 3; ++q) {
+            mismatch += a.impact.channels[q][t] != b.impact.channels[q][t];
+            mismatch += a.dirt.channels[q][t] != b.dirt.channels[q][t];
+        }
+        bool flipped = b.normal.channels[2][t] < 0.0f; // faces away from the eye
+        away += flipped;
+        for (int q = 0; q < 3; ++q) {
+            float want = flipped ? -b.normal.channels[q][t] : b.normal.channels[q][t];
+            mismatch += a.normal.channels[q][t] != want;
+        }
+    }
+    ENSURE(mismatch == 0);
+    // The quad covers x in [-1.8, -0.6] at z = 2, y in [-0.5, 0.5]: 19 x 16 texels.
+    ENSURE(away == 19 * 16);
+    ENSURE_NEAR(at(&b.normal, 2, 8, 32), -1.0, 1e-3);
+    ENSURE_NEAR(at(&b.impact, 0, 8, 32), 0.125, 1e-6);
+    free_maps(&a);
+    free_maps(&b);
+    scene_end(&zero);
+    scene_end(&one);
+    scene_end(&four);
+}
+
+TEST(layers_share_initial_dirt_with_other_cameras)
+{
+    // The box with density 1 seen from the front with 2 layers and from the top
+    // with one: the front camera's layers hold the front and back faces, the
+    // top camera the top face (which it sees head-on), each once; nobody sees
+    // the bottom and the sides.
+    const float density = 1.0f;
+    wx_scene s;
+    scene_begin(&s);
+    const float eye_front[3] = { 0, 0, 5 }, eye_top[3] = { 0, 5, 0 }, up_top[3] = { 0, 0, -1 };
+    add_camera(&s, "front", eye_front, ORIGIN, UP_Y, 4, 4, 64, 64, false)->layers = 2;
+    add_camera(&s, "top", eye_top, ORIGIN, up_top, 4, 4, 64, 64, false);
+    add_surface(add_mesh(&s, data_path("bake_box.obj"), 30), "*", 0, 0, density, 0, 0);
+    wx_run_def o;
+    options_for(&o, "layers_dirt_shared");
+    wx_error err = { 0 };
+    ENSURE(wx_bake_scene(&s, &o, &err) == WX_OK);
+    maps4 front0, front1, top;
+    ENSURE(read_layer_maps(&s.cameras[0], 0, &front0));
+    ENSURE(read_layer_maps(&s.cameras[0], 1, &front1));
+    ENSURE(read_maps(&s.cameras[1], &top));
+    ENSURE_NEAR(plane_sum(&front0.dirt, 0), density * 4.0, 1e-4);
+    ENSURE_NEAR(plane_sum(&front1.dirt, 0), density * 4.0, 1e-4);
+    ENSURE_NEAR(plane_sum(&top.dirt, 0), density * 4.0, 1e-4);
+    free_maps(&front0);
+    free_maps(&front1);
+    free_maps(&top);
+    scene_end(&s);
+}
+
+TEST(layers_hold_every_substance_the_surface_and_the_area)
+{
+    // Two substances, a <Surface> with rules of its own (so the surface record)
+    // and a Grow (so Grow's area): each layer of the box carries them all,
+    // named "layer1.water.amount"... .
+    char dir[4200];
+    snprintf(dir, sizeof dir, "%s/layers_substances", ensure_tmpdir());
+    mkdir(dir, 0777);
+    char *box = ensure_read_file(data_path("bake_box.obj"));
+    ensure_write_file(dir, "box.obj", box != NULL ? box : "");
+    free(box);
+    const char *path = ensure_write_file(
+        dir, "scene.xml",
+        "<?xml version=\"1.0\"?>\n<Weathering>\n"
+        "  <Substances><Substance name=\"water\"/><Substance name=\"dirt\"/></Substances>\n"
+        "  <Collider><ProjectedMaps>\n"
+        "    <Ortho cameraName=\"front\"><View eye=\"0 0 5\" target=\"0 0 0\" up=\"0 1 0\" "
+        "width=\"4\" height=\"4\" resolution=\"64\"/></Ortho>\n"
+        "    <Ortho cameraName=\"shot\" out=\"true\"><View eye=\"0 0 5\" target=\"0 0 0\" "
+        "up=\"0 1 0\" width=\"4\" height=\"4\" resolution=\"32\"/>\n"
+        "      <OutputMap file=\"mask.exr\" width=\"32\" height=\"32\"/></Ortho>\n"
+        "  </ProjectedMaps></Collider>\n"
+        "  <Geometry><Mesh file=\"box.obj\">\n"
+        "    <Surface material=\"*\" absorption=\"0.25\" bounce=\"0.5\" dirt=\"2\" deposit=\"0.75\" "
+        "erosion=\"0.125\">\n"
+        "      <Exchange substance=\"water\" initial=\"3\" deposit=\"0.5\" erosion=\"0.25\"/>\n"
+        "      <Grow substance=\"water\" amount=\"0.1\"/>\n"
+        "    </Surface>\n"
+        "  </Mesh></Geometry>\n</Weathering>\n");
+    wx_scene s;
+    wx_error err = { 0 };
+    wx_result r = wx_scene_load(path, &s, &err);
+    if (r != WX_OK) {
+        fprintf(stderr, "%s\n", err.message);
+    }
+    ENSURE(r == WX_OK);
+    s.cameras[0].layers = 2; // the scene file's attribute is not read yet
+    wx_run_def o;
+    options_for(&o, "layers_substances");
+    r = wx_bake_scene(&s, &o, &err);
+    if (r != WX_OK) {
+        fprintf(stderr, "%s\n", err.message);
+    }
+    ENSURE(r == WX_OK);
+    static const char *const names[] = { "water.amount", "water.deposit", "water.erosion",
+                                         "dirt.amount",  "dirt.deposit",  "dirt.erosion",
+                                         "surface",      "area" };
+    const double texel_area = (4.0 / 64) * (4.0 / 64);
+    const double want[] = { 3 * texel_area, 0.5, 0.25, 2 * texel_area, 0.75, 0.125, 1,
+                            texel_area };
+    for (int l = 0; l < 2; ++l) {
+        char layered[8][WX_NAME_MAX];
+        const char *wanted[8];
+        for (int k = 0; k < 8; ++k) {
+            ENSURE(wx_layer_channel(layered[k], l, names[k]));
+            wanted[k] = layered[k];
+        }
+        wx_image dirt;
+        r = wx_exr_read(s.cameras[0].dirt_path, wanted, 8, &dirt, &err);
+        if (r != WX_OK) {
+            fprintf(stderr, "%s\n", err.message);
+        }
+        ENSURE(r == WX_OK);
+        for (int k = 0; k < 8; ++k) {
+            ENSURE_NEAR(at(&dirt, k, 32, 32), want[k], 1e-6);
+            ENSURE(at(&dirt, k, 5, 32) == 0.0f); // background
+        }
+        ENSURE_NEAR(plane_sum(&dirt, 0), 3 * 4.0, 1e-4);
+        wx_image_free(&dirt);
+    }
+    scene_end(&s);
+}
+
 int main(void)
 {
     RUN(sphere_depth_and_normal);
@@ -1050,5 +1476,12 @@ int main(void)
     RUN(scene_file_bakes_maps_the_scene_reads_back);
     RUN(warns_about_geometry_outside_the_frame_or_behind_the_eye);
     RUN(cli_bake_writes_the_maps_and_refuses_a_bad_mesh);
+    RUN(layers_box_back_face_points_out);
+    RUN(layers_box_wound_inwards_points_out);
+    RUN(layers_pane_one_millimetre_before_a_wall);
+    RUN(layers_sill_underside_points_down);
+    RUN(layers_one_is_today_and_layer_zero_of_four_matches_it);
+    RUN(layers_share_initial_dirt_with_other_cameras);
+    RUN(layers_hold_every_substance_the_surface_and_the_area);
     return ensure_summary();
 }

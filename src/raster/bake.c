@@ -13,6 +13,12 @@
 // (compute_initial_dirt). Each camera's maps go to def->on_maps (the pipeline
 // writes them, its files compressed in parallel) before the next camera renders,
 // so one set of images is alive. docs/cameras.md describes the choices.
+//
+// A layered input camera (docs/design.md section 14) is drawn once per layer,
+// depth peeling: after layer k is read back, attachment 0 is copied into the
+// `previous` texture, and the next pass keeps only the crossings behind it
+// (bake_frag.glsl). Its normals are then the mesh's own, out of the solid, and
+// every (camera, layer) is a view of the initial-dirt ownership.
 #define GL_GLEXT_PROTOTYPES 1
 #include <GL/osmesa.h>
 #include <GL/gl.h>
@@ -59,7 +65,11 @@ typedef struct cam_state {
     bool bake;         // rendered here
     double d_min;      // depth range of all vertices
     double d_max;
-    float *depth;      // depth plane kept for the initial-dirt visibility test, or NULL
+    int layers;        // the layers baked (cam_layers), or those of the given depth
+    float *depth;      // depth planes (one per layer, one after the other) kept for the
+                       // initial-dirt visibility test, or NULL
+    float *normal;     // with more than one layer: each layer's outward normals,
+                       // 3 interleaved floats per texel, one layer after the other
     int depth_width;
     int depth_height;
 } cam_state;
@@ -78,10 +88,12 @@ typedef struct baker {
     bool current;    // the context is current: GL objects may be deleted
     unsigned char context_buffer[16 * 16 * 4];
     GLuint program;
-    GLint loc_wtc, loc_depth_range, loc_depth_row, loc_view_dir;
+    GLint loc_wtc, loc_depth_range, loc_depth_row, loc_view_dir, loc_outward, loc_peel;
     GLuint fbo;
     GLuint renderbuffers[TARGET_COUNT + 1]; // colour targets, then depth
     int fb_width, fb_height;
+    GLuint previous; // depth peeling: the layer before's attachment 0 (0: none yet)
+    int previous_width, previous_height;
     GLint max_side;
     GLint max_texture_buffer;
     gpu_mesh *meshes;
@@ -165,8 +177,11 @@ static wx_result create_program(baker *b, wx_error *err)
     b->loc_depth_range = glGetUniformLocation(b->program, "u_depth_range");
     b->loc_depth_row = glGetUniformLocation(b->program, "u_depth_row");
     b->loc_view_dir = glGetUniformLocation(b->program, "u_view_dir");
+    b->loc_outward = glGetUniformLocation(b->program, "u_outward");
+    b->loc_peel = glGetUniformLocation(b->program, "u_peel");
     glUseProgram(b->program);
     glUniform1i(glGetUniformLocation(b->program, "u_material_props"), 0);
+    glUniform1i(glGetUniformLocation(b->program, "u_previous"), 1);
     return gl_check("setting up the bake shaders", err);
 }
 
@@ -271,6 +286,35 @@ static wx_result ensure_framebuffer(baker *b, int width, int height, wx_error *e
     b->fb_width = width;
     b->fb_height = height;
     return WX_OK;
+}
+
+// Copies attachment 0 (d, normal) of the layer just drawn into the `previous`
+// texture the next peeling pass reads (made, or remade, at the framebuffer's
+// size: 16 bytes a texel more while a layered camera bakes).
+static wx_result keep_previous_layer(baker *b, wx_error *err)
+{
+    int width = b->fb_width, height = b->fb_height;
+    if (b->previous == 0 || b->previous_width != width || b->previous_height != height) {
+        glDeleteTextures(1, &b->previous);
+        glGenTextures(1, &b->previous);
+        glBindTexture(GL_TEXTURE_2D, b->previous);
+        glTexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA32F, width, height);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+        glBindTexture(GL_TEXTURE_2D, 0);
+        b->previous_width = width;
+        b->previous_height = height;
+        wx_result r = gl_check("allocating the depth peeling texture", err);
+        if (r != WX_OK) {
+            wx_error_prefix(err, "%d x %d maps", width, height);
+            glDeleteTextures(1, &b->previous);
+            b->previous = 0;
+            return r;
+        }
+    }
+    glCopyImageSubData(b->renderbuffers[TARGET_DEPTH_NORMAL], GL_RENDERBUFFER, 0, 0, 0, 0,
+                       b->previous, GL_TEXTURE_2D, 0, 0, 0, 0, width, height, 1);
+    return gl_check("keeping a layer for depth peeling", err);
 }
 
 // ---------------------------------------------------------------------------
@@ -548,7 +592,20 @@ static wx_result load_meshes(baker *b, wx_geometry *geometry, wx_error *err)
 // ---------------------------------------------------------------------------
 // Rendering and readback.
 
-static wx_result draw_camera(baker *b, int c, int targets, wx_error *err)
+// The layers camera c records: the scene's (0 read as 1, at most
+// WX_MAX_LAYERS); one for the output camera.
+static int cam_layers(const wx_scene_camera *sc)
+{
+    if (sc->is_output || sc->layers <= 1) {
+        return 1;
+    }
+    return sc->layers < WX_MAX_LAYERS ? sc->layers : WX_MAX_LAYERS;
+}
+
+// Draws layer `layer` of camera c into the framebuffer (the first `targets`
+// colour targets). A layer after the first keeps the crossings behind the
+// layer in the `previous` texture (keep_previous_layer).
+static wx_result draw_camera(baker *b, int c, int targets, int layer, wx_error *err)
 {
     const wx_scene_camera *sc = &b->scene->cameras[c];
     const cam_state *cs = &b->cams[c];
@@ -585,6 +642,10 @@ static wx_result draw_camera(baker *b, int c, int targets, wx_error *err)
     wx_camera_view_dir(&sc->camera, view);
     glUniform3f(b->loc_view_dir, view[0], view[1], view[2]);
     glUniform2f(b->loc_depth_range, (float)near, (float)far);
+    glUniform1i(b->loc_outward, cam_layers(sc) > 1);
+    glUniform1i(b->loc_peel, layer > 0);
+    glActiveTexture(GL_TEXTURE1);
+    glBindTexture(GL_TEXTURE_2D, layer > 0 ? b->previous : 0);
     for (int i = 0; i < b->mesh_count; ++i) {
         const gpu_mesh *g = &b->meshes[i];
         float m[16];
@@ -602,7 +663,8 @@ static wx_result draw_camera(baker *b, int c, int targets, wx_error *err)
 
 // Destination of one channel of a colour target: a plane in EXR row order.
 typedef struct plane_out {
-    float *plane; // NULL: channel not wanted
+    float *plane;  // NULL: channel not wanted
+    size_t stride; // floats from one texel to the next (0: 1; 3: interleaved normals)
 } plane_out;
 
 // Reads colour target `target` (`channels` floats per texel) in strips and
@@ -633,12 +695,19 @@ static wx_result read_target(baker *b, int target, int channels, const plane_out
             size_t row = (size_t)(height - 1 - (y0 + k)) * (size_t)width;
             for (int c = 0; c < channels; ++c) {
                 float *dst = out[c].plane;
+                size_t stride = out[c].stride > 0 ? out[c].stride : 1;
                 if (dst == NULL) {
                     continue;
                 }
-                dst += row;
+                dst += row * stride;
+                if (stride == 1) {
+                    for (int i = 0; i < width; ++i) {
+                        dst[i] = src[(size_t)i * (size_t)channels + (size_t)c];
+                    }
+                    continue;
+                }
                 for (int i = 0; i < width; ++i) {
-                    dst[i] = src[(size_t)i * (size_t)channels + (size_t)c];
+                    dst[(size_t)i * stride] = src[(size_t)i * (size_t)channels + (size_t)c];
                 }
             }
         }
@@ -648,10 +717,11 @@ static wx_result read_target(baker *b, int target, int channels, const plane_out
 
 // ---------------------------------------------------------------------------
 // Initial dirt (docs/design.md section 3): stored once, in the input camera that sees the
-// patch most head-on.
+// patch most head-on. Every layer of a layered camera is a view of its own.
 
 // The depth map of an input camera that the scene gives as files (read by the
-// caller), for the visibility test: copied, "no surface" as +inf.
+// caller), for the visibility test: copied, "no surface" as +inf. Its layers
+// count when the caller read their normals too, else its layer 0 alone.
 static wx_result take_given_depth(baker *b, int c, wx_error *err)
 {
     const wx_maps *given = b->def->given_depth != NULL ? &b->def->given_depth[c] : NULL;
@@ -660,11 +730,20 @@ static wx_result take_given_depth(baker *b, int c, wx_error *err)
                        b->scene->cameras[c].name);
     }
     cam_state *cs = &b->cams[c];
-    size_t n = (size_t)given->width * (size_t)given->height;
+    int layers = wx_maps_layers(given) > 1 && given->normal != NULL ? wx_maps_layers(given) : 1;
+    size_t n = (size_t)given->width * (size_t)given->height * (size_t)layers;
     cs->depth = malloc((n > 0 ? n : 1) * sizeof *cs->depth);
     if (cs->depth == NULL) {
         return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "bake: out of memory");
     }
+    if (layers > 1) {
+        cs->normal = malloc(3 * n * sizeof *cs->normal);
+        if (cs->normal == NULL) {
+            return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "bake: out of memory");
+        }
+        memcpy(cs->normal, given->normal, 3 * n * sizeof *cs->normal);
+    }
+    cs->layers = layers;
     cs->depth_width = given->width;
     cs->depth_height = given->height;
     for (size_t k = 0; k < n; ++k) {
@@ -673,18 +752,67 @@ static wx_result take_given_depth(baker *b, int c, wx_error *err)
     return WX_OK;
 }
 
-// Turns the density planes of camera c (one per substance) into amounts:
-// density x texel area / |N.view| x the share of the texel's surface c owns
-// (model/ownership.h: the camera that sees a point most head-on holds what
-// lies there, so every amount is stored once and a border between two
-// cameras' parts is shared as the gather reads it); `area` (may be NULL)
-// receives texel area / |N.view| x that share (what Grow multiplies).
-static wx_result compute_initial_dirt(baker *b, int c, const float *depth,
-                                      const wx_image *normal, float *const *planes, int count,
-                                      float *area, wx_error *err)
+// The views of the initial-dirt ownership while camera c bakes: one per layer
+// of every input camera whose depth is known, in scene order, each camera's
+// layers nearest first; a layered camera's views carry its outward normals.
+// Camera c's are its planes just baked: depth[l] per layer and, layered,
+// `normal` (3 interleaved floats per texel, one layer after the other).
+// *self is the index of c's layer 0. NULL when out of memory.
+static wx_owner_view *owner_views(const baker *b, int c, float *const *depth, const float *normal,
+                                  int *count, int *self)
 {
     const wx_scene *scene = b->scene;
-    const wx_scene_camera *sc = &scene->cameras[c];
+    int total = 0;
+    for (int k = 0; k < scene->camera_count; ++k) {
+        if (scene->cameras[k].is_output || (k != c && b->cams[k].depth == NULL)) {
+            continue;
+        }
+        total += k == c ? cam_layers(&scene->cameras[k]) : b->cams[k].layers;
+    }
+    wx_owner_view *views = malloc((total > 0 ? (size_t)total : 1) * sizeof *views);
+    if (views == NULL) {
+        return NULL;
+    }
+    int n = 0;
+    for (int k = 0; k < scene->camera_count; ++k) {
+        const wx_scene_camera *sk = &scene->cameras[k];
+        const cam_state *ks = &b->cams[k];
+        if (sk->is_output || (k != c && ks->depth == NULL)) {
+            continue;
+        }
+        int layers = k == c ? cam_layers(sk) : ks->layers;
+        int w = k == c ? sk->camera.width : ks->depth_width;
+        int h = k == c ? sk->camera.height : ks->depth_height;
+        size_t texels = (size_t)w * (size_t)h;
+        const float *normals = k == c ? normal : ks->normal;
+        if (k == c) {
+            *self = n;
+        }
+        for (int l = 0; l < layers; ++l) {
+            const float *d = k == c ? depth[l] : ks->depth + (size_t)l * texels;
+            wx_owner_view_init(&views[n], &sk->camera, d, w, h);
+            if (layers > 1) {
+                views[n].normal = normals + 3 * (size_t)l * texels;
+            }
+            ++n;
+        }
+    }
+    *count = n;
+    return views;
+}
+
+// Turns the density planes of view `self` (a layer of camera c; one per
+// substance) into amounts: density x texel area / |N.view| x the share of the
+// texel's surface the view owns (model/ownership.h: the view that sees a point
+// most head-on holds what lies there, so every amount is stored once and a
+// border between two views' parts is shared as the gather reads it); `area`
+// (may be NULL) receives texel area / |N.view| x that share (what Grow
+// multiplies). `normal`: the layer's x, y, z planes.
+static wx_result compute_initial_dirt(baker *b, int c, const wx_owner_view *views, int count,
+                                      int self, float *const *normal, float *const *planes,
+                                      int planes_count, float *area, wx_error *err)
+{
+    const wx_scene_camera *sc = &b->scene->cameras[c];
     int width = sc->camera.width, height = sc->camera.height;
     float view[3], frame_w, frame_h;
     wx_camera_view_dir(&sc->camera, view);
@@ -692,40 +820,21 @@ static wx_result compute_initial_dirt(baker *b, int c, const float *depth,
     float texel_area = (frame_w / (float)width) * (frame_h / (float)height);
 
     size_t texels = (size_t)width * (size_t)height;
-    wx_owner_view *owners = malloc((size_t)scene->camera_count * sizeof *owners);
     float *share = malloc((texels > 0 ? texels : 1) * sizeof *share);
-    if (owners == NULL || share == NULL) {
-        free(owners);
-        free(share);
+    if (share == NULL) {
         return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "bake: out of memory");
     }
-    int count_views = 0, self = -1;
-    for (int k = 0; k < scene->camera_count; ++k) {
-        const cam_state *ks = &b->cams[k];
-        if (scene->cameras[k].is_output || (k != c && ks->depth == NULL)) {
-            continue;
-        }
-        if (k == c) {
-            self = count_views;
-            wx_owner_view_init(&owners[count_views++], &sc->camera, depth, width, height);
-        } else {
-            wx_owner_view_init(&owners[count_views++], &scene->cameras[k].camera, ks->depth,
-                               ks->depth_width, ks->depth_height);
-        }
-    }
-    wx_result r = wx_owned_fraction(owners, count_views, self, normal->channels[0],
-                                    normal->channels[1], normal->channels[2], 1,
+    wx_result r = wx_owned_fraction(views, count, self, normal[0], normal[1], normal[2], 1,
                                     b->def->threads > 0 ? b->def->threads : 1, share, err);
-    free(owners);
     if (r != WX_OK) {
         free(share);
         return r;
     }
     for (size_t t = 0; t < texels; ++t) {
-        float cos_c = fabsf(normal->channels[0][t] * view[0] + normal->channels[1][t] * view[1] +
-                            normal->channels[2][t] * view[2]);
+        float cos_c = fabsf(normal[0][t] * view[0] + normal[1][t] * view[1] +
+                            normal[2][t] * view[2]);
         float owned_area = share[t] * texel_area / fmaxf(cos_c, MIN_COSINE);
-        for (int s = 0; s < count; ++s) {
+        for (int s = 0; s < planes_count; ++s) {
             planes[s][t] = owned_area > 0.0f ? planes[s][t] * owned_area : 0.0f;
         }
         if (area != NULL) {
@@ -740,31 +849,62 @@ static wx_result compute_initial_dirt(baker *b, int c, const float *depth,
 // The images handed to the caller.
 
 // Makes the set's images W x H: depth (R), normal, impact (R, G, B), dirt (the
-// scene's layout, model/maps.h: R, G, B for version 1's one substance).
+// scene's layout, model/maps.h: R, G, B for version 1's one substance), each
+// channel once per layer: layer 0's as they are, then layer 1's named
+// "layer1.R"... (wx_layer_channel), and so on.
 static wx_result size_set(const wx_scene *scene, map_set *set, int width, int height, int count,
-                          wx_error *err)
+                          int layers, wx_error *err)
 {
     static const char *const rgb[3] = { "R", "G", "B" };
-    char dirt_names[WX_IMAGE_MAX_CHANNELS][WX_NAME_MAX];
-    const char *dirt[WX_IMAGE_MAX_CHANNELS];
-    int dirt_count = wx_dirt_channels(scene, false, dirt_names);
-    for (int k = 0; k < dirt_count; ++k) {
-        dirt[k] = dirt_names[k];
+    // The names (2 x 20 KiB): not on the stack.
+    char (*dirt_names)[WX_NAME_MAX] = malloc(2 * WX_IMAGE_MAX_CHANNELS * sizeof *dirt_names);
+    if (dirt_names == NULL) {
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "bake: out of memory");
     }
+    char (*names)[WX_NAME_MAX] = dirt_names + WX_IMAGE_MAX_CHANNELS;
+    const char *base[WX_IMAGE_MAX_CHANNELS];
+    const char *layered[WX_IMAGE_MAX_CHANNELS];
+    int dirt_count = wx_dirt_channels(scene, false, dirt_names);
+    wx_result r = WX_OK;
     set->count = count;
-    for (int k = 0; k < count; ++k) {
+    for (int k = 0; k < count && r == WX_OK; ++k) {
+        int per = k == 0 ? 1 : k < 3 ? 3 : dirt_count;
+        for (int i = 0; i < per; ++i) {
+            base[i] = k < 3 ? rgb[i] : dirt_names[i];
+        }
+        if (per * layers > WX_IMAGE_MAX_CHANNELS) {
+            r = wx_fail(err, WX_CAUSE_BAD_SCENE,
+                        "bake: %d layers of %d channels are more than an image holds (%d)",
+                        layers, per, WX_IMAGE_MAX_CHANNELS);
+            break;
+        }
+        for (int l = 0; l < layers && r == WX_OK; ++l) {
+            for (int i = 0; i < per && r == WX_OK; ++i) {
+                int at = l * per + i;
+                if (!wx_layer_channel(names[at], l, base[i])) {
+                    r = wx_fail(err, WX_CAUSE_BAD_SCENE,
+                                "bake: channel '%s' of layer %d has too long a name", base[i], l);
+                }
+                layered[at] = names[at];
+            }
+        }
+        if (r != WX_OK) {
+            break;
+        }
         wx_image *img = &set->maps[k];
-        if (img->width == width && img->height == height) {
+        bool same = img->width == width && img->height == height &&
+                    img->channel_count == per * layers;
+        for (int i = 0; same && i < per * layers; ++i) {
+            same = strcmp(img->channel_names[i], layered[i]) == 0;
+        }
+        if (same) {
             continue; // every plane read back or filled is overwritten; impact B stays 0
         }
         wx_image_free(img);
-        wx_result r = k == 3 ? wx_image_alloc(img, width, height, dirt_count, dirt, err)
-                             : wx_image_alloc(img, width, height, k == 0 ? 1 : 3, rgb, err);
-        if (r != WX_OK) {
-            return r;
-        }
+        r = wx_image_alloc(img, width, height, per * layers, layered, err);
     }
-    return WX_OK;
+    free(dirt_names);
+    return r;
 }
 
 // Index of the channel called `name` in `image`, or -1.
@@ -780,9 +920,10 @@ static int channel_index(const wx_image *image, const char *name)
 
 // The substances the renderer does not carry, from each texel's <Surface>
 // (surface index + 1 in `surface`): their initial density (turned into amounts
-// with the rendered one), deposit and erosion.
-static wx_result fill_substances(const wx_scene *scene, const float *surface, wx_image *dirt,
-                                 size_t texels, wx_error *err)
+// with the rendered one), deposit and erosion, into one layer's dirt planes
+// (substance s at 3s, 3s+1, 3s+2).
+static wx_result fill_substances(const wx_scene *scene, const float *surface,
+                                 float *const *dirt, size_t texels, wx_error *err)
 {
     const wx_surface **by_index = wx_scene_surfaces_by_index(scene);
     if (by_index == NULL) {
@@ -794,8 +935,7 @@ static wx_result fill_substances(const wx_scene *scene, const float *surface, wx
         if (s == rendered) {
             continue;
         }
-        float *amount = dirt->channels[3 * s], *deposit = dirt->channels[3 * s + 1],
-              *erosion = dirt->channels[3 * s + 2];
+        float *amount = dirt[3 * s], *deposit = dirt[3 * s + 1], *erosion = dirt[3 * s + 2];
         for (size_t t = 0; t < texels; ++t) {
             int id = (int)surface[t] - 1;
             const wx_surface *sf = id >= 0 && id < known ? by_index[id] : NULL;
@@ -811,105 +951,215 @@ static wx_result fill_substances(const wx_scene *scene, const float *surface, wx
 // ---------------------------------------------------------------------------
 // One camera.
 
-// Renders camera c and keeps only its depth plane (for the visibility test).
+// Whether a depth plane just read back holds some surface (a finite d): when
+// layer k holds none, no layer after it does, and they are not drawn.
+static bool any_surface(const float *depth, size_t texels)
+{
+    for (size_t t = 0; t < texels; ++t) {
+        if (depth[t] < INFINITY) {
+            return true;
+        }
+    }
+    return false;
+}
+
+// Renders camera c and keeps only its depth planes and, layered, its outward
+// normals (for the visibility test).
 static wx_result render_depth_only(baker *b, int c, wx_error *err)
 {
     const wx_scene_camera *sc = &b->scene->cameras[c];
     cam_state *cs = &b->cams[c];
+    int layers = cam_layers(sc);
     size_t n = (size_t)sc->camera.width * (size_t)sc->camera.height;
-    cs->depth = malloc(n * sizeof(float));
+    cs->depth = malloc(n * (size_t)layers * sizeof(float));
     if (cs->depth == NULL) {
         return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "bake: out of memory");
     }
+    if (layers > 1) {
+        cs->normal = malloc(3 * n * (size_t)layers * sizeof(float));
+        if (cs->normal == NULL) {
+            return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "bake: out of memory");
+        }
+    }
+    cs->layers = layers;
     cs->depth_width = sc->camera.width;
     cs->depth_height = sc->camera.height;
     double t0 = wx_now_s();
-    wx_result r = draw_camera(b, c, 1, err);
-    if (r == WX_OK) {
-        plane_out out[4] = { { cs->depth }, { NULL }, { NULL }, { NULL } };
-        r = read_target(b, TARGET_DEPTH_NORMAL, 4, out, err);
+    wx_result r = WX_OK;
+    for (int l = 0; l < layers && r == WX_OK; ++l) {
+        float *depth = cs->depth + (size_t)l * n;
+        float *normal = layers > 1 ? cs->normal + 3 * (size_t)l * n : NULL;
+        if (l > 0 && !any_surface(depth - n, n)) {
+            for (size_t t = 0; t < n; ++t) {
+                depth[t] = INFINITY;
+            }
+            memset(normal, 0, 3 * n * sizeof *normal);
+            continue;
+        }
+        r = draw_camera(b, c, 1, l, err);
+        if (r == WX_OK) {
+            plane_out out[4] = { { depth, 1 },
+                                 { normal, 3 },
+                                 { normal != NULL ? normal + 1 : NULL, 3 },
+                                 { normal != NULL ? normal + 2 : NULL, 3 } };
+            r = read_target(b, TARGET_DEPTH_NORMAL, 4, out, err);
+        }
+        if (r == WX_OK && l + 1 < layers) {
+            r = keep_previous_layer(b, err);
+        }
     }
     b->stats->render_s += wx_now_s() - t0;
     return r;
 }
 
+// Layer `layer` of the set as the background: depth +inf, every other plane 0.
+static void clear_layer(map_set *set, int layers, int layer, size_t texels)
+{
+    for (int k = 0; k < set->count; ++k) {
+        wx_image *img = &set->maps[k];
+        int per = img->channel_count / layers;
+        for (int i = 0; i < per; ++i) {
+            float *plane = img->channels[layer * per + i];
+            if (k == 0) {
+                for (size_t t = 0; t < texels; ++t) {
+                    plane[t] = INFINITY;
+                }
+            } else {
+                memset(plane, 0, texels * sizeof *plane);
+            }
+        }
+    }
+}
+
+// The outward normals of the set's layers, interleaved (3 floats a texel, one
+// layer after the other), as the ownership views of a layered camera read them.
+static float *interleaved_normals(const wx_image *normal, int layers, size_t texels)
+{
+    float *out = malloc(3 * texels * (size_t)layers * sizeof *out);
+    for (int l = 0; out != NULL && l < layers; ++l) {
+        float *dst = out + 3 * texels * (size_t)l;
+        for (size_t t = 0; t < texels; ++t) {
+            for (int q = 0; q < 3; ++q) {
+                dst[3 * t + (size_t)q] = normal->channels[3 * l + q][t];
+            }
+        }
+    }
+    return out;
+}
+
 static wx_result bake_camera(baker *b, int c, wx_error *err)
 {
-    const wx_scene_camera *sc = &b->scene->cameras[c];
+    const wx_scene *scene = b->scene;
+    const wx_scene_camera *sc = &scene->cameras[c];
     bool input = !sc->is_output;
+    int layers = cam_layers(sc);
     char label[sizeof sc->name + 8];
     snprintf(label, sizeof label, "bake %s", sc->name);
     wx_progress progress;
-    wx_progress_begin(&progress, label, 4, b->def->quiet);
+    wx_progress_begin(&progress, label, 2 * layers + 2, b->def->quiet);
 
     map_set *set = &b->set;
-    wx_result r = size_set(b->scene, set, sc->camera.width, sc->camera.height, input ? 4 : 2, err);
+    size_t texels = (size_t)sc->camera.width * (size_t)sc->camera.height;
+    wx_result r = size_set(scene, set, sc->camera.width, sc->camera.height, input ? 4 : 2,
+                           layers, err);
     wx_image *maps = set->maps;
-    double t0 = wx_now_s();
-    if (r == WX_OK) {
-        r = draw_camera(b, c, input ? TARGET_COUNT : 1, err);
-    }
-    wx_progress_update(&progress, 1);
-    if (r == WX_OK) {
-        plane_out out[4] = { { maps[0].channels[0] },
-                             { maps[1].channels[0] },
-                             { maps[1].channels[1] },
-                             { maps[1].channels[2] } };
-        r = read_target(b, TARGET_DEPTH_NORMAL, 4, out, err);
-    }
-    // The dirt image's planes: the rendered substance's at 3g (3g+1, 3g+2), the
-    // surface record and Grow's area when the scene's layout has them.
-    const wx_scene *scene = b->scene;
-    int g = b->scene->substances_declared ? rendered_substance(scene) : 0;
-    int S = b->scene->substances_declared ? scene->substance_count : 1;
-    int surface_channel = input ? channel_index(&maps[3], WX_SURFACE_CHANNEL) : -1;
-    int area_channel = input ? channel_index(&maps[3], WX_AREA_CHANNEL) : -1;
-    float *surface = NULL;
+    // The dirt image's planes, per layer (`per` of them, layer l's from l*per):
+    // the rendered substance's at 3g (3g+1, 3g+2), the surface record and
+    // Grow's area when the scene's layout has them.
+    int g = scene->substances_declared ? rendered_substance(scene) : 0;
+    int S = scene->substances_declared ? scene->substance_count : 1;
+    int per = r == WX_OK && input ? maps[3].channel_count / layers : 0;
+    int surface_channel = r == WX_OK && input ? channel_index(&maps[3], WX_SURFACE_CHANNEL) : -1;
+    int area_channel = r == WX_OK && input ? channel_index(&maps[3], WX_AREA_CHANNEL) : -1;
+    // Every layer's surface record: the dirt map's own planes, or a scratch.
+    float *scratch = NULL;
+    float *surface[WX_MAX_LAYERS] = { NULL };
     if (r == WX_OK && input && (S > 1 || surface_channel >= 0)) {
-        surface = surface_channel >= 0 ? maps[3].channels[surface_channel]
-                                       : malloc((size_t)sc->camera.width *
-                                                (size_t)sc->camera.height * sizeof *surface);
-        if (surface == NULL) {
-            r = wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "bake: out of memory");
+        if (surface_channel < 0) {
+            scratch = malloc(texels * (size_t)layers * sizeof *scratch);
+            if (scratch == NULL) {
+                r = wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "bake: out of memory");
+            }
+        }
+        for (int l = 0; l < layers && r == WX_OK; ++l) {
+            surface[l] = scratch != NULL ? scratch + (size_t)l * texels
+                                         : maps[3].channels[l * per + surface_channel];
         }
     }
-    if (r == WX_OK && input) {
-        plane_out out[4] = { { maps[2].channels[0] },
-                             { maps[2].channels[1] },
-                             { maps[3].channels[3 * g + 1] },
-                             { maps[3].channels[3 * g + 2] } };
-        r = read_target(b, TARGET_IMPACT_DIRT, 4, out, err);
-        if (r == WX_OK && surface == NULL) {
-            plane_out density[1] = { { maps[3].channels[3 * g] } };
-            r = read_target(b, TARGET_DENSITY, 1, density, err);
-        } else if (r == WX_OK) {
-            plane_out density[2] = { { maps[3].channels[3 * g] }, { surface } };
-            r = read_target(b, TARGET_DENSITY, 2, density, err);
+    double t0 = wx_now_s();
+    int drawn = 0; // layers drawn; those after them hold no crossing
+    for (int l = 0; l < layers && r == WX_OK; ++l) {
+        if (l > 0 && !any_surface(maps[0].channels[l - 1], texels)) {
+            clear_layer(set, layers, l, texels);
+            if (scratch != NULL) {
+                memset(surface[l], 0, texels * sizeof *surface[l]);
+            }
+            continue;
         }
+        r = draw_camera(b, c, input ? TARGET_COUNT : 1, l, err);
+        wx_progress_update(&progress, 2 * l + 1);
+        if (r == WX_OK) {
+            plane_out out[4] = { { maps[0].channels[l], 1 },
+                                 { maps[1].channels[3 * l], 1 },
+                                 { maps[1].channels[3 * l + 1], 1 },
+                                 { maps[1].channels[3 * l + 2], 1 } };
+            r = read_target(b, TARGET_DEPTH_NORMAL, 4, out, err);
+        }
+        if (r == WX_OK && input) {
+            float *const *dirt = &maps[3].channels[l * per];
+            plane_out out[4] = { { maps[2].channels[3 * l], 1 },
+                                 { maps[2].channels[3 * l + 1], 1 },
+                                 { dirt[3 * g + 1], 1 },
+                                 { dirt[3 * g + 2], 1 } };
+            r = read_target(b, TARGET_IMPACT_DIRT, 4, out, err);
+            if (r == WX_OK && surface[l] == NULL) {
+                plane_out density[1] = { { dirt[3 * g], 1 } };
+                r = read_target(b, TARGET_DENSITY, 1, density, err);
+            } else if (r == WX_OK) {
+                plane_out density[2] = { { dirt[3 * g], 1 }, { surface[l], 1 } };
+                r = read_target(b, TARGET_DENSITY, 2, density, err);
+            }
+        }
+        if (r == WX_OK && l + 1 < layers) {
+            r = keep_previous_layer(b, err);
+        }
+        drawn = l + 1;
+        wx_progress_update(&progress, 2 * l + 2);
     }
     double t1 = wx_now_s();
     b->stats->render_s += t1 - t0;
-    wx_progress_update(&progress, 2);
     if (r == WX_OK && input) {
-        size_t texels = (size_t)sc->camera.width * (size_t)sc->camera.height;
-        if (S > 1) {
-            r = fill_substances(scene, surface, &maps[3], texels, err);
+        // Every (camera, layer) is a view of the ownership; a layer with no
+        // crossing holds no dirt (its planes are already the background's).
+        float *normal = layers > 1 ? interleaved_normals(&maps[1], layers, texels) : NULL;
+        int count = 0, self = 0;
+        wx_owner_view *views = layers == 1 || normal != NULL
+                                   ? owner_views(b, c, maps[0].channels, normal, &count, &self)
+                                   : NULL;
+        if (views == NULL) {
+            r = wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "bake: out of memory");
         }
-        float *planes[WX_MAX_SUBSTANCES];
-        for (int s = 0; s < S; ++s) {
-            planes[s] = maps[3].channels[3 * s];
+        for (int l = 0; l < drawn && r == WX_OK; ++l) {
+            float *const *dirt = &maps[3].channels[l * per];
+            if (S > 1) {
+                r = fill_substances(scene, surface[l], dirt, texels, err);
+            }
+            float *planes[WX_MAX_SUBSTANCES];
+            for (int s = 0; s < S; ++s) {
+                planes[s] = dirt[3 * s];
+            }
+            if (r == WX_OK) {
+                r = compute_initial_dirt(b, c, views, count, self + l, &maps[1].channels[3 * l],
+                                         planes, S, area_channel >= 0 ? dirt[area_channel] : NULL,
+                                         err);
+            }
         }
-        if (r == WX_OK) {
-            r = compute_initial_dirt(b, c, maps[0].channels[0], &maps[1], planes, S,
-                                     area_channel >= 0 ? maps[3].channels[area_channel] : NULL,
-                                     err);
-        }
+        free(views);
+        free(normal);
     }
-    if (surface_channel < 0) {
-        free(surface);
-    }
+    free(scratch);
     b->stats->dirt_s += wx_now_s() - t1;
-    wx_progress_update(&progress, 3);
+    wx_progress_update(&progress, 2 * layers + 1);
     if (r == WX_OK) {
         double t2 = wx_now_s();
         r = b->def->on_maps(c, set->maps, set->count, b->def->user, err);
@@ -936,6 +1186,7 @@ static void baker_free(baker *b)
             glDeleteFramebuffers(1, &b->fbo);
             glDeleteRenderbuffers(TARGET_COUNT + 1, b->renderbuffers);
         }
+        glDeleteTextures(1, &b->previous);
         if (b->program != 0) {
             glDeleteProgram(b->program);
         }
@@ -948,6 +1199,7 @@ static void baker_free(baker *b)
     if (b->cams != NULL) {
         for (int c = 0; c < b->scene->camera_count; ++c) {
             free(b->cams[c].depth);
+            free(b->cams[c].normal);
         }
     }
     free(b->cams);

@@ -11,6 +11,26 @@
 // section 3) is stored once: each texel of the input camera that sees its
 // surface patch most head-on holds density x texel area / |N.view|, the others
 // 0 (docs/cameras.md describes the visibility test).
+//
+// Layers (docs/design.md section 14): an input camera with `layers` K > 1 is
+// drawn K times, depth peeling: layer 0 is the nearest crossing of each texel
+// centre's view ray with any triangle, front- or back-facing; layer k the next
+// one farther than layer k-1's by more than 1e-5 x (1 + |d|) (surfaces 1 mm
+// apart at 50 m are two layers). Its normals are then the mesh's own, out of
+// the solid (with one layer they face the camera, as version 2's). A texel
+// with no crossing left holds the background (+inf, 0). Every map holds layer
+// 0's channels, then layer 1's named "layer1.R"..., and so on (wx_layer_channel);
+// every (input camera, layer) is a view of the initial-dirt ownership, a
+// layered camera's views reading its outward normals. The output camera has
+// one layer whatever it asks.
+//
+// Cost: a layered camera costs one draw of every mesh and one readback per
+// layer (the layers after the first with no crossing are not drawn), plus a
+// copy of the layer before into a texture (16 bytes a texel, in GL) and, for
+// the initial dirt, its outward normals interleaved (12 bytes a texel a
+// layer); the images handed to on_maps are K times today's. When the
+// visibility test keeps every input camera's depth, a layered camera's K depth
+// planes and K normal planes are kept too (16 bytes a texel a layer).
 #ifndef WX_BAKE_H
 #define WX_BAKE_H
 
@@ -39,8 +59,9 @@ typedef struct wx_bake_stats {
 
 /// Receives the maps of baked scene camera `camera`: maps[0] depth (R),
 /// maps[1] normal (R G B) and, for an input camera, maps[2] impact (R G B) and
-/// maps[3] dirt (R G B); count 2 or 4. The images are the bake's (valid during
-/// the call; the caller may add header attributes).
+/// maps[3] dirt (R G B); count 2 or 4. A layered camera's images hold each
+/// layer's channels after the layer before's ("layer1.R" ...). The images are
+/// the bake's (valid during the call; the caller may add header attributes).
 typedef wx_result wx_bake_maps_fn(int camera, wx_image *maps, int count, void *user,
                                   wx_error *err);
 
