@@ -1161,7 +1161,11 @@ TEST(layers_pane_one_millimetre_before_a_wall)
     // A pane (one quad, absorption 0.9) at z = 0.001 over x, y in [-0.5, 0.5],
     // before a wall box (absorption 0.1) x, y in [-1, 1], z in [-0.2, 0], seen
     // from 30 m: behind the pane, layer 0 is the pane, layer 1 the wall 1 mm
-    // farther, layer 2 the wall's back face (normal -z).
+    // farther, layer 2 the wall's back face (normal -z). Both start with dirt 1
+    // per square metre, stored once: 1 on the pane, 1 on the wall behind it
+    // (the layer whose surface the point is on owns it, though the pane's
+    // layer sees it within its depth tolerance), 3 on the rest of the wall's
+    // front, 4 on its back.
     wx_scene s;
     scene_begin(&s);
     const float eye[3] = { 0, 0, 30 };
@@ -1169,8 +1173,8 @@ TEST(layers_pane_one_millimetre_before_a_wall)
     const char *pane = ensure_write_file(
         ensure_tmpdir(), "pane.obj",
         "v -0.5 -0.5 0.001\nv 0.5 -0.5 0.001\nv 0.5 0.5 0.001\nv -0.5 0.5 0.001\nf 1 2 3 4\n");
-    add_surface(add_mesh(&s, pane, 30), "*", 0.9f, 0, 0, 0, 0);
-    add_surface(add_mesh(&s, write_box("wall.obj", -1, 1, -1, 1, -0.2f, 0), 40), "*", 0.1f, 0, 0,
+    add_surface(add_mesh(&s, pane, 30), "*", 0.9f, 0, 1, 0, 0);
+    add_surface(add_mesh(&s, write_box("wall.obj", -1, 1, -1, 1, -0.2f, 0), 40), "*", 0.1f, 0, 1,
                 0, 0);
     wx_run_def o;
     options_for(&o, "layers_pane");
@@ -1201,6 +1205,18 @@ TEST(layers_pane_one_millimetre_before_a_wall)
     ENSURE_NEAR(at(&m[1].depth, 0, 20, 32), 30.2, 1e-4);
     ensure_normal(&m[1], 20, 32, 0, 0, -1);
     ENSURE(layer_empty_at(&m[2], 20, 32));
+    double pane_dirt = 0.0, behind_dirt = 0.0;
+    for (int j = 24; j <= 39; ++j) {
+        for (int i = 24; i <= 39; ++i) {
+            pane_dirt += at(&m[0].dirt, 0, i, j);
+            behind_dirt += at(&m[1].dirt, 0, i, j);
+        }
+    }
+    ENSURE_NEAR(pane_dirt, 1.0, 1e-3);
+    ENSURE_NEAR(behind_dirt, 1.0, 1e-3);
+    ENSURE_NEAR(plane_sum(&m[0].dirt, 0), 4.0, 1e-3);
+    ENSURE_NEAR(plane_sum(&m[1].dirt, 0), 1.0 + 4.0 - 1.0, 1e-3);
+    ENSURE_NEAR(plane_sum(&m[1].dirt, 0) + plane_sum(&m[2].dirt, 0), 5.0, 1e-3);
     for (int l = 0; l < 4; ++l) {
         free_maps(&m[l]);
     }

@@ -99,6 +99,25 @@ bool wx_owner_sees(const wx_owner_view *view, const double p[3], const float n[3
     return fabs(uvd[2] - own) <= precision && fabs(uvd[2] - between) <= precision;
 }
 
+// |d - depth| of p against the texel of `view` it falls in (+inf outside).
+static double depth_error(const wx_owner_view *view, const double p[3])
+{
+    double uvd[3];
+    wx_matrix_apply_affine(view->camera->wtc, p, uvd);
+    int i = (int)floor(uvd[0] * view->width), j = (int)floor((1.0 - uvd[1]) * view->height);
+    if (i < 0 || j < 0 || i >= view->width || j >= view->height) {
+        return INFINITY;
+    }
+    float own = view->depth[(size_t)j * (size_t)view->width + (size_t)i];
+    return wx_depth_is_empty(own) ? INFINITY : fabs(uvd[2] - own);
+}
+
+// Two layers of one camera (docs/design.md section 14): the same matrices.
+static bool same_camera(const wx_owner_view *a, const wx_owner_view *b)
+{
+    return a->camera == b->camera || memcmp(a->camera->wtc, b->camera->wtc, sizeof a->camera->wtc) == 0;
+}
+
 int wx_owner_of(const wx_owner_view *views, int count, const double p[3], const float n[3],
                 int known)
 {
@@ -108,7 +127,16 @@ int wx_owner_of(const wx_owner_view *views, int count, const double p[3], const 
         const wx_owner_view *v = &views[k];
         float c = fabsf(n[0] * v->view[0] + n[1] * v->view[1] + n[2] * v->view[2]);
         if (!(c > best_cos + TIE_COSINE)) {
-            continue; // cannot win: ties go to the view listed first
+            // Ties go to the view listed first, but between two layers of one
+            // camera that both see p (a pane 1 mm in front of a wall: within
+            // the depth tolerance of each other) to the layer whose surface p
+            // is on.
+            if (best >= 0 && v->normal != NULL && c >= best_cos - TIE_COSINE &&
+                same_camera(v, &views[best]) && (k == known || wx_owner_sees(v, p, n)) &&
+                (k == known || depth_error(v, p) < depth_error(&views[best], p))) {
+                best = k;
+            }
+            continue;
         }
         if (k == known || wx_owner_sees(v, p, n)) {
             best = k;
