@@ -102,11 +102,14 @@ typedef struct wx_hit {
     uint32_t texel;   ///< j*W + i in that camera's maps (of that layer)
     float point[3];   ///< world point where the segment enters the surface
     /// Where the particle is put back: on that camera's surface slightly in
-    /// front of it (or, when it entered through a silhouette or frame edge, just
-    /// back along its segment); never a colliding point unless the segment
-    /// started inside.
+    /// front of it (with layers: on the hit face's free side), or, when it
+    /// entered through a silhouette or frame edge, just back along its segment;
+    /// never a colliding point unless the segment started inside.
     float front[3];
-    float normal[3];  ///< unit world normal at the texel
+    /// Unit world normal at the texel (with layers: the hit face's, turned to
+    /// face the particle when it points along the segment, a sheet hit from
+    /// behind).
+    float normal[3];
     float absorption; ///< impact R
     float bounce;     ///< impact G
 } wx_hit;
