@@ -342,6 +342,433 @@ TEST(coarse_test_is_conservative_and_put_back_is_outside)
     ENSURE(hits > 1000);
 }
 
+// --- layered maps (docs/design.md section 14) ------------------------------------
+
+// A world for layered maps: closed solids (each ray crossing enters and leaves
+// them, normals out) and one-sided sheets (a zero-thick solid of which a ray
+// records one crossing, with the sheet's own normal whichever side it comes from).
+typedef struct lay_world {
+    fx_world solids;
+    fx_world sheets;
+    float sheet_normal[FX_MAX_SOLIDS][3];
+} lay_world;
+
+typedef struct crossing {
+    double t;
+    float n[3];
+} crossing;
+
+// Entry and exit of a ray through a convex solid, with the planes' outward normals.
+static bool cross_solid(const fx_solid *s, const double o[3], const double d[3], crossing *in,
+                        crossing *out)
+{
+    double t0 = -1e30, t1 = 1e30;
+    int p0 = -1, p1 = -1;
+    for (int k = 0; k < s->plane_count; ++k) {
+        double nd = s->n[k][0] * d[0] + s->n[k][1] * d[1] + s->n[k][2] * d[2];
+        double no = s->n[k][0] * o[0] + s->n[k][1] * o[1] + s->n[k][2] * o[2];
+        if (fabs(nd) < 1e-12) {
+            if (no > s->c[k]) {
+                return false;
+            }
+            continue;
+        }
+        double t = (s->c[k] - no) / nd;
+        if (nd < 0 && t > t0) {
+            t0 = t;
+            p0 = k;
+        } else if (nd > 0 && t < t1) {
+            t1 = t;
+            p1 = k;
+        }
+    }
+    if (p0 < 0 || p1 < 0 || t0 > t1 || t0 < 0) {
+        return false;
+    }
+    in->t = t0;
+    out->t = t1;
+    memcpy(in->n, s->n[p0], sizeof in->n);
+    memcpy(out->n, s->n[p1], sizeof out->n);
+    return true;
+}
+
+static bool before(const crossing *a, const crossing *b, const double view[3])
+{
+    if (a->t != b->t) {
+        return a->t < b->t;
+    }
+    double fa = a->n[0] * view[0] + a->n[1] * view[1] + a->n[2] * view[2];
+    double fb = b->n[0] * view[0] + b->n[1] * view[1] + b->n[2] * view[2];
+    return fa > 0.0 && !(fb > 0.0); // leaving (n . view > 0) first
+}
+
+// Renders the first `layers` crossings of every texel's view ray (fx_render's
+// depth convention: distance from the camera's d = 0 plane), layer k's block
+// at k*W*H in each plane.
+static void render_layers(const wx_camera *cam, const lay_world *world, int layers, wx_maps *maps)
+{
+    int W = cam->width, H = cam->height;
+    size_t n = (size_t)W * (size_t)H;
+    memset(maps, 0, sizeof *maps);
+    maps->width = W;
+    maps->height = H;
+    maps->layers = layers;
+    maps->depth = malloc((size_t)layers * n * sizeof(float));
+    maps->normal = calloc(3 * (size_t)layers * n, sizeof(float));
+    maps->impact = malloc(2 * (size_t)layers * n * sizeof(float));
+    float dir[3];
+    wx_camera_view_dir(cam, dir);
+    double d[3] = { dir[0], dir[1], dir[2] };
+    for (int j = 0; j < H; ++j) {
+        for (int i = 0; i < W; ++i) {
+            size_t t = (size_t)j * (size_t)W + (size_t)i;
+            float uvd[3], eye[3];
+            wx_map_texel_center(W, H, i, j, &uvd[0], &uvd[1]);
+            uvd[2] = 0.0f;
+            wx_camera_map_to_world(cam, uvd, eye);
+            double o[3] = { eye[0], eye[1], eye[2] };
+            crossing list[2 * 2 * FX_MAX_SOLIDS];
+            int count = 0;
+            for (int s = 0; s < world->solids.solid_count; ++s) {
+                if (cross_solid(&world->solids.solids[s], o, d, &list[count],
+                                &list[count + 1])) {
+                    count += 2;
+                }
+            }
+            for (int s = 0; s < world->sheets.solid_count; ++s) {
+                crossing out;
+                if (cross_solid(&world->sheets.solids[s], o, d, &list[count], &out)) {
+                    memcpy(list[count].n, world->sheet_normal[s], sizeof list[count].n);
+                    count++;
+                }
+            }
+            // Nearest first; where two solids touch (a post on a floor), the
+            // leaving crossing before the entering one at the same depth, as
+            // the collider needs (docs/physics.md, "Layered maps").
+            for (int a = 1; a < count; ++a) {
+                for (int b = a; b > 0 && before(&list[b], &list[b - 1], d); --b) {
+                    crossing x = list[b];
+                    list[b] = list[b - 1];
+                    list[b - 1] = x;
+                }
+            }
+            for (int k = 0; k < layers; ++k) {
+                size_t at = (size_t)k * n + t;
+                maps->depth[at] = k < count ? (float)list[k].t : INFINITY;
+                if (k < count) {
+                    memcpy(&maps->normal[3 * at], list[k].n, sizeof list[k].n);
+                }
+                maps->impact[2 * at] = 0.1f * (float)k; // tells the layers apart
+                maps->impact[2 * at + 1] = 0.5f;
+            }
+        }
+    }
+}
+
+static bool build_layers(wx_collider *col, const wx_camera *cams, wx_maps *maps, int count,
+                         const lay_world *world, int layers)
+{
+    for (int c = 0; c < count; ++c) {
+        render_layers(&cams[c], world, layers, &maps[c]);
+    }
+    wx_error err;
+    return wx_collider_init(col, cams, maps, count, false, &err) == WX_OK;
+}
+
+static fx_solid *sheet(lay_world *w, float x0, float y0, float z0, float x1, float y1, float z1,
+                       float nx, float ny, float nz)
+{
+    int k = w->sheets.solid_count;
+    w->sheet_normal[k][0] = nx;
+    w->sheet_normal[k][1] = ny;
+    w->sheet_normal[k][2] = nz;
+    return fx_box(&w->sheets, x0, y0, z0, x1, y1, z1);
+}
+
+// A railing on a floor slab: a wide handrail (y 1.0 to 1.1, z 0.6 to 1.0) and a
+// low bar in its front plane (y 0.4 to 0.5, z 0.9 to 1.0), seen by a front and a
+// top camera. Behind the bar and under the handrail both one-layer maps say
+// "behind": a drop falling there stops at the bar's top (y = 0.5), in mid-air.
+// With four layers it falls through the free space and lands on the floor.
+TEST(railing_layers_let_a_drop_fall_behind_the_bars)
+{
+    lay_world world = { 0 };
+    fx_box(&world.solids, -3, -1, -3, 3, 0, 3);        // floor
+    fx_box(&world.solids, -2, 1.0f, 0.6f, 2, 1.1f, 1); // handrail
+    fx_box(&world.solids, -2, 0.4f, 0.9f, 2, 0.5f, 1); // low bar
+    wx_camera cams[2] = { fx_camera(0, 0, 10, 0, 0, 0, 0, 1, 0, 6.4f, 64), top_camera(6.4f, 64) };
+    float p0[3] = { 0.33f, 0.8f, 0.77f }, p1[3] = { 0.33f, -0.4f, 0.77f };
+    // Between the bars, through the railing's plane, under the handrail.
+    float q0[3] = { -0.47f, 0.75f, 1.5f }, q1[3] = { -0.47f, 0.7f, 0.7f };
+    wx_hit hit[2], through[2];
+    bool hits[2], crosses[2], start[2];
+    for (int mode = 0; mode < 2; ++mode) {
+        int layers = mode == 0 ? 1 : 4;
+        wx_maps maps[2];
+        wx_collider col;
+        ENSURE(build_layers(&col, cams, maps, 2, &world, layers));
+        start[mode] = wx_collider_point_collides(&col, p0);
+        hits[mode] = wx_collider_sweep(&col, p0, p1, &hit[mode]);
+        crosses[mode] = wx_collider_sweep(&col, q0, q1, &through[mode]);
+        release(&col, maps, 2);
+    }
+    ENSURE(!start[0] && !start[1]);
+    ENSURE(hits[0] && hits[1]);
+    // One layer: stopped at the bar's top, behind it, under the handrail.
+    ENSURE_NEAR(hit[0].point[1], 0.5, 1e-5);
+    ENSURE(hit[0].layer == 0);
+    // Four layers: on the floor, as the top camera sees it through the
+    // handrail's two crossings (layer 2, normal up).
+    ENSURE_NEAR(hit[1].s, 0.8 / 1.2, 1e-5 * (0.8 / 1.2));
+    ENSURE_NEAR(hit[1].point[1], 0.0, 1e-5);
+    ENSURE(hit[1].camera == 1);
+    ENSURE(hit[1].layer == 2);
+    ENSURE_NEAR(hit[1].normal[1], 1.0, 1e-6);
+    ENSURE(hit[1].absorption == 0.2f);
+    ENSURE(hit[1].front[1] > 0.0f && hit[1].front[1] < 0.002f);
+    ENSURE(!crosses[1]);
+}
+
+// A roof slab (y 2.0 to 2.2) over a floor, seen from above and from the front
+// with four layers: under the roof is free space; a drop through the roof hits
+// its top; a particle rising under it hits its underside (layer 1, normal down)
+// and is put back below it.
+TEST(overhang_layers_free_under_the_roof_and_hit_its_underside)
+{
+    lay_world world = { 0 };
+    fx_box(&world.solids, -3, -1, -3, 3, 0, 3);        // floor
+    fx_box(&world.solids, -1, 2.0f, -1, 1, 2.2f, 1);   // roof
+    wx_camera cams[2] = { fx_camera(0, 0, 10, 0, 0, 0, 0, 1, 0, 6.4f, 64), top_camera(6.4f, 64) };
+    wx_maps maps[2];
+    wx_collider col;
+    ENSURE(build_layers(&col, cams, maps, 2, &world, 4));
+    float a0[3] = { -1.5f, 1.23f, 0.27f }, a1[3] = { 1.5f, 1.23f, 0.31f };   // under the roof
+    float b0[3] = { 0.33f, 3.0f, 0.27f }, b1[3] = { 0.33f, 1.0f, 0.27f };    // falls on it
+    float c0[3] = { 0.33f, 1.0f, 0.27f }, c1[3] = { 0.33f, 2.1f, 0.27f };    // rises under it
+    float under[3] = { 0.1f, 1.5f, 0.1f }, inside[3] = { 0.1f, 2.1f, 0.1f };
+    wx_hit side, top, below;
+    bool hs = wx_collider_sweep(&col, a0, a1, &side);
+    bool ht = wx_collider_sweep(&col, b0, b1, &top);
+    bool hb = wx_collider_sweep(&col, c0, c1, &below);
+    bool pu = wx_collider_point_collides(&col, under), pi = wx_collider_point_collides(&col, inside);
+    bool front_out = hb && !wx_collider_point_collides(&col, below.front);
+    release(&col, maps, 2);
+    ENSURE(!hs);
+    ENSURE(!pu && pi);
+    ENSURE(ht && hb);
+    ENSURE_NEAR(top.s, 0.4, 1e-5 * 0.4);
+    ENSURE_NEAR(top.point[1], 2.2, 1e-5);
+    ENSURE(top.layer == 0 && top.camera == 1);
+    ENSURE_NEAR(top.normal[1], 1.0, 1e-6);
+    ENSURE_NEAR(below.s, 1.0 / 1.1, 1e-5 / 1.1);
+    ENSURE_NEAR(below.point[1], 2.0, 1e-5);
+    ENSURE(below.camera == 1 && below.layer == 1);
+    ENSURE_NEAR(below.normal[1], -1.0, 1e-6);
+    ENSURE(below.absorption == 0.1f);
+    ENSURE(below.front[1] < 2.0f && below.front[1] > 1.998f); // put back below it
+    ENSURE(front_out);
+}
+
+// The underside of a tilted roof (y = 2 + 0.2 x): the layer's bilinear depth is
+// exact on a plane, so a rising particle hits the underside where the plane is.
+TEST(tilted_underside_hit_is_exact)
+{
+    lay_world world = { 0 };
+    fx_box(&world.solids, -3, -1, -3, 3, 0, 3);
+    fx_solid *roof = fx_box(&world.solids, -1.5f, 1.0f, -1, 1.5f, 3.5f, 1);
+    fx_plane(roof, -0.2f, 1.0f, 0.0f, 2.2f);   // y - 0.2 x <= 2.2
+    fx_plane(roof, 0.2f, -1.0f, 0.0f, -2.0f);  // y - 0.2 x >= 2.0
+    wx_camera cam = top_camera(6.4f, 64);
+    wx_maps maps;
+    wx_collider col;
+    ENSURE(build_layers(&col, &cam, &maps, 1, &world, 4));
+    double worst = 0.0;
+    int hits = 0, layer1 = 0;
+    for (int i = 0; i < 200; ++i) {
+        float x = -1.2f + 2.4f * (float)i / 200.0f, z = -0.8f + 1.6f * (float)((i * 37) % 200) / 200.0f;
+        float p0[3] = { x, 1.0f, z }, p1[3] = { x, 3.0f, z };
+        wx_hit hit;
+        if (!wx_collider_sweep(&col, p0, p1, &hit)) {
+            continue;
+        }
+        hits++;
+        layer1 += hit.layer == 1 && hit.normal[1] < 0.0f;
+        double s = ((2.0 + 0.2 * x) - 1.0) / 2.0; // analytic crossing of the underside
+        worst = fmax(worst, fabs(hit.s - s) / s);
+    }
+    release(&col, &maps, 1);
+    ENSURE(hits == 200);
+    ENSURE(layer1 == 200);
+    ENSURE(worst < 1e-5);
+}
+
+// A one-sided pane (z = 1, normal +z) in front of a wall (z -1 to 0), seen
+// from the front and from behind with four layers. A segment crossing the pane
+// from the front hits it there; one from behind, between pane and wall, hits
+// its back a quarter texel (the sheet's slab) behind it, with the normal turned
+// towards the particle; the space between pane and wall is free.
+TEST(pane_is_a_thin_sheet_hit_from_either_side)
+{
+    lay_world world = { 0 };
+    fx_box(&world.solids, -2, 0, -1, 2, 3, 0);              // wall
+    sheet(&world, -1, 0.5f, 1, 1, 2.5f, 1, 0.0f, 0.0f, 1.0f); // pane
+    wx_camera cams[2] = { fx_camera(0, 0, 10, 0, 0, 0, 0, 1, 0, 6.4f, 64),
+                          fx_camera(0, 0, -10, 0, 0, 0, 0, 1, 0, 6.4f, 64) };
+    wx_maps maps[2];
+    wx_collider col;
+    ENSURE(build_layers(&col, cams, maps, 2, &world, 4));
+    float t = 0.25f * col.cameras[0].texel_ws; // the sheet's thickness
+    float f0[3] = { 0.33f, 1.27f, 2.0f }, f1[3] = { 0.33f, 1.27f, 0.5f };
+    float b0[3] = { 0.33f, 1.27f, 0.5f }, b1[3] = { 0.33f, 1.27f, 2.0f };
+    float g0[3] = { -0.8f, 1.27f, 0.5f }, g1[3] = { 0.8f, 1.6f, 0.3f }; // between pane and wall
+    float w0[3] = { 0.33f, 1.27f, 0.5f }, w1[3] = { 0.33f, 1.27f, -0.5f }; // onto the wall
+    float gap[3] = { 0.1f, 1.5f, 0.5f };
+    wx_hit front, back, free_hit, wall;
+    bool hf = wx_collider_sweep(&col, f0, f1, &front);
+    bool hb = wx_collider_sweep(&col, b0, b1, &back);
+    bool hg = wx_collider_sweep(&col, g0, g1, &free_hit);
+    bool hw = wx_collider_sweep(&col, w0, w1, &wall);
+    bool pg = wx_collider_point_collides(&col, gap);
+    bool out_f = hf && !wx_collider_point_collides(&col, front.front);
+    bool out_b = hb && !wx_collider_point_collides(&col, back.front);
+    release(&col, maps, 2);
+    ENSURE(!hg && !pg);
+    ENSURE(hf && hb && hw);
+    ENSURE_NEAR(front.s, 1.0 / 1.5, 1e-5);
+    ENSURE_NEAR(front.point[2], 1.0, 1e-5);
+    ENSURE_NEAR(front.normal[2], 1.0, 1e-6);
+    ENSURE(front.front[2] > 1.0f && front.front[2] < 1.002f);
+    double sb = (1.0 - t - 0.5) / 1.5; // where z = 1 - t, from z = 0.5
+    ENSURE_NEAR(back.s, sb, 1e-5 * sb);
+    ENSURE_NEAR(back.normal[2], -1.0, 1e-6); // flipped towards the particle
+    ENSURE(back.front[2] < 1.0f - t && back.front[2] > 1.0f - t - 0.002f);
+    ENSURE(out_f && out_b);
+    ENSURE_NEAR(wall.point[2], 0.0, 1e-5); // the wall's front, as before
+    ENSURE(wall.layer == 1 && wall.camera == 0);
+}
+
+// Random segments through a layered scene (an overhang on posts over a floor, a
+// pane) seen by three cameras with four layers: the coarse test never clears a
+// segment that hits; the sweep agrees with the point rule (no point before the
+// hit collides, and without a hit none along the segment does); every put-back
+// point is outside.
+TEST(layered_sweep_agrees_with_the_point_rule)
+{
+    lay_world world = { 0 };
+    fx_box(&world.solids, -3, -1, -3, 3, 0, 3);          // floor
+    fx_box(&world.solids, -1.5f, 1.5f, -1.5f, 1.5f, 1.8f, 1.5f); // roof
+    fx_box(&world.solids, -1.5f, 0, -1.5f, -1.2f, 1.5f, -1.2f);  // a post
+    fx_box(&world.solids, 0.3f, 0.3f, -0.4f, 0.7f, 0.6f, 0.2f);  // a block under the roof
+    sheet(&world, -2.0f, 0.2f, 2.2f, 2.0f, 1.2f, 2.2f, 0.0f, 0.0f, 1.0f); // pane
+    wx_camera cams[3] = { fx_camera(0, 0, 10, 0, 0, 0, 0, 1, 0, 7, 128),
+                          fx_camera(10, 0, 0, 0, 0, 0, 0, 1, 0, 7, 128), top_camera(7, 128) };
+    wx_maps maps[3];
+    wx_collider col;
+    ENSURE(build_layers(&col, cams, maps, 3, &world, 4));
+    uint64_t state = 7;
+    int hits = 0, cleared = 0, contradictions = 0, early = 0, missed = 0, bad_front = 0;
+    int phantom = 0;
+    for (int i = 0; i < 40000; ++i) {
+        float r[6];
+        for (int q = 0; q < 6; ++q) {
+            state = wx_mix64(state + 1);
+            r[q] = (float)((state >> 11) * (1.0 / 9007199254740992.0));
+        }
+        float len = (i % 4 == 0) ? 2.0f : 0.3f;
+        float p0[3] = { -3.2f + 6.4f * r[0], -0.5f + 3.0f * r[1], -3.2f + 6.4f * r[2] };
+        float p1[3] = { p0[0] + len * (r[3] - 0.5f), p0[1] + len * (r[4] - 0.5f),
+                        p0[2] + len * (r[5] - 0.5f) };
+        if (wx_collider_point_collides(&col, p0)) {
+            continue;
+        }
+        wx_hit hit;
+        bool h = wx_collider_sweep(&col, p0, p1, &hit);
+        bool clear = wx_collider_coarse_clear(&col, p0, p1);
+        cleared += clear;
+        contradictions += clear && h;
+        double end = h ? hit.s - 1e-4 : 1.0;
+        for (int k = 0; k <= 64; ++k) {
+            double s = end * k / 64.0;
+            float q[3];
+            for (int a = 0; a < 3; ++a) {
+                q[a] = (float)(p0[a] + s * ((double)p1[a] - p0[a]));
+            }
+            if (wx_collider_point_collides(&col, q)) {
+                early += h;
+                missed += !h;
+                break;
+            }
+        }
+        if (h) {
+            hits++;
+            bad_front += wx_collider_point_collides(&col, hit.front);
+            // Just after the hit (a hundredth of a texel on) the segment is inside.
+            bool inside = false;
+            double seg = sqrt(((double)p1[0] - p0[0]) * ((double)p1[0] - p0[0]) +
+                              ((double)p1[1] - p0[1]) * ((double)p1[1] - p0[1]) +
+                              ((double)p1[2] - p0[2]) * ((double)p1[2] - p0[2]));
+            for (int k = 1; k <= 4 && !inside; ++k) {
+                double s = fmin(1.0, hit.s + k * 0.0025 * col.cameras[0].texel_ws / seg);
+                float q[3];
+                for (int a = 0; a < 3; ++a) {
+                    q[a] = (float)(p0[a] + s * ((double)p1[a] - p0[a]));
+                }
+                inside = wx_collider_point_collides(&col, q);
+            }
+            phantom += !inside;
+        }
+    }
+    release(&col, maps, 3);
+    ENSURE(contradictions == 0);
+    ENSURE(early == 0);
+    ENSURE(missed == 0);
+    ENSURE(bad_front == 0);
+    ENSURE(phantom == 0);
+    ENSURE(hits > 1500);
+    ENSURE(cleared > 20000);
+}
+
+// A map whose only layer is given as layers = 1 works exactly as one with
+// layers = 0 (version 2's maps), bit for bit.
+TEST(one_layer_is_todays_collider)
+{
+    lay_world world = { 0 };
+    fx_box(&world.solids, -1, -1, -1, 1, 1, 1);
+    fx_box(&world.solids, -3, -2, -3, 3, -1.5f, 3);
+    wx_camera cams[2] = { fx_camera(0, 0, 10, 0, 0, 0, 0, 1, 0, 7, 64), top_camera(7, 64) };
+    wx_hit h[2][200];
+    bool r[2][200];
+    for (int mode = 0; mode < 2; ++mode) {
+        wx_maps maps[2];
+        wx_collider col;
+        ENSURE(build_layers(&col, cams, maps, 2, &world, 1));
+        for (int c = 0; c < 2; ++c) {
+            maps[c].layers = mode; // 0 or 1: one layer
+        }
+        wx_collider_free(&col);
+        wx_error err;
+        ENSURE(wx_collider_init(&col, cams, maps, 2, false, &err) == WX_OK);
+        uint64_t state = 11;
+        for (int i = 0; i < 200; ++i) {
+            float v[6];
+            for (int q = 0; q < 6; ++q) {
+                state = wx_mix64(state + 1);
+                v[q] = -3.0f + 6.0f * (float)((state >> 11) * (1.0 / 9007199254740992.0));
+            }
+            memset(&h[mode][i], 0, sizeof h[mode][i]);
+            r[mode][i] = wx_collider_sweep(&col, v, v + 3, &h[mode][i]);
+        }
+        release(&col, maps, 2);
+    }
+    int hits = 0;
+    for (int i = 0; i < 200; ++i) {
+        ENSURE(r[0][i] == r[1][i]);
+        ENSURE(memcmp(&h[0][i], &h[1][i], sizeof h[0][i]) == 0);
+        hits += r[0][i];
+    }
+    ENSURE(hits > 20);
+}
+
 TEST(projective_cameras_are_refused)
 {
     fx_world world = { 0 };
@@ -371,5 +798,11 @@ int main(void)
     RUN(start_inside_is_pushed_out);
     RUN(coarse_test_is_conservative_and_put_back_is_outside);
     RUN(projective_cameras_are_refused);
+    RUN(railing_layers_let_a_drop_fall_behind_the_bars);
+    RUN(overhang_layers_free_under_the_roof_and_hit_its_underside);
+    RUN(tilted_underside_hit_is_exact);
+    RUN(pane_is_a_thin_sheet_hit_from_either_side);
+    RUN(layered_sweep_agrees_with_the_point_rule);
+    RUN(one_layer_is_todays_collider);
     return ensure_summary();
 }

@@ -149,6 +149,79 @@ static bool border_is_empty(const float *depth, int W, int H)
     return true;
 }
 
+// What crossing k of a texel bounds, in a camera with layered maps (docs/physics.md,
+// "Layered maps"), walking the texel's crossings nearest first:
+//  - ENTER: it enters a solid that crossing k + 1 (LEAVE) leaves: [d_k, d_k+1];
+//  - SHEET: one-sided (an entering crossing followed by another entering one or
+//    by none while layers are left, or a leaving one with nothing open): a slab
+//    `sheet` thick on the inner side of its normal (sheet_start);
+//  - TAIL: solid from d_k on: the last crossing when every layer holds one, for
+//    what lies behind it is unknown (then a LEAVE there is SPENT: no face).
+// The FACING bit is set where the crossing enters (n . view <= 0).
+enum {
+    WX_ROLE_NONE = 0,
+    WX_ROLE_ENTER = 1,
+    WX_ROLE_LEAVE = 2,
+    WX_ROLE_SHEET = 3,
+    WX_ROLE_TAIL = 4,
+    WX_ROLE_SPENT = 5,
+    WX_ROLE_KIND = 7,
+    WX_ROLE_FACING = 8,
+};
+
+// The roles of every texel's crossings (depth already copied, normals set).
+static void classify_layers(wx_collider_camera *cam)
+{
+    int K = cam->layers;
+    size_t texels = (size_t)cam->width * (size_t)cam->height;
+    for (size_t t = 0; t < texels; ++t) {
+        int n = 0, open = -1;
+        uint8_t *role = cam->role + t;
+        for (int k = 0; k < K; ++k) {
+            size_t at = (size_t)k * texels + t;
+            if (n < k || !isfinite(cam->depth[at])) {
+                cam->depth[at] = INFINITY; // a crossing after an empty layer is ignored
+                role[k * texels] = WX_ROLE_NONE;
+                continue;
+            }
+            n = k + 1;
+            const float *nv = cam->normal + 3 * at;
+            // back points towards the camera: n . view < 0 is n . back > 0. A
+            // grazing or missing normal counts as entering, as one layer's does.
+            float dot = nv[0] * cam->back[0] + nv[1] * cam->back[1] + nv[2] * cam->back[2];
+            bool entering = !(dot < 0.0f);
+            role[k * texels] = entering ? WX_ROLE_FACING : 0;
+            if (entering) {
+                if (open >= 0) {
+                    role[open * texels] |= WX_ROLE_SHEET;
+                }
+                open = k;
+            } else if (open >= 0) {
+                role[open * texels] |= WX_ROLE_ENTER;
+                role[k * texels] |= WX_ROLE_LEAVE;
+                open = -1;
+            } else {
+                role[k * texels] |= WX_ROLE_SHEET;
+            }
+        }
+        if (open >= 0) {
+            role[open * texels] |= n == K ? WX_ROLE_TAIL : WX_ROLE_SHEET;
+        } else if (n == K) {
+            // Every layer holds a crossing and the last one leaves: what lies
+            // behind it is unknown, so solid, as one layer's map says (the
+            // other cameras decide by the point rule).
+            uint8_t *last = &role[(n - 1) * texels];
+            if ((*last & WX_ROLE_KIND) == WX_ROLE_LEAVE) {
+                uint8_t *enter = &role[(n - 2) * texels];
+                *enter = (uint8_t)((*enter & ~WX_ROLE_KIND) | WX_ROLE_TAIL);
+                *last = (uint8_t)((*last & ~WX_ROLE_KIND) | WX_ROLE_SPENT);
+            } else {
+                *last = (uint8_t)((*last & ~WX_ROLE_KIND) | WX_ROLE_TAIL);
+            }
+        }
+    }
+}
+
 wx_result wx_collider_init(wx_collider *collider, const wx_camera *cameras, const wx_maps *maps,
                            int count, bool nearest, wx_error *err)
 {
@@ -188,18 +261,40 @@ wx_result wx_collider_init(wx_collider *collider, const wx_camera *cameras, cons
             wx_collider_free(collider);
             return r;
         }
+        int layers = wx_maps_layers(m);
+        if (layers > WX_MAX_LAYERS) {
+            wx_collider_free(collider);
+            return wx_fail(err, WX_CAUSE_BAD_ARGUMENT,
+                           "input camera %d: %d layers; the collider takes at most %d", c,
+                           layers, WX_MAX_LAYERS);
+        }
         size_t texels = (size_t)m->width * (size_t)m->height;
-        cam->depth = malloc(texels * sizeof *cam->depth);
-        if (cam->depth == NULL) {
+        cam->layers = layers;
+        cam->depth = malloc((size_t)layers * texels * sizeof *cam->depth);
+        if (layers > 1) {
+            cam->role = malloc((size_t)layers * texels);
+        }
+        if (cam->depth == NULL || (layers > 1 && cam->role == NULL)) {
             wx_collider_free(collider);
             return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (collider depth)");
         }
-        for (size_t t = 0; t < texels; ++t) {
+        for (size_t t = 0; t < (size_t)layers * texels; ++t) {
             cam->depth[t] = wx_depth_is_empty(m->depth[t]) ? INFINITY : m->depth[t];
         }
         cam->frames_model = border_is_empty(cam->depth, m->width, m->height);
         cam->normal = m->normal;
         cam->impact = m->impact;
+        if (layers > 1) {
+            // A quarter texel (docs/physics.md, "Layered maps"): thick enough for
+            // float rounding and to bridge the steps the silhouette rule leaves
+            // along a sheet's edge, thin enough that a hit from behind lies
+            // within half the collider's precision (half a texel) of the sheet.
+            double bl = sqrt((double)cam->back[0] * cam->back[0] +
+                             (double)cam->back[1] * cam->back[1] +
+                             (double)cam->back[2] * cam->back[2]);
+            cam->sheet = 0.25 * cam->texel_ws / bl;
+            classify_layers(cam);
+        }
         r = build_coarse(cam, err);
         if (r != WX_OK) {
             wx_collider_free(collider);
@@ -213,6 +308,7 @@ void wx_collider_free(wx_collider *collider)
 {
     for (int c = 0; c < collider->camera_count; ++c) {
         free(collider->cameras[c].depth);
+        free(collider->cameras[c].role);
         free(collider->cameras[c].coarse);
     }
     free(collider->cameras);
@@ -280,11 +376,130 @@ static bool cell_surface(const wx_collider *collider, const wx_collider_camera *
     return true;
 }
 
+// Layer k's depth over half-texel cell (hx, hy) of a camera with layers, whose
+// own texel holds crossing `own` with role `own_role`: the bilinear cell when
+// the four texels around hold layer k facing the same way (the silhouette rule
+// generalised: a layer's surface is smooth where its neighbours see the same
+// side of something), else the texel's own depth.
+static void layer_cell(const wx_collider *collider, const wx_collider_camera *cam, int k,
+                       int hx, int hy, float own, uint8_t own_role, cell_depth *cd)
+{
+    cd->k1 = cd->k2 = cd->k3 = 0.0;
+    cd->k0 = own;
+    cd->ox = cd->oy = 0.0;
+    if (collider->nearest) {
+        return;
+    }
+    int W = cam->width, H = cam->height;
+    size_t plane = (size_t)k * (size_t)W * (size_t)H;
+    int i0 = hx / 2 - 1 + (hx & 1), j0 = hy / 2 - 1 + (hy & 1);
+    int ia = clampi(i0, 0, W - 1), ib = clampi(i0 + 1, 0, W - 1);
+    int ja = clampi(j0, 0, H - 1), jb = clampi(j0 + 1, 0, H - 1);
+    size_t ra = plane + (size_t)ja * (size_t)W, rb = plane + (size_t)jb * (size_t)W;
+    double d00 = cam->depth[ra + ia], d10 = cam->depth[ra + ib];
+    double d01 = cam->depth[rb + ia], d11 = cam->depth[rb + ib];
+    if (!isfinite(d00) || !isfinite(d10) || !isfinite(d01) || !isfinite(d11)) {
+        return;
+    }
+    unsigned differ = (unsigned)(cam->role[ra + ia] ^ own_role) |
+                      (unsigned)(cam->role[ra + ib] ^ own_role) |
+                      (unsigned)(cam->role[rb + ia] ^ own_role) |
+                      (unsigned)(cam->role[rb + ib] ^ own_role);
+    if (differ & WX_ROLE_FACING) {
+        return;
+    }
+    cd->ox = i0 + 0.5;
+    cd->oy = j0 + 0.5;
+    cd->k0 = d00;
+    cd->k1 = d10 - d00;
+    cd->k2 = d01 - d00;
+    cd->k3 = d00 - d10 - d01 + d11;
+}
+
+static inline double cell_value(const cell_depth *cd, double X, double Y)
+{
+    double fx = X - cd->ox, fy = Y - cd->oy;
+    return cd->k0 + cd->k1 * fx + cd->k2 * fy + cd->k3 * fx * fy;
+}
+
+// Where a sheet's slab starts, past its crossing's depth: the slab lies on the
+// side its outward normal points away from, where a solid would be: behind the
+// crossing (along the view) when the camera sees the sheet's front, in front of
+// it when it sees its back. So cameras that see a sheet from opposite sides
+// agree on one slab, a quarter texel thick, not two that only touch.
+static inline double sheet_start(const wx_collider_camera *cam, uint8_t role)
+{
+    return (role & WX_ROLE_FACING) ? 0.0 : -cam->sheet;
+}
+
+// The crossings' depths at texel-space point (X, Y) inside the frame of a camera
+// with layers: how many there are (layers after the first empty one hold none),
+// their depths and roles.
+static int layer_depths(const wx_collider *collider, const wx_collider_camera *cam, double X,
+                        double Y, double depth[WX_MAX_LAYERS], uint8_t role[WX_MAX_LAYERS])
+{
+    int hx = clampi((int)(2.0 * X), 0, 2 * cam->width - 1);
+    int hy = clampi((int)(2.0 * Y), 0, 2 * cam->height - 1);
+    size_t texels = (size_t)cam->width * (size_t)cam->height;
+    size_t t = (size_t)(hy >> 1) * (size_t)cam->width + (size_t)(hx >> 1);
+    int n = 0;
+    for (; n < cam->layers; ++n) {
+        float own = cam->depth[(size_t)n * texels + t];
+        if (!isfinite(own)) {
+            break;
+        }
+        role[n] = cam->role[(size_t)n * texels + t];
+        cell_depth cd;
+        layer_cell(collider, cam, n, hx, hy, own, role[n], &cd);
+        depth[n] = cell_value(&cd, X, Y);
+    }
+    return n;
+}
+
+// The point rule of one camera with layers at (X, Y, D) inside its frame: D lies
+// strictly inside one of the solid intervals or sheet slabs of the crossings.
+static bool layers_may_collide(const wx_collider *collider, const wx_collider_camera *cam,
+                               double X, double Y, double D)
+{
+    double depth[WX_MAX_LAYERS];
+    uint8_t role[WX_MAX_LAYERS];
+    int n = layer_depths(collider, cam, X, Y, depth, role);
+    for (int k = 0; k < n; ++k) {
+        switch (role[k] & WX_ROLE_KIND) {
+        case WX_ROLE_ENTER:
+            if (D > depth[k] && D < depth[k + 1]) {
+                return true;
+            }
+            break;
+        case WX_ROLE_SHEET: {
+            double front = depth[k] + sheet_start(cam, role[k]);
+            if (D > front && D < front + cam->sheet) {
+                return true;
+            }
+            break;
+        }
+        case WX_ROLE_TAIL:
+            if (D > depth[k]) {
+                return true;
+            }
+            break;
+        default:
+            break;
+        }
+    }
+    return false;
+}
+
 double wx_collider_depth_at(const wx_collider *collider, int c, double X, double Y)
 {
     const wx_collider_camera *cam = &collider->cameras[c];
     if (!(X >= 0.0 && X < cam->width && Y >= 0.0 && Y < cam->height)) {
         return INFINITY;
+    }
+    if (cam->layers > 1) {
+        double depth[WX_MAX_LAYERS];
+        uint8_t role[WX_MAX_LAYERS];
+        return layer_depths(collider, cam, X, Y, depth, role) > 0 ? depth[0] : INFINITY;
     }
     int hx = clampi((int)(2.0 * X), 0, 2 * cam->width - 1);
     int hy = clampi((int)(2.0 * Y), 0, 2 * cam->height - 1);
@@ -294,6 +509,17 @@ double wx_collider_depth_at(const wx_collider *collider, int c, double X, double
     }
     double fx = X - cd.ox, fy = Y - cd.oy;
     return cd.k0 + cd.k1 * fx + cd.k2 * fy + cd.k3 * fx * fy;
+}
+
+// Camera c's answer for a point (X, Y, D) inside its frame: it may collide
+// (behind its surface, or inside one of its solid intervals with layers).
+static bool camera_may_collide(const wx_collider *collider, int c, double X, double Y, double D)
+{
+    const wx_collider_camera *cam = &collider->cameras[c];
+    if (cam->layers > 1) {
+        return layers_may_collide(collider, cam, X, Y, D);
+    }
+    return D > wx_collider_depth_at(collider, c, X, Y);
 }
 
 bool wx_collider_point_collides(const wx_collider *collider, const float p[3])
@@ -311,7 +537,7 @@ bool wx_collider_point_collides(const wx_collider *collider, const float p[3])
             continue; // no information
         }
         informed = true;
-        if (!(D > wx_collider_depth_at(collider, c, X, Y))) {
+        if (!camera_may_collide(collider, c, X, Y, D)) {
             return false; // this camera sees the point in front (or no surface)
         }
     }
@@ -334,6 +560,13 @@ typedef struct march {
     double sa, sb;      ///< its parameter interval
     bool surface;       ///< the cell's texel holds a surface
     double A, B, C;     ///< f over the cell
+    // With layers: f_k = D - depth_k = LA + LB s + LC s^2 for the cell texel's
+    // `count` crossings, their roles, and the crossing whose interval or slab
+    // the last answer of march_entry lies in (-1: none).
+    int count;
+    int hit_k;
+    uint8_t role[WX_MAX_LAYERS];
+    double LA[WX_MAX_LAYERS], LB[WX_MAX_LAYERS], LC[WX_MAX_LAYERS];
 } march;
 
 // Parameter interval where lo <= P0 + s*dP < hi, intersected into [*a, *b);
@@ -374,6 +607,7 @@ static void march_init(march *m, const wx_collider_camera *cam, const double p0[
     clip_slab(m->X0, m->rX, 0.0, cam->width, &m->s_in, &m->s_out);
     clip_slab(m->Y0, m->rY, 0.0, cam->height, &m->s_in, &m->s_out);
     m->placed = false;
+    m->hit_k = -1;
 }
 
 static inline bool march_inside(const march *m, double s)
@@ -394,8 +628,40 @@ static double next_boundary(double P0, double r, int h)
     return INFINITY;
 }
 
+// The cell's functions f_k for a camera with layers.
+static void cell_layers(const wx_collider *collider, march *m)
+{
+    const wx_collider_camera *cam = m->cam;
+    size_t texels = (size_t)cam->width * (size_t)cam->height;
+    size_t t = (size_t)(m->hy >> 1) * (size_t)cam->width + (size_t)(m->hx >> 1);
+    int n = 0;
+    for (; n < cam->layers; ++n) {
+        float own = cam->depth[(size_t)n * texels + t];
+        if (!isfinite(own)) {
+            break;
+        }
+        uint8_t role = cam->role[(size_t)n * texels + t];
+        cell_depth cd;
+        layer_cell(collider, cam, n, m->hx, m->hy, own, role, &cd);
+        double fx0 = m->X0 - cd.ox, fy0 = m->Y0 - cd.oy;
+        double c0 = cd.k0 + cd.k1 * fx0 + cd.k2 * fy0 + cd.k3 * fx0 * fy0;
+        double c1 = cd.k1 * m->dX + cd.k2 * m->dY + cd.k3 * (fx0 * m->dY + fy0 * m->dX);
+        double c2 = cd.k3 * m->dX * m->dY;
+        m->role[n] = role;
+        m->LA[n] = m->D0 - c0;
+        m->LB[n] = m->dD - c1;
+        m->LC[n] = -c2;
+    }
+    m->count = n;
+    m->surface = n > 0;
+}
+
 static void cell_function(const wx_collider *collider, march *m)
 {
+    if (m->cam->layers > 1) {
+        cell_layers(collider, m);
+        return;
+    }
     cell_depth cd;
     m->surface = cell_surface(collider, m->cam, m->hx, m->hy, &cd);
     if (!m->surface) {
@@ -485,6 +751,97 @@ static double first_nonnegative(double A, double B, double C, double lo, double 
     return tau <= len ? lo + tau : INFINITY;
 }
 
+// Smallest s in [lo, hi] with g1(s) >= 0 and, when `bounded`, g2(s) <= 0 (inside
+// [enter, leave] of a solid interval, f measured from each face): leapfrogs
+// between the two conditions, each step past a root of one quadratic, so a few
+// rounds settle it; +inf when none.
+static double first_between(double A1, double B1, double C1, bool bounded, double A2, double B2,
+                            double C2, double lo, double hi)
+{
+    double s = lo;
+    for (int round = 0; round < 8; ++round) {
+        double s1 = first_nonnegative(A1, B1, C1, s, hi);
+        if (!(s1 <= hi)) {
+            return INFINITY;
+        }
+        if (!bounded || A2 + s1 * (B2 + s1 * C2) <= 0.0) {
+            return s1;
+        }
+        double s2 = first_nonnegative(-A2, -B2, -C2, s1, hi);
+        if (!(s2 <= hi)) {
+            return INFINITY;
+        }
+        if (A1 + s2 * (B1 + s2 * C1) >= 0.0) {
+            return s2;
+        }
+        s = s2;
+    }
+    return INFINITY;
+}
+
+// With layers: the smallest s in [lo, hi] inside one of the cell texel's solid
+// intervals or sheet slabs (m->hit_k: the crossing that starts it), or +inf.
+static double layers_first(march *m, double lo, double hi)
+{
+    double best = INFINITY;
+    double sheet = m->cam->sheet;
+    for (int k = 0; k < m->count; ++k) {
+        int kind = m->role[k] & WX_ROLE_KIND;
+        double r;
+        double top = dmin(hi, best);
+        if (kind == WX_ROLE_ENTER) {
+            r = first_between(m->LA[k], m->LB[k], m->LC[k], true, m->LA[k + 1], m->LB[k + 1],
+                              m->LC[k + 1], lo, top);
+        } else if (kind == WX_ROLE_SHEET) {
+            double front = m->LA[k] - sheet_start(m->cam, m->role[k]);
+            r = first_between(front, m->LB[k], m->LC[k], true, front - sheet, m->LB[k],
+                              m->LC[k], lo, top);
+        } else if (kind == WX_ROLE_TAIL) {
+            r = first_nonnegative(m->LA[k], m->LB[k], m->LC[k], lo, top);
+        } else {
+            continue;
+        }
+        if (r < best) {
+            best = r;
+            m->hit_k = k;
+        }
+    }
+    return best;
+}
+
+// The face of a camera with layers that a hit at s (inside the interval or slab
+// of crossing m->hit_k) is on: the nearer of the interval's two faces (the
+// entering one for a particle from the front, the leaving one from behind; a
+// sheet's front or back). `dist` is how far behind that face (into the solid)
+// the point lies, `side` +1 when the free side is towards the camera, -1 when
+// away, `offset` the face's depth past the crossing's (a sheet's faces: where
+// its slab starts and ends).
+typedef struct layer_face {
+    int layer;
+    double dist, side, offset;
+} layer_face;
+
+static layer_face hit_face(const march *m, double s)
+{
+    int k = m->hit_k;
+    double fk = m->LA[k] + s * (m->LB[k] + s * m->LC[k]);
+    layer_face face = { k, fk, 1.0, 0.0 };
+    int kind = m->role[k] & WX_ROLE_KIND;
+    if (kind == WX_ROLE_ENTER) {
+        double fl = m->LA[k + 1] + s * (m->LB[k + 1] + s * m->LC[k + 1]);
+        if (-fl < fk) {
+            face = (layer_face){ k + 1, -fl, -1.0, 0.0 };
+        }
+    } else if (kind == WX_ROLE_SHEET) {
+        double start = sheet_start(m->cam, m->role[k]), end = start + m->cam->sheet;
+        face = (layer_face){ k, fk - start, 1.0, start };
+        if (end - fk < fk - start) {
+            face = (layer_face){ k, end - fk, -1.0, end };
+        }
+    }
+    return face;
+}
+
 // The smallest s' >= s where this camera puts the segment's point behind its
 // surface or outside its frame (both let a collision happen, unless the camera
 // frames the whole model: then outside is free space); > 1 when none within the
@@ -510,7 +867,8 @@ static double march_entry(const wx_collider *collider, march *m, double s)
         double lo = dmax(s, m->sa);
         double hi = dmin(m->sb, end);
         if (m->surface && lo <= hi) {
-            double r = first_nonnegative(m->A, m->B, m->C, lo, hi);
+            double r = m->cam->layers > 1 ? layers_first(m, lo, hi)
+                                          : first_nonnegative(m->A, m->B, m->C, lo, hi);
             if (r <= hi) {
                 return r;
             }
@@ -547,11 +905,22 @@ static int pick_camera(const wx_collider *collider, const march *m, double s)
         }
         const wx_collider_camera *cam = &collider->cameras[c];
         double f = m[c].A + s * (m[c].B + s * m[c].C);
+        size_t texel = (size_t)(m[c].hy >> 1) * (size_t)cam->width + (size_t)(m[c].hx >> 1);
+        double face_depth = 0.0;
+        if (cam->layers > 1) {
+            // The chosen layer's face: its distance and its own texel's depth.
+            if (m[c].hit_k < 0) {
+                continue;
+            }
+            layer_face face = hit_face(&m[c], s);
+            f = face.dist;
+            texel += (size_t)face.layer * (size_t)cam->width * (size_t)cam->height;
+            face_depth = face.offset;
+        }
         if (closest < 0 || f < closest_f) {
             closest = c;
             closest_f = f;
         }
-        size_t texel = (size_t)(m[c].hy >> 1) * (size_t)cam->width + (size_t)(m[c].hx >> 1);
         const float *n = cam->normal + 3 * texel;
         double bl = sqrt((double)cam->back[0] * cam->back[0] + (double)cam->back[1] * cam->back[1] +
                          (double)cam->back[2] * cam->back[2]);
@@ -567,7 +936,7 @@ static int pick_camera(const wx_collider *collider, const march *m, double s)
         // slab's edge in front of it the bilinear depth is no surface at all,
         // and a point behind it (on the ground between them) is not seen there.
         double d = m[c].D0 + s * m[c].dD;
-        double off = fabs(d - (double)cam->depth[texel]) * bl;
+        double off = fabs(d - ((double)cam->depth[texel] + face_depth)) * bl;
         if (f * bl <= precision && off <= precision && cos_view > best_cos) {
             best = c;
             best_cos = cos_view;
@@ -588,7 +957,7 @@ static bool camera_sees_in_front(const wx_collider *collider, const wx_collider_
         return false;
     }
     int c = (int)(cam - collider->cameras);
-    return !(D > wx_collider_depth_at(collider, c, X, Y));
+    return !camera_may_collide(collider, c, X, Y, D);
 }
 
 // Where the particle goes back after a hit at s, validated by the point rule:
@@ -599,12 +968,15 @@ static bool camera_sees_in_front(const wx_collider *collider, const wx_collider_
 //    larger: the surface that camera records is elsewhere), a little back along
 //    the segment, where it came from;
 //  - else the start of the segment (outside, since particles always are).
+// With layers the surface is the hit face and "in front" its free side: `side`
+// is +1 to go towards the camera (an entering face, as with one layer), -1 to go
+// away from it (a leaving face, a sheet's back), and f the depth behind the face.
 static void put_back(const wx_collider *collider, const wx_collider_camera *cam,
-                     const double a[3], const double d[3], double s, double f, double D,
-                     float out[3])
+                     const double a[3], const double d[3], double s, double f, double side,
+                     double D, float out[3])
 {
     double eps = dmax(0.01 * cam->texel_ws, 2e-6 * (1.0 + fabs(D)));
-    double lift = dmax(f, 0.0) + eps;
+    double lift = side * (dmax(f, 0.0) + eps);
     float on_surface[3];
     for (int k = 0; k < 3; ++k) {
         on_surface[k] = (float)(a[k] + s * d[k] + lift * cam->back[k]);
@@ -689,31 +1061,47 @@ bool wx_collider_sweep(const wx_collider *collider, const float p0[3], const flo
     const wx_collider_camera *cam = &collider->cameras[best];
     int tx = m[best].hx >> 1, ty = m[best].hy >> 1;
     size_t texel = (size_t)ty * (size_t)cam->width + (size_t)tx;
+    // The layer whose planes give the hit: 0 with one layer, else the hit face's.
+    layer_face face = { 0, best_f, 1.0, 0.0 };
+    if (cam->layers > 1) {
+        face = hit_face(&m[best], s);
+    }
+    size_t at = (size_t)face.layer * (size_t)cam->width * (size_t)cam->height + texel;
     hit->s = (float)s;
     hit->camera = best;
+    hit->layer = face.layer;
     hit->texel = (uint32_t)texel;
     double point[3];
     for (int k = 0; k < 3; ++k) {
         point[k] = a[k] + s * d[k];
         hit->point[k] = (float)point[k];
     }
-    put_back(collider, cam, a, d, s, best_f, m[best].D0 + s * m[best].dD, hit->front);
-    const float *n = cam->normal + 3 * texel;
+    put_back(collider, cam, a, d, s, face.dist, face.side, m[best].D0 + s * m[best].dD,
+             hit->front);
+    const float *n = cam->normal + 3 * at;
     float len = sqrtf(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
     if (len > 1e-6f && isfinite(len)) {
         for (int k = 0; k < 3; ++k) {
             hit->normal[k] = n[k] / len;
         }
     } else {
-        // No usable normal: face the camera.
+        // No usable normal: face the camera (the free side, with layers).
         float bl = sqrtf(cam->back[0] * cam->back[0] + cam->back[1] * cam->back[1] +
                          cam->back[2] * cam->back[2]);
         for (int k = 0; k < 3; ++k) {
-            hit->normal[k] = cam->back[k] / bl;
+            hit->normal[k] = (float)face.side * cam->back[k] / bl;
         }
     }
-    hit->absorption = cam->impact[2 * texel];
-    hit->bounce = cam->impact[2 * texel + 1];
+    if (cam->layers > 1 &&
+        hit->normal[0] * d[0] + hit->normal[1] * d[1] + hit->normal[2] * d[2] > 0.0) {
+        // Pointing along the segment: a sheet hit from behind. The bounce
+        // reflects off the side the particle is on.
+        for (int k = 0; k < 3; ++k) {
+            hit->normal[k] = -hit->normal[k];
+        }
+    }
+    hit->absorption = cam->impact[2 * at];
+    hit->bounce = cam->impact[2 * at + 1];
     return true;
 }
 

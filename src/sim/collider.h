@@ -15,6 +15,12 @@
 // 5.1.2), and the texel's own depth otherwise (silhouettes, the thesis'
 // nearest-texel rule everywhere when `nearest` is set).
 //
+// A camera with layered maps (wx_maps.layers = K > 1, docs/design.md section
+// 14) records each texel's first K crossings with outward normals; it says
+// "behind" only inside the solid intervals and thin-sheet slabs they bound
+// (docs/physics.md, "Layered maps"), so the space behind a railing or under an
+// overhang is free. A camera with one layer works exactly as before.
+//
 // A conservative coarse test answers most steps without the walk: per camera a
 // pyramid of minimum depths over 3x3 blocks around each block proves that a short
 // segment stays in front of every surface near it.
@@ -44,9 +50,19 @@ typedef struct wx_collider_camera {
     float fmx[4], fmy[4], fmd[4]; ///< the same in float, for the coarse test
     float back[3];  ///< world displacement that lowers d by 1 and keeps u, v
     float texel_ws; ///< world size of the smaller side of a texel
-    float *depth;   ///< W*H, +inf where there is no surface (owned copy)
-    const float *normal; ///< 3*W*H world normals (borrowed)
-    const float *impact; ///< 2*W*H absorption, bounce (borrowed)
+    /// layers*W*H (layer k at k*W*H; layer 0 is today's map), +inf where there
+    /// is no surface (owned copy)
+    float *depth;
+    const float *normal; ///< 3*layers*W*H world normals (borrowed)
+    const float *impact; ///< 2*layers*W*H absorption, bounce (borrowed)
+    /// Layered maps (docs/physics.md, "Layered maps"): 1, or the K > 1 crossings
+    /// each texel records. With one layer everything behind the surface is
+    /// solid and `role` is NULL; with more, role[k*W*H + t] says what crossing
+    /// k of texel t bounds (WX_ROLE_* in collider.c, plus a bit for its
+    /// facing), and a one-sided crossing is a slab `sheet` thick (in d).
+    int layers;
+    uint8_t *role;
+    double sheet;
     /// Coarse pyramid: level l has blocks of 4 << 2l texels; its value at block
     /// (bx, by) is the least depth over the 3x3 blocks around it, lowered by a
     /// rounding margin. Levels are stored one after the other in `coarse`.
@@ -86,11 +102,14 @@ typedef struct wx_hit {
     uint32_t texel;   ///< j*W + i in that camera's maps (of that layer)
     float point[3];   ///< world point where the segment enters the surface
     /// Where the particle is put back: on that camera's surface slightly in
-    /// front of it (or, when it entered through a silhouette or frame edge, just
-    /// back along its segment); never a colliding point unless the segment
-    /// started inside.
+    /// front of it (with layers: on the hit face's free side), or, when it
+    /// entered through a silhouette or frame edge, just back along its segment;
+    /// never a colliding point unless the segment started inside.
     float front[3];
-    float normal[3];  ///< unit world normal at the texel
+    /// Unit world normal at the texel (with layers: the hit face's, turned to
+    /// face the particle when it points along the segment, a sheet hit from
+    /// behind).
+    float normal[3];
     float absorption; ///< impact R
     float bounce;     ///< impact G
 } wx_hit;
@@ -127,7 +146,8 @@ bool wx_collider_coarse_clear(const wx_collider *collider, const float p0[3], co
 void wx_collider_prefetch(const wx_collider *collider, const float p[3]);
 
 /// Depth of the collider's surface at texel-space point (X, Y) of camera c (the
-/// bilinear or nearest rule above); +inf where there is no surface or outside.
+/// bilinear or nearest rule above; layer 0, the first crossing, with layered
+/// maps); +inf where there is no surface or outside.
 double wx_collider_depth_at(const wx_collider *collider, int c, double X, double Y);
 
 #endif
