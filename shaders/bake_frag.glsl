@@ -7,10 +7,20 @@
 // from the depth buffer.
 //
 // Depth peeling (docs/design.md section 14): for layer k >= 1 of a layered
-// camera, u_previous holds layer k-1's attachment 0, and a fragment no farther
-// than that layer's d (plus a rounding margin) at its texel is discarded, so
-// the depth test keeps the next crossing behind it. A texel with no crossing
-// left keeps the background.
+// camera, u_previous holds layer k-1's attachment 0, and a fragment that does
+// not come after that layer at its texel is discarded, so the depth test
+// keeps the next crossing behind it. A texel with no crossing left keeps the
+// background.
+//
+// "Comes after" orders crossings by a key: d, plus a tie step TIE (2e-5 of
+// 1 + |d|) for a crossing that enters a solid (its outward normal faces the
+// camera). Where two solids touch (a post on a floor, a house on its slab) the
+// ray leaves one and enters the other at the same d: the key keeps both, the
+// leaving one first, so the collider reads two solids and no sheet. The key
+// is also the fragment's depth, so the depth test picks the leaving one of
+// such a pair. The same surface met again (two triangles' rounding, a face
+// drawn twice) has the same key and is one crossing. One-layer cameras keep
+// the rasterised depth and no key.
 #version 450 core
 
 in vec3 v_position;
@@ -24,6 +34,7 @@ uniform vec3 u_view_dir;   // unit viewing direction (towards larger d)
 uniform bool u_outward;    // a layered camera: keep the mesh's normal, never flip it
 uniform bool u_peel;       // layer k >= 1: only crossings behind u_previous's d
 uniform sampler2D u_previous; // the layer before's attachment 0 (d in .r)
+uniform vec2 u_depth_range;   // d of the near and far planes (the depth buffer's 0 and 1)
 
 layout(location = 0) out vec4 o_depth_normal;
 layout(location = 1) out vec4 o_impact_dirt;
@@ -32,17 +43,15 @@ layout(location = 2) out vec2 o_density_surface;
 const float COLORS_IMPACT = 1.0; // wx_color_use
 const float COLORS_DIRT = 2.0;
 
+// The peeling key of a crossing at d with outward normal n (above).
+float peel_key(float d, vec3 n)
+{
+    return dot(n, u_view_dir) < 0.0 ? d + 2e-5 * (1.0 + abs(d)) : d;
+}
+
 void main()
 {
     float d = dot(v_position, u_depth_row.xyz) + u_depth_row.w;
-    if (u_peel) {
-        // Two surfaces 1 mm apart at d = 50 are still two layers; the same
-        // surface met again (rounding between two triangles) is not.
-        float previous = texelFetch(u_previous, ivec2(gl_FragCoord.xy), 0).r;
-        if (!(d > previous + 1e-5 * (1.0 + abs(previous)))) {
-            discard;
-        }
-    }
     vec3 n = v_normal;
     float len = length(n);
     if (!(len > 1e-6)) {
@@ -58,6 +67,22 @@ void main()
     n = len > 0.0 ? n / len : -u_view_dir;
     if (!u_outward && dot(n, u_view_dir) > 0.0) {
         n = -n;
+    }
+    if (u_outward) {
+        float key = peel_key(d, n);
+        if (u_peel) {
+            // Two surfaces 1 mm apart at d = 50 are still two layers; the same
+            // surface met again (rounding between two triangles) is not.
+            vec4 previous = texelFetch(u_previous, ivec2(gl_FragCoord.xy), 0);
+            float before = peel_key(previous.r, previous.gba);
+            if (!(key > before + 1e-5 * (1.0 + abs(previous.r)))) {
+                discard;
+            }
+        }
+        gl_FragDepth = clamp((key - u_depth_range.x) / (u_depth_range.y - u_depth_range.x), 0.0,
+                             1.0);
+    } else {
+        gl_FragDepth = gl_FragCoord.z;
     }
     o_depth_normal = vec4(d, n);
 
