@@ -717,7 +717,7 @@ TEST(substances_cycle_and_colour_by_the_shown_one)
                 out_samples += vw_world_deposit(&w, i) == -1.0;
                 continue;
             }
-            const wx_dirt_map *map = wx_sim_dirt_map(w.sim, w.camera_maps[c]);
+            const wx_dirt_map *map = wx_sim_dirt_map(w.sim, w.first_view[c]);
             ENSURE(map->substances == 3);
             float uvd[3];
             int ti = -1, tj = -1;
@@ -1006,6 +1006,7 @@ TEST(masks_at_sparse_samples)
     free(w.samples);
     free(w.camera_lines);
     free(w.camera_points);
+    free(w.layer_points);
     ENSURE(build_geometry_within(&w, 40000, &err) == WX_OK);
     ENSURE(w.sample_stride == 3);
     ENSURE(vw_world_show_mask(&w, 1, &err) == WX_OK);
