@@ -684,9 +684,9 @@ static void status_line(const app *a, bool live, char *out, size_t cap)
     // The layer shown, in scenes with a layered camera (L).
     if (w->max_layers > 1 && n > 0 && (size_t)n < cap) {
         if (a->show.layer < 0) {
-            n += snprintf(out + n, cap - (size_t)n, "  layers all %d", w->max_layers);
+            n += snprintf(out + n, cap - (size_t)n, "  all %d layers", w->max_layers);
         } else {
-            n += snprintf(out + n, cap - (size_t)n, "  layer %d of 0-%d", a->show.layer,
+            n += snprintf(out + n, cap - (size_t)n, "  layer %d only (0-%d)", a->show.layer,
                           w->max_layers - 1);
         }
     }
