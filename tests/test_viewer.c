@@ -1062,7 +1062,7 @@ static float layered_value(bool a, const char *kind, int layer, int ch, int i)
         return layer == 0 ? (a ? 2.0f : 1.5f) : i < 4 ? 3.0f : 0.0f;
     }
     if (strcmp(kind, "normal") == 0) {
-        return !a ? (ch == 1 ? 1.0f : 0.0f) : ch == 2 ? (layer == 0 ? 1.0f : -1.0f) : 0.0f;
+        return !a ? (ch == 2 ? 1.0f : 0.0f) : ch == 1 ? (layer == 0 ? 1.0f : -1.0f) : 0.0f;
     }
     if (strcmp(kind, "impact") == 0) {
         return 0.5f;
@@ -1107,8 +1107,8 @@ static bool write_layered_maps(const char *dir, const char *cam, int size, int l
     return true;
 }
 
-// A scene with a layered camera "a" (layers="2", from +z) and a camera "b"
-// of one layer (from above), with the maps a bake that peels layers writes,
+// A scene with a layered camera "a" (layers="2", from above: its layers at y
+// = 3 and 2) and a camera "b" of one layer (from +z), with a Height mask, with the maps a bake that peels layers writes,
 // made by hand in `out_dir` (this branch's bake does not peel yet), newer
 // than the scene and the mesh. NULL when they cannot be written.
 static const char *layered_scene(char out_dir[4200])
@@ -1121,15 +1121,16 @@ static const char *layered_scene(char out_dir[4200])
         "  <Emitters><PointEmitter centerY=\"2\" rate=\"100\"/></Emitters>\n"
         "  <Collider><ProjectedMaps>\n"
         "    <Ortho cameraName=\"a\" layers=\"2\">\n"
-        "      <View eye=\"0 0 5\" target=\"0 0 0\" up=\"0 1 0\" width=\"2\" height=\"2\"\n"
+        "      <View eye=\"0 5 0\" target=\"0 0 0\" up=\"0 0 -1\" width=\"2\" height=\"2\"\n"
         "            resolution=\"8\"/>\n"
         "    </Ortho>\n"
         "    <Ortho cameraName=\"b\">\n"
-        "      <View eye=\"0 5 0\" target=\"0 0 0\" up=\"0 0 -1\" width=\"2\" height=\"2\"\n"
+        "      <View eye=\"0 0 5\" target=\"0 0 0\" up=\"0 1 0\" width=\"2\" height=\"2\"\n"
         "            resolution=\"4\"/>\n"
         "    </Ortho>\n"
         "  </ProjectedMaps></Collider>\n"
         "  <Geometry><Mesh file=\"layered.obj\"><Surface material=\"*\"/></Mesh></Geometry>\n"
+        "  <Masks><Height name=\"y\" min=\"0\" max=\"5\"/></Masks>\n"
         "</Weathering>\n");
     snprintf(out_dir, 4200, "%s/layered_out", tmp);
     mkdir(out_dir, 0777);
@@ -1239,6 +1240,14 @@ TEST(layers_cycle_and_samples_name_their_views)
     ENSURE(vw_world_view_camera(&w, 1, &layer) == 0 && layer == 1);
     ENSURE(vw_world_view_camera(&w, 2, &layer) == 1 && layer == 0);
     ENSURE(vw_world_view_camera(&w, 3, &layer) == -1 && vw_world_view_camera(&w, -1, NULL) == -1);
+    // A mask is evaluated on each layer's own depth: Height at every sample's
+    // own point, 0.6 on a's layer 0 and 0.4 on its layer 1.
+    ENSURE(vw_world_show_mask(&w, 0, &err) == WX_OK);
+    for (int i = 0; i < w.point_count; ++i) {
+        wrong += !(fabsf(w.mask_values[0][i] - height_at(&w, 0, i)) <= 1e-6f);
+    }
+    ENSURE(wrong == 0);
+    ENSURE(fabsf(w.mask_values[0][back.first] - 0.4f) < 1e-5f);
 
     // G: the dirt maps hold every layer ("layer1." channels for a), and the
     // next load starts each layer from its own initial dirt.
