@@ -17,7 +17,11 @@
 // sample (Height by its formula; at the samples of the input cameras, the
 // values wx_masks_at_camera gives on their maps; at a stride of 3 too), the
 // ramps' colours and Curvature's scale, and a screenshot with --mask showing
-// the bright end of the ramp above its dark end; a bad --mask exits 2.
+// the bright end of the ramp above its dark end; a bad --mask exits 2. With
+// a layered camera (maps written by hand, as a peeling bake writes them):
+// every layer's depth samples, each naming its view of the simulation, deeper
+// layers darker, L's cycle, hits' views, masks per layer, and G and a reload
+// keeping every layer; with one layer per camera, nothing changes.
 #include <fcntl.h>
 #include <png.h>
 #include <stdint.h>
