@@ -17,7 +17,11 @@
 // sample (Height by its formula; at the samples of the input cameras, the
 // values wx_masks_at_camera gives on their maps; at a stride of 3 too), the
 // ramps' colours and Curvature's scale, and a screenshot with --mask showing
-// the bright end of the ramp above its dark end; a bad --mask exits 2.
+// the bright end of the ramp above its dark end; a bad --mask exits 2. With
+// a layered camera (maps written by hand, as a peeling bake writes them):
+// every layer's depth samples, each naming its view of the simulation, deeper
+// layers darker, L's cycle, hits' views, masks per layer, and G and a reload
+// keeping every layer; with one layer per camera, nothing changes.
 #include <fcntl.h>
 #include <png.h>
 #include <stdint.h>
@@ -32,6 +36,7 @@
 #include "../viewer/view.c"
 #include "../viewer/world.c"
 #include "ensure.h"
+#include "io/exr.h"
 #include "model/camera.h"
 #include "sim/simulate.h"
 
@@ -479,6 +484,21 @@ TEST(thesis_scene_geometry)
         total += surface;
     }
     ENSURE(total == w.point_count && total > 0 && total <= VW_MAX_DEPTH_SAMPLES);
+    // One layer per camera: L has nothing to cycle, every sample is of layer
+    // 0 in full colour, and its view is its input camera.
+    ENSURE(w.max_layers == 1 && vw_world_next_layer(&w, -1) == -1);
+    ENSURE(wx_sim_input_count(w.sim) == 2 && w.first_view[0] == 0 && w.first_view[1] == 1);
+    for (int c = 0; c < 3; ++c) {
+        vw_range r = w.camera_points[c], r0 = vw_world_layer_points(&w, c, 0);
+        ENSURE(vw_world_camera_layers(&w, c) == 1 && vw_world_layer_points(&w, c, 1).count == 0);
+        ENSURE(r0.first == r.first && r0.count == r.count);
+        int wrong = 0;
+        for (int i = r.first; i < r.first + r.count; ++i) {
+            wrong += w.samples[i].layer != 0 ||
+                     w.samples[i].input != (w.scene.cameras[c].is_output ? -1 : c);
+        }
+        ENSURE(wrong == 0);
+    }
     const vw_vertex *first = &w.points[w.camera_points[0].first];
     float uvd[3];
     wx_camera_world_to_map(&w.scene.cameras[0].camera, first->position, uvd);
@@ -717,7 +737,7 @@ TEST(substances_cycle_and_colour_by_the_shown_one)
                 out_samples += vw_world_deposit(&w, i) == -1.0;
                 continue;
             }
-            const wx_dirt_map *map = wx_sim_dirt_map(w.sim, w.camera_maps[c]);
+            const wx_dirt_map *map = wx_sim_dirt_map(w.sim, w.first_view[c]);
             ENSURE(map->substances == 3);
             float uvd[3];
             int ti = -1, tj = -1;
@@ -1006,6 +1026,7 @@ TEST(masks_at_sparse_samples)
     free(w.samples);
     free(w.camera_lines);
     free(w.camera_points);
+    free(w.layer_points);
     ENSURE(build_geometry_within(&w, 40000, &err) == WX_OK);
     ENSURE(w.sample_stride == 3);
     ENSURE(vw_world_show_mask(&w, 1, &err) == WX_OK);
@@ -1032,6 +1053,235 @@ TEST(masks_at_sparse_samples)
     vw_world_free(&w);
 }
 
+// --- layers (docs/design.md section 14) ---------------------------------------------
+
+// Value of channel `ch` of map `kind` of the layered fixture's camera `a` (two
+// layers, 8 x 8) or `b` (one, 4 x 4) at layer `layer`, column i: a's layer 0
+// is a front face at depth 2 everywhere, its layer 1 a back face at depth 3
+// in columns 0-3 only (none elsewhere); b sees a face at depth 1.5. Normals
+// point out of the solid; dirt (R) is 1 on a's layer 0, 2 on its layer 1, 3 on b.
+static float layered_value(bool a, const char *kind, int layer, int ch, int i)
+{
+    if (strcmp(kind, "depth") == 0) {
+        return layer == 0 ? (a ? 2.0f : 1.5f) : i < 4 ? 3.0f : 0.0f;
+    }
+    if (strcmp(kind, "normal") == 0) {
+        return !a ? (ch == 2 ? 1.0f : 0.0f) : ch == 1 ? (layer == 0 ? 1.0f : -1.0f) : 0.0f;
+    }
+    if (strcmp(kind, "impact") == 0) {
+        return 0.5f;
+    }
+    return ch == 0 ? (a ? 1.0f + (float)layer : 3.0f) : 1.0f; // dirt, deposit, erosion
+}
+
+// Camera `cam`'s four maps as `weathering bake` writes a layered camera's:
+// layer k's channels as "layerK.R" and so on.
+static bool write_layered_maps(const char *dir, const char *cam, int size, int layers)
+{
+    static const char *const kinds[4] = { "depth", "normal", "impact", "dirt" };
+    static const char *const rgb[3] = { "R", "G", "B" };
+    static const int counts[4] = { 1, 3, 2, 3 };
+    for (int k = 0; k < 4; ++k) {
+        char names[3 * WX_MAX_LAYERS][WX_NAME_MAX], path[4400];
+        const char *channels[3 * WX_MAX_LAYERS];
+        int n = 0;
+        for (int layer = 0; layer < layers; ++layer) {
+            for (int c = 0; c < counts[k]; ++c, ++n) {
+                wx_layer_channel(names[n], layer, rgb[c]);
+                channels[n] = names[n];
+            }
+        }
+        wx_image file;
+        if (wx_image_alloc(&file, size, size, n, channels, NULL) != WX_OK) {
+            return false;
+        }
+        for (int c = 0; c < n; ++c) {
+            for (int t = 0; t < size * size; ++t) {
+                file.channels[c][t] = layered_value(cam[0] == 'a', kinds[k], c / counts[k],
+                                                     c % counts[k], t % size);
+            }
+        }
+        snprintf(path, sizeof path, "%s/%s_%s.exr", dir, cam, kinds[k]);
+        bool ok = wx_exr_write(path, &file, NULL) == WX_OK;
+        wx_image_free(&file);
+        if (!ok) {
+            return false;
+        }
+    }
+    return true;
+}
+
+// A scene with a layered camera "a" (layers="2", from above: its layers at y
+// = 3 and 2) and a camera "b" of one layer (from +z), with a Height mask, with the maps a bake that peels layers writes,
+// made by hand in `out_dir` (this branch's bake does not peel yet), newer
+// than the scene and the mesh. NULL when they cannot be written.
+static const char *layered_scene(char out_dir[4200])
+{
+    const char *tmp = ensure_tmpdir();
+    const char *mesh = ensure_write_file(tmp, "layered.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    const char *scene = ensure_write_file(
+        tmp, "layered.xml",
+        "<Weathering>\n"
+        "  <Emitters><PointEmitter centerY=\"2\" rate=\"100\"/></Emitters>\n"
+        "  <Collider><ProjectedMaps>\n"
+        "    <Ortho cameraName=\"a\" layers=\"2\">\n"
+        "      <View eye=\"0 5 0\" target=\"0 0 0\" up=\"0 0 -1\" width=\"2\" height=\"2\"\n"
+        "            resolution=\"8\"/>\n"
+        "    </Ortho>\n"
+        "    <Ortho cameraName=\"b\">\n"
+        "      <View eye=\"0 0 5\" target=\"0 0 0\" up=\"0 1 0\" width=\"2\" height=\"2\"\n"
+        "            resolution=\"4\"/>\n"
+        "    </Ortho>\n"
+        "  </ProjectedMaps></Collider>\n"
+        "  <Geometry><Mesh file=\"layered.obj\"><Surface material=\"*\"/></Mesh></Geometry>\n"
+        "  <Masks><Height name=\"y\" min=\"0\" max=\"5\"/></Masks>\n"
+        "</Weathering>\n");
+    snprintf(out_dir, 4200, "%s/layered_out", tmp);
+    mkdir(out_dir, 0777);
+    if (!write_layered_maps(out_dir, "a", 8, 2) || !write_layered_maps(out_dir, "b", 4, 1)) {
+        return NULL;
+    }
+    time_t now = time(NULL);
+    set_mtime(scene, now - 100);
+    set_mtime(mesh, now - 100);
+    return scene;
+}
+
+// The deposits of every depth sample (the amount on its texel of its view)
+// against the fixture's dirt; returns the samples that differ.
+static int wrong_layered_deposits(const vw_world *w)
+{
+    int wrong = 0;
+    for (int c = 0; c < 2; ++c) {
+        for (int k = 0; k < vw_world_camera_layers(w, c); ++k) {
+            vw_range r = vw_world_layer_points(w, c, k);
+            for (int i = r.first; i < r.first + r.count; ++i) {
+                wrong += vw_world_deposit(w, i) != layered_value(c == 0, "dirt", k, 0, 0);
+            }
+        }
+    }
+    return wrong;
+}
+
+// A layered camera: every layer's depth samples, each naming its view (its
+// dirt map in the simulation), deeper ones darker; L's cycle; hits' views
+// mapped to their cameras and layers; G writes and a reload reads every layer.
+TEST(layers_cycle_and_samples_name_their_views)
+{
+    char out_dir[4200];
+    const char *scene = layered_scene(out_dir);
+    ENSURE(scene != NULL);
+    vw_settings settings = { .scene_path = scene, .out_dir = out_dir, .threads = 1,
+                             .hit_capacity = 64 };
+    static vw_world w, again;
+    wx_error err = { 0 };
+    ENSURE(vw_world_parse(&w, &settings, &err) == WX_OK);
+    ENSURE(!vw_world_needs_bake(&w, NULL));
+    wx_result r = vw_world_finish(&w, &settings, &err);
+    if (r != WX_OK) {
+        fprintf(stderr, "        %s\n", err.message);
+    }
+    ENSURE(r == WX_OK);
+    ENSURE(w.max_layers == 2 && w.sample_stride == 1);
+    ENSURE(vw_world_camera_layers(&w, 0) == 2 && vw_world_camera_layers(&w, 1) == 1);
+    // Views: a's layers 0 and 1, then b.
+    ENSURE(wx_sim_input_count(w.sim) == 3 && w.first_view[0] == 0 && w.first_view[1] == 2);
+    // L: every layer -> layer 0 -> layer 1 -> every layer.
+    ENSURE(vw_world_next_layer(&w, -1) == 0);
+    ENSURE(vw_world_next_layer(&w, 0) == 1);
+    ENSURE(vw_world_next_layer(&w, 1) == -1);
+    // Samples per layer: a's 64 front texels and 32 back ones, b's 16; b has
+    // no layer 1. Every layer together is the camera's whole run.
+    static const int want[2][2] = { { 64, 32 }, { 16, 0 } };
+    int shown[3] = { 0, 0, 0 }; // per L setting: every layer, layer 0, layer 1
+    for (int c = 0; c < 2; ++c) {
+        for (int k = 0; k < 2; ++k) {
+            ENSURE(vw_world_layer_points(&w, c, k).count == want[c][k]);
+        }
+        vw_range all = vw_world_layer_points(&w, c, -1);
+        ENSURE(all.count == want[c][0] + want[c][1] && all.first == w.camera_points[c].first);
+        for (int layer = -1, n = 0; n < 3; layer = vw_world_next_layer(&w, layer), ++n) {
+            shown[n] += vw_world_layer_points(&w, c, layer).count;
+        }
+    }
+    ENSURE(shown[0] == 112 && shown[1] == 80 && shown[2] == 32 && w.point_count == 112);
+    // Each sample: its layer, its view, its point at its layer's depth.
+    int wrong = 0;
+    for (int c = 0; c < 2; ++c) {
+        for (int k = 0; k < vw_world_camera_layers(&w, c); ++k) {
+            vw_range lr = vw_world_layer_points(&w, c, k);
+            for (int i = lr.first; i < lr.first + lr.count; ++i) {
+                const vw_sample *smp = &w.samples[i];
+                float uvd[3];
+                wx_camera_world_to_map(&w.scene.cameras[c].camera, w.points[i].position, uvd);
+                int size = c == 0 ? 8 : 4;
+                wrong += smp->layer != k || smp->input != w.first_view[c] + k;
+                wrong += fabsf(uvd[2] - layered_value(c == 0, "depth", k, 0, smp->texel % size)) >
+                         1e-4f;
+            }
+        }
+    }
+    ENSURE(wrong == 0);
+    // Deposits read each sample's own view: 1 and 2 on a's layers, 3 on b.
+    ENSURE(wrong_layered_deposits(&w) == 0);
+    // Layer 1 is drawn darker: a back face's sample is its front face's
+    // colour (the same normal shading, the normals opposite) times 0.7.
+    vw_range front = vw_world_layer_points(&w, 0, 0), back = vw_world_layer_points(&w, 0, 1);
+    for (int i = back.first; i < back.first + back.count; ++i) {
+        const vw_vertex *f = &w.points[front.first + w.samples[i].texel];
+        ENSURE(w.samples[front.first + w.samples[i].texel].texel == w.samples[i].texel);
+        for (int ch = 0; ch < 3; ++ch) {
+            wrong += fabsf(w.points[i].color[ch] - VW_LAYER_SHADE[1] * f->color[ch]) > 1e-6f;
+        }
+        wrong += fabsf(w.samples[i].shade -
+                       VW_LAYER_SHADE[1] * w.samples[front.first + w.samples[i].texel].shade) >
+                 1e-6f;
+    }
+    ENSURE(wrong == 0 && VW_LAYER_SHADE[1] < 1.0f);
+    // A hit's camera is a view: a's layer 1 is view 1, b is view 2.
+    int layer = -1;
+    ENSURE(vw_world_view_camera(&w, 0, &layer) == 0 && layer == 0);
+    ENSURE(vw_world_view_camera(&w, 1, &layer) == 0 && layer == 1);
+    ENSURE(vw_world_view_camera(&w, 2, &layer) == 1 && layer == 0);
+    ENSURE(vw_world_view_camera(&w, 3, &layer) == -1 && vw_world_view_camera(&w, -1, NULL) == -1);
+    // A mask is evaluated on each layer's own depth: Height at every sample's
+    // own point, 0.6 on a's layer 0 and 0.4 on its layer 1.
+    ENSURE(vw_world_show_mask(&w, 0, &err) == WX_OK);
+    for (int i = 0; i < w.point_count; ++i) {
+        wrong += !(fabsf(w.mask_values[0][i] - height_at(&w, 0, i)) <= 1e-6f);
+    }
+    ENSURE(wrong == 0);
+    ENSURE(fabsf(w.mask_values[0][back.first] - 0.4f) < 1e-5f);
+
+    // G: the dirt maps hold every layer ("layer1." channels for a), and the
+    // next load starts each layer from its own initial dirt.
+    for (int k = 0; k < 20; ++k) {
+        ENSURE(wx_sim_step(w.sim, &err) == WX_OK);
+    }
+    char saved[WX_PATH_MAX], path[4400];
+    r = vw_world_gather(&w, saved, &err);
+    if (r != WX_OK) {
+        fprintf(stderr, "        %s\n", err.message);
+    }
+    ENSURE(r == WX_OK);
+    snprintf(path, sizeof path, "%s/a_dirt.exr", out_dir);
+    wx_image *header = calloc(1, sizeof *header);
+    ENSURE(header != NULL && wx_exr_read_header(path, header, &err) == WX_OK);
+    bool layer1 = false;
+    for (int c = 0; c < header->channel_count; ++c) {
+        layer1 |= strcmp(header->channel_names[c], "layer1." WX_INITIAL_DIRT_CHANNEL) == 0;
+    }
+    free(header);
+    ENSURE(layer1);
+    ENSURE(vw_world_parse(&again, &settings, &err) == WX_OK);
+    ENSURE(!vw_world_needs_bake(&again, &w));
+    ENSURE(vw_world_finish(&again, &settings, &err) == WX_OK);
+    ENSURE(again.max_layers == 2 && again.point_count == 112);
+    ENSURE(wrong_layered_deposits(&again) == 0);
+    vw_world_free(&again);
+    vw_world_free(&w);
+}
+
 int main(void)
 {
     RUN(thesis_scene_geometry);
@@ -1042,6 +1292,7 @@ int main(void)
     RUN(substances_cycle_and_colour_by_the_shown_one);
     RUN(masks_cycle_and_colour_the_depth_samples);
     RUN(masks_at_sparse_samples);
+    RUN(layers_cycle_and_samples_name_their_views);
     RUN(bad_usage_exits_2);
     RUN(bad_scene_exits_2_and_names_the_file);
     RUN(failed_bake_exits_2);

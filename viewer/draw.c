@@ -226,7 +226,7 @@ static bool depth_samples_current(const vw_draw *draw, const vw_world *world, co
                                   const float mvp[16], int width, int height)
 {
     if (!draw->depth_valid || width != draw->depth_width || height != draw->depth_height ||
-        draw->depth_mask != world->mask ||
+        draw->depth_mask != world->mask || draw->depth_layer != show->layer ||
         memcmp(mvp, draw->depth_mvp, sizeof draw->depth_mvp) != 0) {
         return false;
     }
@@ -238,8 +238,8 @@ static bool depth_samples_current(const vw_draw *draw, const vw_world *world, co
     return true;
 }
 
-// The depth samples of the shown cameras, nearest per pixel: picked again only
-// when the view, the shown cameras or the shown mask change; coloured again
+// The depth samples of the shown cameras and layer, nearest per pixel: picked
+// again only when the view, the shown cameras or layer or the shown mask change; coloured again
 // every frame when they show deposits, which change with every step (a mask
 // shown instead stays as it is).
 static wx_result update_depth_samples(vw_draw *draw, const vw_world *world, const vw_show *show,
@@ -260,7 +260,7 @@ static wx_result update_depth_samples(vw_draw *draw, const vw_world *world, cons
         return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (depth samples)");
     }
     for (int c = 0; c < world->scene.camera_count; ++c) {
-        vw_range r = world->camera_points[c];
+        vw_range r = vw_world_layer_points(world, c, show->layer);
         for (int i = r.first; show->cameras[c] && i < r.first + r.count; ++i) {
             const float *p = world->points[i].position;
             float index; // the sample's index travels as the fourth float's bits
@@ -288,6 +288,7 @@ static wx_result update_depth_samples(vw_draw *draw, const vw_world *world, cons
     draw->depth_height = height;
     memcpy(draw->depth_cameras, show->cameras, (size_t)draw->camera_count * sizeof(bool));
     draw->depth_mask = world->mask;
+    draw->depth_layer = show->layer;
     draw->depth_valid = true;
     return WX_OK;
 }
@@ -320,12 +321,13 @@ static wx_result update_particles(vw_draw *draw, const vw_world *world, const fl
 static void update_hits(vw_draw *draw, const vw_world *world, const vw_show *show)
 {
     int n = wx_sim_recent_hits(world->sim, draw->hits, draw->hit_capacity);
-    int input_count = world->scene.input_count;
     draw->hit_count = 0;
     for (int k = 0; k < n; ++k) {
         const wx_hit_sample *h = &draw->hits[k];
-        if (h->camera >= 0 && h->camera < input_count &&
-            !show->cameras[world->input_camera[h->camera]]) {
+        // h->camera is a view: a camera and one of its layers.
+        int layer = 0;
+        int c = vw_world_view_camera(world, h->camera, &layer);
+        if (c >= 0 && (!show->cameras[c] || (show->layer >= 0 && layer != show->layer))) {
             continue;
         }
         int kind = h->impact >= WX_IMPACT_ABSORB && h->impact <= WX_IMPACT_SLIDE ? (int)h->impact

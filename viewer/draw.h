@@ -19,6 +19,9 @@
 /// What to show.
 typedef struct vw_show {
     const bool *cameras; ///< per scene camera: frame and depth samples
+    /// The layer whose depth samples and hits are shown (docs/design.md
+    /// section 14): -1 every layer's, else layer k's only (key L).
+    int layer;
     bool depth_samples;
     bool particles;
     bool hits;
@@ -38,6 +41,7 @@ typedef struct vw_draw {
     float depth_mvp[16];           ///< the view the depth samples were picked for
     int depth_width, depth_height;
     bool *depth_cameras;           ///< cameras shown when they were picked
+    int depth_layer;               ///< the layer shown when they were picked
     int depth_mask;                ///< the world's mask shown when they were coloured
     uint32_t *depth_picked;        ///< the picked samples (indices into world->points)
     int camera_count;
@@ -64,8 +68,9 @@ wx_result vw_draw_init(vw_draw *draw, int hit_capacity, wx_error *err);
 wx_result vw_draw_set_world(vw_draw *draw, const vw_world *world, wx_error *err);
 
 /// Refills the buffers for a frame seen through `mvp` on fb_width x fb_height
-/// pixels: the depth samples when the view, the shown cameras or the world's
-/// shown mask changed, the live particles, and the recent hits of shown cameras.
+/// pixels: the depth samples when the view, the shown cameras or layer or the
+/// world's shown mask changed, the live particles, and the recent hits of shown
+/// cameras and layer.
 wx_result vw_draw_update(vw_draw *draw, const vw_world *world, const vw_show *show,
                          const float mvp[16], int fb_width, int fb_height, wx_error *err);
 

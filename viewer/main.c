@@ -104,6 +104,7 @@ static const char *const KEY_HELP[] = {
     "H        hit points on / off",
     "1-9      camera 1-9 on / off (scene order)",
     "D        depth samples on / off",
+    "L        layers of the depth samples and hits: all, 0, 1, ..., the deepest, all",
     "P        particles on / off",
     "S        next substance: what particles and deposits show",
     "M        next derived mask on the depth samples (<Masks>; off, 1, 2, ..., off)",
@@ -117,7 +118,8 @@ enum { KEY_HELP_COUNT = sizeof KEY_HELP / sizeof KEY_HELP[0] };
 
 static const char *const COLOUR_HELP[] = {
     "colours: input cameras blue, green, magenta, yellow, cyan, orange, ...;",
-    "  output camera white; depth samples in their camera's colour;",
+    "  output camera white; depth samples in their camera's colour,",
+    "  deeper layers darker (layer 1 at 70%, 2 at 50%, ...);",
     "  particles pale blue (clean) to brown (carrying dirt), or to the",
     "  colour of the substance shown (S); with <Substances>, depth samples",
     "  tinted towards it where it lies on their surface;",
@@ -409,6 +411,9 @@ static void adopt_world(app *a, vw_world *world)
     if (world->scene.camera_count != old_cameras && !reset_camera_visibility(a)) {
         report(a, true, "out of memory");
     }
+    if (a->show.layer >= world->max_layers) {
+        a->show.layer = -1; // the new scene has fewer layers: show them all
+    }
     reset_rates(a);
     a->playing = true;
     if (mask >= 0) {
@@ -676,6 +681,15 @@ static void status_line(const app *a, bool live, char *out, size_t cap)
                       vw_world_substance_name(w), w->substance + 1,
                       vw_world_substance_count(w));
     }
+    // The layer shown, in scenes with a layered camera (L).
+    if (w->max_layers > 1 && n > 0 && (size_t)n < cap) {
+        if (a->show.layer < 0) {
+            n += snprintf(out + n, cap - (size_t)n, "  all %d layers", w->max_layers);
+        } else {
+            n += snprintf(out + n, cap - (size_t)n, "  layer %d only (0-%d)", a->show.layer,
+                          w->max_layers - 1);
+        }
+    }
     if (w->mask >= 0 && n > 0 && (size_t)n < cap) {
         n += snprintf(out + n, cap - (size_t)n, "  mask %s %d/%d (%s)",
                       w->scene.masks[w->mask].name, w->mask + 1, w->scene.mask_count,
@@ -707,6 +721,31 @@ static void toggle_camera(app *a, int c)
     a->camera_visible[c] = !a->camera_visible[c];
     const wx_scene_camera *cam = &a->world->scene.cameras[c];
     report(a, false, "camera %d '%s' %s", c + 1, cam->name, a->camera_visible[c] ? "on" : "off");
+}
+
+// L: the next layer shown (every layer's samples, then each layer's alone).
+static void next_layer(app *a)
+{
+    const vw_world *w = a->world;
+    if (w->max_layers <= 1) {
+        report(a, false, "every camera has one layer: nothing to cycle (layers=\"K\" on an "
+                         "<Ortho> bakes more)");
+        return;
+    }
+    a->show.layer = vw_world_next_layer(w, a->show.layer);
+    if (a->show.layer < 0) {
+        report(a, false, "depth samples and hits of all %d layers (deeper ones darker)",
+               w->max_layers);
+        return;
+    }
+    int samples = 0, cameras = 0;
+    for (int c = 0; c < w->scene.camera_count; ++c) {
+        samples += vw_world_layer_points(w, c, a->show.layer).count;
+        cameras += a->show.layer < vw_world_camera_layers(w, c);
+    }
+    report(a, false, "layer %d of 0-%d only: %d depth samples of %d camera%s%s", a->show.layer,
+           w->max_layers - 1, samples, cameras, cameras == 1 ? "" : "s",
+           a->show.layer == 0 ? " (the first surface each ray meets)" : "");
 }
 
 static void next_substance(app *a)
@@ -785,6 +824,7 @@ static void on_key(GLFWwindow *window, int key, int scancode, int action, int mo
         report(a, false, "particles %s", a->show.particles ? "on" : "off");
         break;
     case GLFW_KEY_S: next_substance(a); break;
+    case GLFW_KEY_L: next_layer(a); break;
     case GLFW_KEY_M:
         if (a->mask_request < 0) {
             next_mask(a);
@@ -1098,6 +1138,7 @@ int main(int argc, char **argv)
     static app a; // large; zero-initialised
     a.speed = 1.0;
     a.mask_request = -1;
+    a.show.layer = -1;
     a.show.depth_samples = true;
     a.show.particles = true;
     a.show.hits = true;

@@ -3,7 +3,8 @@
 //
 // Input camera k is drawn in VW_CAMERA_COLORS[k % VW_CAMERA_COLOR_COUNT]: its
 // frame rectangle exactly, its depth samples shaded by their normal. The output
-// camera is white.
+// camera is white. Depth samples of a layered camera's deeper layers (docs/
+// design.md section 14) are darker: layer k's times VW_LAYER_SHADE[k].
 #ifndef VW_PALETTE_H
 #define VW_PALETTE_H
 
@@ -21,6 +22,20 @@ static const uint8_t VW_CAMERA_COLORS[VW_CAMERA_COLOR_COUNT][3] = {
     { 179, 128, 255 }, // violet
     { 153, 204, 102 }, // olive
 };
+
+/// Depth samples of layer k are drawn in their camera's colour times this
+/// (and their normal shading): the first surface in full colour, each deeper
+/// one darker, so that front and back surfaces are told apart.
+enum { VW_LAYER_SHADE_COUNT = 8 };
+static const float VW_LAYER_SHADE[VW_LAYER_SHADE_COUNT] = { 1.0f,  0.7f, 0.5f,  0.4f,
+                                                            0.34f, 0.3f, 0.27f, 0.25f };
+
+/// The darkening of layer k (the last entry beyond the table).
+static inline float vw_layer_shade(int layer)
+{
+    int k = layer < VW_LAYER_SHADE_COUNT ? layer : VW_LAYER_SHADE_COUNT - 1;
+    return VW_LAYER_SHADE[k > 0 ? k : 0];
+}
 
 static const uint8_t VW_OUTPUT_COLOR[3] = { 255, 255, 255 };
 static const uint8_t VW_BACKGROUND_COLOR[3] = { 20, 23, 28 };

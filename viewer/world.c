@@ -95,7 +95,7 @@ static bool same_bake_input(const wx_scene *a, const wx_scene *b)
     for (int c = 0; c < a->camera_count; ++c) {
         const wx_scene_camera *ca = &a->cameras[c], *cb = &b->cameras[c];
         if (strcmp(ca->name, cb->name) != 0 || ca->is_output != cb->is_output ||
-            ca->has_view != cb->has_view || (ca->has_view && !same_view(&ca->view, &cb->view))) {
+            ca->layers != cb->layers || ca->has_view != cb->has_view || (ca->has_view && !same_view(&ca->view, &cb->view))) {
             return false;
         }
     }
@@ -245,18 +245,22 @@ static void add_camera_lines(vw_world *world, vertex_list *lines, int c)
     push_line(lines, t0, t1, color);
 }
 
-// Depth samples: every stride-th texel of every camera with a surface.
-static void add_camera_points(vw_world *world, vertex_list *points, int c, int stride)
+// Depth samples of layer `layer` of camera c: every stride-th texel with a
+// surface, in the camera's colour darkened for deeper layers.
+static void add_layer_points(vw_world *world, vertex_list *points, int c, int layer, int stride)
 {
-    const wx_maps *m = &world->maps[world->camera_maps[c]];
+    wx_maps view;
+    wx_maps_layer_view(&world->maps[world->camera_maps[c]], layer, &view);
+    const wx_maps *m = &view;
     const wx_camera *cam = &world->scene.cameras[c].camera;
     if (m->depth == NULL) {
         return;
     }
     float color[3];
     camera_color(world, c, color);
-    int input = world->scene.cameras[c].is_output ? -1 : world->camera_maps[c];
+    int input = world->first_view[c] >= 0 ? world->first_view[c] + layer : -1;
     const float light[3] = { 0.40f, 0.80f, 0.45f }; // roughly unit
+    const float darken = vw_layer_shade(layer);
     for (int j = stride / 2; j < m->height; j += stride) {
         for (int i = stride / 2; i < m->width; i += stride) {
             size_t t = (size_t)j * (size_t)m->width + (size_t)i;
@@ -274,6 +278,7 @@ static void add_camera_points(vw_world *world, vertex_list *points, int c, int s
                 float ndotl = n[0] * light[0] + n[1] * light[1] + n[2] * light[2];
                 shade = 0.45f + 0.55f * fminf(1.0f, fabsf(ndotl));
             }
+            shade *= darken;
             for (int a = 0; a < 3; ++a) {
                 shaded[a] = color[a] * shade;
             }
@@ -283,10 +288,21 @@ static void add_camera_points(vw_world *world, vertex_list *points, int c, int s
                 return;
             }
             points->samples[points->count] = (vw_sample){
-                .input = input, .texel = (int)t, .shade = shade
+                .input = input, .texel = (int)t, .layer = layer, .shade = shade
             };
             push_vertex(points, p, shaded);
         }
+    }
+}
+
+// Depth samples of camera c, layer after layer.
+static void add_camera_points(vw_world *world, vertex_list *points, int c, int stride)
+{
+    for (int k = 0; k < vw_world_camera_layers(world, c); ++k) {
+        vw_range *r = &world->layer_points[(size_t)c * WX_MAX_LAYERS + (size_t)k];
+        r->first = points->count;
+        add_layer_points(world, points, c, k, stride);
+        r->count = points->count - r->first;
     }
 }
 
@@ -299,7 +315,7 @@ static int64_t sample_count(const vw_world *world, int stride)
             int64_t first = stride / 2;
             int64_t cols = m->width > first ? (m->width - first + stride - 1) / stride : 0;
             int64_t rows = m->height > first ? (m->height - first + stride - 1) / stride : 0;
-            n += cols * rows;
+            n += cols * rows * wx_maps_layers(m);
         }
     }
     return n;
@@ -394,7 +410,9 @@ static wx_result build_geometry_within(vw_world *world, int64_t max_samples, wx_
     int n = scene->camera_count;
     world->camera_lines = calloc((size_t)n, sizeof *world->camera_lines);
     world->camera_points = calloc((size_t)n, sizeof *world->camera_points);
-    if (world->camera_lines == NULL || world->camera_points == NULL) {
+    world->layer_points = calloc((size_t)n * WX_MAX_LAYERS, sizeof *world->layer_points);
+    if (world->camera_lines == NULL || world->camera_points == NULL ||
+        world->layer_points == NULL) {
         return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (viewer geometry)");
     }
     vertex_list lines = { 0 }, points = { 0 };
@@ -472,14 +490,24 @@ static wx_result load_maps(vw_world *world, wx_error *err)
     world->maps = calloc((size_t)n, sizeof *world->maps);
     world->camera_maps = calloc((size_t)n, sizeof *world->camera_maps);
     world->input_camera = calloc((size_t)n, sizeof *world->input_camera);
-    if (world->maps == NULL || world->camera_maps == NULL || world->input_camera == NULL) {
+    world->first_view = calloc((size_t)n, sizeof *world->first_view);
+    if (world->maps == NULL || world->camera_maps == NULL || world->input_camera == NULL ||
+        world->first_view == NULL) {
         return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (maps)");
     }
-    int inputs = 0;
+    // The simulation's views: each input camera's layers, camera by camera.
+    int inputs = 0, views = 0;
+    world->max_layers = 1;
     for (int c = 0; c < n; ++c) {
-        if (!scene->cameras[c].is_output) {
+        const wx_scene_camera *cam = &scene->cameras[c];
+        world->first_view[c] = -1;
+        if (!cam->is_output) {
+            int layers = cam->layers > 1 ? cam->layers : 1;
             world->input_camera[inputs] = c;
             world->camera_maps[c] = inputs++;
+            world->first_view[c] = views;
+            views += layers;
+            world->max_layers = layers > world->max_layers ? layers : world->max_layers;
         }
     }
     for (int c = 0, outputs = 0; c < n; ++c) {
@@ -502,9 +530,13 @@ static wx_result load_maps(vw_world *world, wx_error *err)
                 which |= WX_MAPS_DIRT | WX_MAPS_INITIAL_DIRT;
             }
         }
-        wx_result r = wx_maps_load_scene(&world->maps[world->camera_maps[c]], which, 1,
-                                         &world->scene, cam->depth_path, cam->normal_path,
-                                         cam->impact_path, cam->dirt_path, err);
+        // Every layer of an input camera (docs/design.md section 14); the
+        // output camera has one.
+        int layers = !cam->is_output && cam->layers > 1 ? cam->layers : 1;
+        wx_result r = wx_maps_load_layers(&world->maps[world->camera_maps[c]], which, 1,
+                                          &world->scene, layers, cam->depth_path,
+                                          cam->normal_path, cam->impact_path, cam->dirt_path,
+                                          err);
         if (r != WX_OK) {
             wx_error_prefix(err, "camera '%s'", cam->name);
             return r;
@@ -520,7 +552,23 @@ static wx_result create_sim(vw_world *world, const vw_settings *settings, wx_err
     config.threads = settings->threads;
     config.hit_capacity = settings->hit_capacity;
     config.maps = world->maps;
-    return wx_sim_create(&world->scene, &config, &world->sim, err);
+    wx_result r = wx_sim_create(&world->scene, &config, &world->sim, err);
+    // The depth samples name their views as load_maps counted them: the
+    // simulation must count the same.
+    for (int c = 0; r == WX_OK && c < world->scene.camera_count; ++c) {
+        int first = -1;
+        if (world->first_view[c] >= 0 &&
+            (wx_sim_camera_views(world->sim, world->camera_maps[c], &first) !=
+                 vw_world_camera_layers(world, c) ||
+             first != world->first_view[c])) {
+            wx_sim_destroy(world->sim);
+            world->sim = NULL;
+            r = wx_fail(err, WX_CAUSE_BAD_ARGUMENT,
+                        "camera '%s': the simulation's views of its layers are not the viewer's",
+                        world->scene.cameras[c].name);
+        }
+    }
+    return r;
 }
 
 wx_result vw_world_finish(vw_world *world, const vw_settings *settings, wx_error *err)
@@ -539,6 +587,40 @@ wx_result vw_world_finish(vw_world *world, const vw_settings *settings, wx_error
         vw_world_show_substance(world, 0);
     }
     return r;
+}
+
+// --- layers --------------------------------------------------------------------------
+
+int vw_world_camera_layers(const vw_world *world, int c)
+{
+    return wx_maps_layers(&world->maps[world->camera_maps[c]]);
+}
+
+vw_range vw_world_layer_points(const vw_world *world, int c, int layer)
+{
+    if (layer < 0) {
+        return world->camera_points[c];
+    }
+    if (layer >= vw_world_camera_layers(world, c)) {
+        return (vw_range){ world->camera_points[c].first, 0 };
+    }
+    return world->layer_points[(size_t)c * WX_MAX_LAYERS + (size_t)layer];
+}
+
+int vw_world_next_layer(const vw_world *world, int layer)
+{
+    return world->max_layers > 1 && layer + 1 < world->max_layers ? layer + 1 : -1;
+}
+
+int vw_world_view_camera(const vw_world *world, int view, int *layer)
+{
+    if (layer != NULL) {
+        *layer = 0;
+    }
+    if (world->sim == NULL || view < 0 || view >= wx_sim_input_count(world->sim)) {
+        return -1;
+    }
+    return world->input_camera[wx_sim_view_camera(world->sim, view, layer)];
 }
 
 // --- substances ----------------------------------------------------------------------
@@ -726,9 +808,10 @@ bool vw_world_mask_ready(const vw_world *world, int m)
     return m < 0 || (m < world->scene.mask_count && world->mask_values[m] != NULL);
 }
 
-// The grid of a camera's sampled texels: texel (first + gi * stride,
-// first + gj * stride) at gj * cols + gi, as add_camera_points walks them,
-// made into surface points as wx_masks_at_camera makes a map's texels.
+// The grid of the sampled texels of one layer of a camera (`m`: that layer's
+// view of its maps): texel (first + gi * stride, first + gj * stride) at
+// gj * cols + gi, as add_layer_points walks them, made into surface points as
+// wx_masks_at_camera makes a map's texels.
 typedef struct sample_grid {
     int cols, rows, first, stride;
     double *position;
@@ -745,9 +828,8 @@ static void free_grid(sample_grid *g)
     memset(g, 0, sizeof *g);
 }
 
-static bool make_grid(const vw_world *world, int c, sample_grid *g)
+static bool make_grid(const vw_world *world, int c, const wx_maps *m, sample_grid *g)
 {
-    const wx_maps *m = &world->maps[world->camera_maps[c]];
     const wx_camera *cam = &world->scene.cameras[c].camera;
     memset(g, 0, sizeof *g);
     g->stride = world->sample_stride > 0 ? world->sample_stride : 1;
@@ -785,10 +867,10 @@ static bool make_grid(const vw_world *world, int c, sample_grid *g)
     return true;
 }
 
-// The grid cell of depth sample `point` of camera c's grid, or -1.
-static ptrdiff_t grid_cell(const vw_world *world, int c, const sample_grid *g, int point)
+// The grid cell of depth sample `point` of a layer's grid (maps `m`), or -1.
+static ptrdiff_t grid_cell(const vw_world *world, const wx_maps *m, const sample_grid *g,
+                           int point)
 {
-    const wx_maps *m = &world->maps[world->camera_maps[c]];
     int texel = world->samples[point].texel;
     int i = texel % m->width, j = texel / m->width;
     int gi = (i - g->first) / g->stride, gj = (j - g->first) / g->stride;
@@ -916,14 +998,21 @@ wx_result vw_world_compute_mask(vw_world *world, int m, wx_error *err)
             }
         }
     }
-    for (int c = 0; c < scene->camera_count && r == WX_OK && !oom; ++c) {
-        vw_range range = world->camera_points[c];
-        const wx_maps *maps = &world->maps[world->camera_maps[c]];
+    // Each layer of each camera is a grid of its own (docs/design.md section 14).
+    for (int view = 0; view < scene->camera_count * WX_MAX_LAYERS && r == WX_OK && !oom; ++view) {
+        int c = view / WX_MAX_LAYERS, layer = view % WX_MAX_LAYERS;
+        if (layer >= vw_world_camera_layers(world, c)) {
+            continue;
+        }
+        vw_range range = vw_world_layer_points(world, c, layer);
+        wx_maps layer_maps;
+        wx_maps_layer_view(&world->maps[world->camera_maps[c]], layer, &layer_maps);
+        const wx_maps *maps = &layer_maps;
         if (range.count == 0 || maps->depth == NULL || maps->normal == NULL) {
             continue;
         }
         sample_grid g;
-        if (!make_grid(world, c, &g)) {
+        if (!make_grid(world, c, maps, &g)) {
             oom = true;
             break;
         }
@@ -948,7 +1037,7 @@ wx_result vw_world_compute_mask(vw_world *world, int m, wx_error *err)
                 continue;
             }
             for (int i = range.first; i < range.first + range.count; ++i) {
-                ptrdiff_t q = grid_cell(world, c, &g, i);
+                ptrdiff_t q = grid_cell(world, maps, &g, i);
                 float v = world->mask_values[k][i];
                 if (q >= 0 && !isnan(v)) {
                     extra[q] = v;
@@ -967,7 +1056,7 @@ wx_result vw_world_compute_mask(vw_world *world, int m, wx_error *err)
         r = wx_masks_at_points(copy, &world->opts, world->mask_context, -1, &points,
                                substances, planes, err);
         for (int i = range.first; r == WX_OK && i < range.first + range.count; ++i) {
-            ptrdiff_t q = grid_cell(world, c, &g, i);
+            ptrdiff_t q = grid_cell(world, maps, &g, i);
             for (int k = 0; q >= 0 && g.valid[q] && k <= m; ++k) {
                 if (values[k] != NULL) {
                     values[k][i] = planes[k][q];
@@ -1105,11 +1194,13 @@ void vw_world_free(vw_world *world)
     free(world->maps);
     free(world->camera_maps);
     free(world->input_camera);
+    free(world->first_view);
     free(world->lines);
     free(world->points);
     free(world->samples);
     free(world->camera_lines);
     free(world->camera_points);
+    free(world->layer_points);
     for (int m = 0; m < WX_MAX_MASKS; ++m) {
         free(world->mask_values[m]);
     }

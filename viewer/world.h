@@ -33,9 +33,14 @@ typedef struct vw_vertex {
 
 /// Where a depth sample lies in its camera's maps, for its deposits.
 typedef struct vw_sample {
-    int input;   ///< input camera (index into the simulation's dirt maps), -1: output camera
-    int texel;   ///< j * width + i
-    float shade; ///< its normal shading: drawn in its camera's colour times this
+    /// Its view (input camera and layer: the index of its dirt map in the
+    /// simulation, wx_sim_dirt_map), -1: output camera.
+    int input;
+    int texel;   ///< j * width + i, in its layer
+    int layer;   ///< its layer of its camera's maps (0: the first surface the rays meet)
+    /// Its normal shading times its layer's (vw_layer_shade): drawn in its
+    /// camera's colour times this.
+    float shade;
 } vw_sample;
 
 /// A run of vertices in one of the world's vertex lists.
@@ -60,6 +65,13 @@ typedef struct vw_world {
     wx_maps *maps;
     int *camera_maps;        ///< scene camera index -> index into maps
     int *input_camera;       ///< input index -> scene camera index
+    /// Scene camera index -> its first view in the simulation (its layer 0;
+    /// layer k is view first_view[c] + k), -1 for the output camera. Views go
+    /// camera by camera, layer 0 first, as wx_sim_camera_views gives them.
+    int *first_view;
+    /// The most layers of any camera's maps (docs/design.md section 14; 1: no
+    /// camera is layered).
+    int max_layers;
     wx_sim *sim;
     /// The substance shown (docs/design.md section 9): particles are coloured
     /// by their load of it, depth samples (with <Substances>) by its amount on
@@ -73,7 +85,11 @@ typedef struct vw_world {
     vw_sample *samples;      ///< per depth sample: its texel
     int point_count;
     vw_range *camera_lines;  ///< per scene camera: frame and viewing direction
-    vw_range *camera_points; ///< per scene camera: its depth samples
+    vw_range *camera_points; ///< per scene camera: its depth samples, every layer's
+    /// Per scene camera c and layer k below its layers: the depth samples of
+    /// that layer, at c * WX_MAX_LAYERS + k (runs of camera_points[c], layer 0
+    /// first; vw_world_layer_points).
+    vw_range *layer_points;
     vw_range emitter_lines;
     vw_range bbox_lines;
     float frame_lo[3];       ///< box around the camera frames (the initial view)
@@ -126,6 +142,23 @@ bool vw_world_finished(const vw_world *world);
 /// output camera, gathers the mask; `saved` receives the mask's path (or the
 /// output folder when there is no output camera).
 wx_result vw_world_gather(vw_world *world, char saved[WX_PATH_MAX], wx_error *err);
+
+/// Layers of scene camera c's maps (1: not layered).
+int vw_world_camera_layers(const vw_world *world, int c);
+
+/// The depth samples of scene camera c shown with `layer` (-1: every layer's,
+/// else that layer's; none when the camera has fewer layers).
+vw_range vw_world_layer_points(const vw_world *world, int c, int layer);
+
+/// What L shows next (docs/viewer.md): every layer (-1) -> layer 0 -> 1 ->
+/// ... -> the deepest of any camera (max_layers - 1) -> every layer; always
+/// -1 when no camera is layered.
+int vw_world_next_layer(const vw_world *world, int layer);
+
+/// The scene camera of view `view` of the world's simulation (a hit's
+/// wx_hit_sample.camera), its layer in *layer (may be NULL); -1 when `view`
+/// is no view (a hit on the bounding box or the ground).
+int vw_world_view_camera(const vw_world *world, int view, int *layer);
 
 /// Substances of the scene (1 without <Substances>).
 int vw_world_substance_count(const vw_world *world);
