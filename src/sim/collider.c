@@ -150,13 +150,13 @@ static bool border_is_empty(const float *depth, int W, int H)
 }
 
 // What crossing k of a texel bounds, in a camera with layered maps (docs/physics.md,
-// "Layered maps"), walking the texel's crossings nearest first:
+// "Layered maps"), once the crossings are reduced to the outline of the solids
+// (classify_layers):
 //  - ENTER: it enters a solid that crossing k + 1 (LEAVE) leaves: [d_k, d_k+1];
-//  - SHEET: one-sided (an entering crossing followed by another entering one or
-//    by none while layers are left, or a leaving one with nothing open): a slab
-//    `sheet` thick on the inner side of its normal (sheet_start);
-//  - TAIL: solid from d_k on: the last crossing when every layer holds one, for
-//    what lies behind it is unknown (then a LEAVE there is SPENT: no face).
+//  - SHEET: one-sided (a crossing no other one closes: a pane, an open sheet),
+//    a slab `sheet` thick on the inner side of its normal (sheet_start);
+//  - TAIL: solid from d_k on: what lies behind the last layer is unknown when
+//    every layer holds a crossing.
 // The FACING bit is set where the crossing enters (n . view <= 0).
 enum {
     WX_ROLE_NONE = 0,
@@ -164,62 +164,128 @@ enum {
     WX_ROLE_LEAVE = 2,
     WX_ROLE_SHEET = 3,
     WX_ROLE_TAIL = 4,
-    WX_ROLE_SPENT = 5,
     WX_ROLE_KIND = 7,
     WX_ROLE_FACING = 8,
 };
 
-// The roles of every texel's crossings (depth already copied, normals set).
+// The outline of one texel's solids from its n crossings (nearest first; K
+// layers): each leaving crossing closes the nearest entering one still open
+// (solids nest: a roof's slab inside a wall, a sill through a facade); what
+// no crossing closes is a sheet, or, when every layer holds a crossing, the
+// start of a solid whose end lies beyond them (TAIL; then also a last
+// crossing that leaves: what is behind it is unknown, so solid, as one
+// layer's map says, and the other cameras decide by the point rule). Nested
+// and overlapping solids merge into one interval; the faces and sheets inside
+// it are dropped. Writes the kept crossings' roles and original layers into
+// kind[], from[]; returns how many.
+static int outline(const bool *entering, int n, int K, uint8_t *kind, uint8_t *from)
+{
+    int partner[WX_MAX_LAYERS], stack[WX_MAX_LAYERS], top = 0, tail = -1;
+    bool sheet[WX_MAX_LAYERS];
+    for (int k = 0; k < n; ++k) {
+        partner[k] = -1;
+        sheet[k] = false;
+        if (entering[k]) {
+            stack[top++] = k;
+        } else if (top > 0) {
+            int e = stack[--top];
+            partner[e] = k;
+            partner[k] = e;
+        } else {
+            sheet[k] = true;
+        }
+    }
+    if (top > 0 && n == K) {
+        tail = stack[0]; // the outermost solid left open
+    }
+    for (int i = 0; i < top; ++i) {
+        sheet[stack[i]] = stack[i] != tail && n < K;
+    }
+    int m = 0, start = -1, end = -1;
+    for (int k = 0; k < n; ++k) {
+        if (start >= 0 && k > end) { // the union of solids so far ends before k
+            kind[m] = WX_ROLE_ENTER, from[m++] = (uint8_t)start;
+            kind[m] = WX_ROLE_LEAVE, from[m++] = (uint8_t)end;
+            start = -1;
+        }
+        if (k == tail) {
+            kind[m] = WX_ROLE_TAIL, from[m++] = (uint8_t)(start >= 0 ? start : k);
+            return m;
+        }
+        if (entering[k] && partner[k] > k) {
+            if (start < 0) {
+                start = k;
+                end = partner[k];
+            } else if (partner[k] > end) {
+                end = partner[k];
+            }
+        } else if (sheet[k] && start < 0) {
+            kind[m] = WX_ROLE_SHEET, from[m++] = (uint8_t)k;
+        }
+    }
+    if (start >= 0) {
+        kind[m] = WX_ROLE_ENTER, from[m++] = (uint8_t)start;
+        kind[m] = WX_ROLE_LEAVE, from[m++] = (uint8_t)end;
+    }
+    if (n == K && m > 0) {
+        if (kind[m - 1] == WX_ROLE_LEAVE) {
+            m--;
+            kind[m - 1] = WX_ROLE_TAIL;
+        } else {
+            kind[m - 1] = WX_ROLE_TAIL;
+        }
+    }
+    return m;
+}
+
+// The roles of every texel's crossings (depth already copied, normals set):
+// each texel's crossings are replaced by their outline (outline above),
+// nearest first, with the layer each came from in `origin`.
 static void classify_layers(wx_collider_camera *cam)
 {
     int K = cam->layers;
     size_t texels = (size_t)cam->width * (size_t)cam->height;
     for (size_t t = 0; t < texels; ++t) {
-        int n = 0, open = -1;
-        uint8_t *role = cam->role + t;
+        bool entering[WX_MAX_LAYERS];
+        float depth[WX_MAX_LAYERS];
+        int n = 0;
         for (int k = 0; k < K; ++k) {
             size_t at = (size_t)k * texels + t;
             if (n < k || !isfinite(cam->depth[at])) {
-                cam->depth[at] = INFINITY; // a crossing after an empty layer is ignored
-                role[k * texels] = WX_ROLE_NONE;
-                continue;
+                continue; // a crossing after an empty layer is ignored
             }
             n = k + 1;
+            depth[k] = cam->depth[at];
             const float *nv = cam->normal + 3 * at;
             // back points towards the camera: n . view < 0 is n . back > 0. A
             // grazing or missing normal counts as entering, as one layer's does.
             float dot = nv[0] * cam->back[0] + nv[1] * cam->back[1] + nv[2] * cam->back[2];
-            bool entering = !(dot < 0.0f);
-            role[k * texels] = entering ? WX_ROLE_FACING : 0;
-            if (entering) {
-                if (open >= 0) {
-                    role[open * texels] |= WX_ROLE_SHEET;
-                }
-                open = k;
-            } else if (open >= 0) {
-                role[open * texels] |= WX_ROLE_ENTER;
-                role[k * texels] |= WX_ROLE_LEAVE;
-                open = -1;
-            } else {
-                role[k * texels] |= WX_ROLE_SHEET;
-            }
+            entering[k] = !(dot < 0.0f);
         }
-        if (open >= 0) {
-            role[open * texels] |= n == K ? WX_ROLE_TAIL : WX_ROLE_SHEET;
-        } else if (n == K) {
-            // Every layer holds a crossing and the last one leaves: what lies
-            // behind it is unknown, so solid, as one layer's map says (the
-            // other cameras decide by the point rule).
-            uint8_t *last = &role[(n - 1) * texels];
-            if ((*last & WX_ROLE_KIND) == WX_ROLE_LEAVE) {
-                uint8_t *enter = &role[(n - 2) * texels];
-                *enter = (uint8_t)((*enter & ~WX_ROLE_KIND) | WX_ROLE_TAIL);
-                *last = (uint8_t)((*last & ~WX_ROLE_KIND) | WX_ROLE_SPENT);
+        uint8_t kind[WX_MAX_LAYERS], from[WX_MAX_LAYERS];
+        int m = outline(entering, n, K, kind, from);
+        for (int k = 0; k < K; ++k) {
+            size_t at = (size_t)k * texels + t;
+            if (k < m) {
+                cam->depth[at] = depth[from[k]];
+                cam->role[at] = (uint8_t)(kind[k] | (entering[from[k]] ? WX_ROLE_FACING : 0));
+                cam->origin[at] = from[k];
             } else {
-                *last = (uint8_t)((*last & ~WX_ROLE_KIND) | WX_ROLE_TAIL);
+                cam->depth[at] = INFINITY;
+                cam->role[at] = WX_ROLE_NONE;
+                cam->origin[at] = 0;
             }
         }
     }
+}
+
+// Index of the maps' planes (normal, impact) of crossing k of texel t: the
+// layer it came from.
+static inline size_t maps_index(const wx_collider_camera *cam, int k, size_t t)
+{
+    size_t texels = (size_t)cam->width * (size_t)cam->height;
+    size_t layer = cam->layers > 1 ? cam->origin[(size_t)k * texels + t] : 0;
+    return layer * texels + t;
 }
 
 wx_result wx_collider_init(wx_collider *collider, const wx_camera *cameras, const wx_maps *maps,
@@ -273,8 +339,9 @@ wx_result wx_collider_init(wx_collider *collider, const wx_camera *cameras, cons
         cam->depth = malloc((size_t)layers * texels * sizeof *cam->depth);
         if (layers > 1) {
             cam->role = malloc((size_t)layers * texels);
+            cam->origin = malloc((size_t)layers * texels);
         }
-        if (cam->depth == NULL || (layers > 1 && cam->role == NULL)) {
+        if (cam->depth == NULL || (layers > 1 && (cam->role == NULL || cam->origin == NULL))) {
             wx_collider_free(collider);
             return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (collider depth)");
         }
@@ -301,6 +368,15 @@ wx_result wx_collider_init(wx_collider *collider, const wx_camera *cameras, cons
             return r;
         }
     }
+    for (int c = 0; c < count; ++c) {
+        if (collider->cameras[c].layers > 1) {
+            for (int k = 0; k < count; ++k) {
+                collider->layered_slack =
+                    fmax(collider->layered_slack, (double)collider->cameras[k].texel_ws);
+            }
+            break;
+        }
+    }
     return WX_OK;
 }
 
@@ -309,6 +385,7 @@ void wx_collider_free(wx_collider *collider)
     for (int c = 0; c < collider->camera_count; ++c) {
         free(collider->cameras[c].depth);
         free(collider->cameras[c].role);
+        free(collider->cameras[c].origin);
         free(collider->cameras[c].coarse);
     }
     free(collider->cameras);
@@ -906,6 +983,7 @@ static int pick_camera(const wx_collider *collider, const march *m, double s)
         const wx_collider_camera *cam = &collider->cameras[c];
         double f = m[c].A + s * (m[c].B + s * m[c].C);
         size_t texel = (size_t)(m[c].hy >> 1) * (size_t)cam->width + (size_t)(m[c].hx >> 1);
+        size_t in_maps = texel;
         double face_depth = 0.0;
         if (cam->layers > 1) {
             // The chosen layer's face: its distance and its own texel's depth.
@@ -914,6 +992,7 @@ static int pick_camera(const wx_collider *collider, const march *m, double s)
             }
             layer_face face = hit_face(&m[c], s);
             f = face.dist;
+            in_maps = maps_index(cam, face.layer, texel);
             texel += (size_t)face.layer * (size_t)cam->width * (size_t)cam->height;
             face_depth = face.offset;
         }
@@ -921,7 +1000,7 @@ static int pick_camera(const wx_collider *collider, const march *m, double s)
             closest = c;
             closest_f = f;
         }
-        const float *n = cam->normal + 3 * texel;
+        const float *n = cam->normal + 3 * in_maps;
         double bl = sqrt((double)cam->back[0] * cam->back[0] + (double)cam->back[1] * cam->back[1] +
                          (double)cam->back[2] * cam->back[2]);
         double nl = sqrt((double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2]);
@@ -931,7 +1010,7 @@ static int pick_camera(const wx_collider *collider, const march *m, double s)
         double cos_view = fabs(n[0] * cam->back[0] + n[1] * cam->back[1] + n[2] * cam->back[2]) /
                           (bl * nl);
         double tan_view = sqrt(fmax(0.0, 1.0 - cos_view * cos_view)) / fmax(cos_view, 0.05);
-        double precision = cam->texel_ws * (0.5 + tan_view);
+        double precision = cam->texel_ws * (0.5 + tan_view) + collider->layered_slack;
         // The texel itself must record this surface too: between a wall and a
         // slab's edge in front of it the bilinear depth is no surface at all,
         // and a point behind it (on the ground between them) is not seen there.
@@ -1066,10 +1145,10 @@ bool wx_collider_sweep(const wx_collider *collider, const float p0[3], const flo
     if (cam->layers > 1) {
         face = hit_face(&m[best], s);
     }
-    size_t at = (size_t)face.layer * (size_t)cam->width * (size_t)cam->height + texel;
+    size_t at = maps_index(cam, face.layer, texel);
     hit->s = (float)s;
     hit->camera = best;
-    hit->layer = face.layer;
+    hit->layer = (int)(at / ((size_t)cam->width * (size_t)cam->height));
     hit->texel = (uint32_t)texel;
     double point[3];
     for (int k = 0; k < 3; ++k) {

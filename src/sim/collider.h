@@ -62,6 +62,11 @@ typedef struct wx_collider_camera {
     /// facing), and a one-sided crossing is a slab `sheet` thick (in d).
     int layers;
     uint8_t *role;
+    /// With layers: the crossings a solid's outline needs, nearest first
+    /// (collider.c classify_layers: the faces inside overlapping solids left
+    /// out), so depth[k*W*H + t] is the k-th of them and origin[k*W*H + t] the
+    /// layer of the maps (normal, impact, the hit's layer) it came from.
+    uint8_t *origin;
     double sheet;
     /// Coarse pyramid: level l has blocks of 4 << 2l texels; its value at block
     /// (bx, by) is the least depth over the 3x3 blocks around it, lowered by a
@@ -82,6 +87,13 @@ typedef struct wx_collider {
     int camera_count;
     wx_collider_camera *cameras;
     bool nearest; ///< nearest-texel depth everywhere (the thesis' rule)
+    /// With layered maps: the largest texel (world units) of any camera. A
+    /// point collides where every camera that sees it agrees; with layers a
+    /// camera seeing a wall edge-on vouches for it only from its own texel's
+    /// edge, so the hit may lie up to a texel of that camera behind the face
+    /// the head-on camera records, and pick_camera allows that much more
+    /// (0 with one layer everywhere: today's rule).
+    double layered_slack;
 } wx_collider;
 
 /// Builds the collider over `count` cameras and their maps (depth, normal and
