@@ -6,21 +6,12 @@
 // d is computed here from the interpolated position, in float, not read back
 // from the depth buffer.
 //
-// Depth peeling (docs/design.md section 14): for layer k >= 1 of a layered
-// camera, u_previous holds layer k-1's attachment 0, and a fragment that does
-// not come after that layer at its texel is discarded, so the depth test
-// keeps the next crossing behind it. A texel with no crossing left keeps the
-// background.
-//
-// "Comes after" orders crossings by a key: d, plus a tie step TIE (2e-5 of
-// 1 + |d|) for a crossing that enters a solid (its outward normal faces the
-// camera). Where two solids touch (a post on a floor, a house on its slab) the
-// ray leaves one and enters the other at the same d: the key keeps both, the
-// leaving one first, so the collider reads two solids and no sheet. The key
-// is also the fragment's depth, so the depth test picks the leaving one of
-// such a pair. The same surface met again (two triangles' rounding, a face
-// drawn twice) has the same key and is one crossing. One-layer cameras keep
-// the rasterised depth and no key.
+// Depth peeling (docs/design.md section 14, raster/bake.c): layer k >= 1 of a
+// layered camera keeps only the crossings after layer k-1's (u_previous) at
+// each texel, ordered by peel_key: d, plus a tie step for a crossing entering
+// a solid, so where solids touch the leaving face comes first and both stay.
+// The key is the fragment's depth there; one-layer cameras keep the
+// rasterised depth.
 #version 450 core
 
 in vec3 v_position;
@@ -55,9 +46,8 @@ void main()
     vec3 n = v_normal;
     float len = length(n);
     if (!(len > 1e-6)) {
-        // No usable vertex normal: the triangle's own plane. cross(dFdx, dFdy)
-        // points along right x up, the way a triangle drawn counter-clockwise
-        // on the map faces: for a layered camera, the winding's side.
+        // No usable vertex normal: the triangle's own plane, on its winding's
+        // side for a layered camera.
         n = cross(dFdx(v_position), dFdy(v_position));
         len = length(n);
         if (u_outward && !gl_FrontFacing) {
@@ -71,8 +61,7 @@ void main()
     if (u_outward) {
         float key = peel_key(d, n);
         if (u_peel) {
-            // Two surfaces 1 mm apart at d = 50 are still two layers; the same
-            // surface met again (rounding between two triangles) is not.
+            // 1 mm apart at d = 50: two layers; one surface met twice: one.
             vec4 previous = texelFetch(u_previous, ivec2(gl_FragCoord.xy), 0);
             float before = peel_key(previous.r, previous.gba);
             if (!(key > before + 1e-5 * (1.0 + abs(previous.r)))) {

@@ -15,8 +15,11 @@
 // Layers (docs/design.md section 14): an input camera with `layers` K > 1 is
 // drawn K times, depth peeling: layer 0 is the nearest crossing of each texel
 // centre's view ray with any triangle, front- or back-facing; layer k the next
-// one farther than layer k-1's by more than 1e-5 x (1 + |d|) (surfaces 1 mm
-// apart at 50 m are two layers). Its normals are then the mesh's own, out of
+// one after layer k-1's in the order of a key: d, plus 2e-5 x (1 + |d|) for a
+// crossing that enters a solid, the next key larger by more than 1e-5 x (1 +
+// |d|). Surfaces 1 mm apart at 50 m are two layers; where two solids touch (a
+// post on a floor) the ray leaves one and enters the other at one d, and both
+// crossings stay, the leaving one first; one surface met twice is one. Its normals are then the mesh's own, out of
 // the solid (with one layer they face the camera, as version 2's). A texel
 // with no crossing left holds the background (+inf, 0). Every map holds layer
 // 0's channels, then layer 1's named "layer1.R"..., and so on (wx_layer_channel);
