@@ -244,6 +244,19 @@ static float chunk_bound(const job *jb, int j, int x0, int x1)
 static void gather_chunk(const job *jb, int j, int x0)
 {
     const int x1 = x0 + CHUNK < jb->width ? x0 + CHUNK : jb->width;
+    // A chunk with no surface is 0 (the deeper layers of a layered camera are
+    // mostly empty: docs/design.md section 14).
+    const float *row_depth = jb->def->depth + (size_t)j * (size_t)jb->width;
+    bool any = false;
+    for (int x = x0; x < x1 && !any; ++x) {
+        any = !wx_depth_is_empty(row_depth[x]);
+    }
+    if (!any) {
+        for (int x = x0; x < x1; ++x) {
+            jb->out[(size_t)j * (size_t)jb->width + (size_t)x] = 0.0f;
+        }
+        return;
+    }
     const float bound = chunk_bound(jb, j, x0, x1);
     const size_t q = jb->base + (size_t)j * jb->stride + (size_t)x0;
     float num[CHUNK], den[CHUNK];

@@ -66,23 +66,34 @@ static bool depth_at(const float *depth, int width, int height, double x, double
     return true;
 }
 
-bool wx_owner_sees(const wx_owner_view *view, const double p[3], const float n[3])
+// The depth tolerance of wx_owner_sees for a surface of unit normal n at
+// depths d (the point's) and own (the texel's).
+static double tolerance(const wx_owner_view *view, const float n[3], double d, double own)
 {
-    // The surface must face the view (a normal map's normals face its camera).
-    float facing = n[0] * view->view[0] + n[1] * view->view[1] + n[2] * view->view[2];
-    if (view->normal == NULL && !(facing < FACING_SLACK)) {
-        return false;
-    }
-    double uvd[3];
-    wx_matrix_apply_affine(view->camera->wtc, p, uvd);
+    float c = fabsf(n[0] * view->view[0] + n[1] * view->view[1] + n[2] * view->view[2]);
+    float cs = c > MIN_SLOPE_COS ? c : MIN_SLOPE_COS;
+    double tan_view = sqrt(fmax(0.0, 1.0 - (double)c * c)) / cs;
+    return view->texel_ws * (0.5 + tan_view) + 4e-6 * (fabs(d) + fabs(own));
+}
+
+// wx_owner_sees with p already in the view's map space (uvd).
+static bool sees_projected(const wx_owner_view *view, const double uvd[3], const float n[3])
+{
     if (view->normal != NULL) {
         // A layer's normals point out of the solid, either way along the view:
-        // the point's surface must face the way the layer's texel does.
+        // the point's surface must face the way the layer's texel does. Most
+        // layers hold another surface at p's texel: the depth tells first.
         int i = (int)floor(uvd[0] * view->width), j = (int)floor((1.0 - uvd[1]) * view->height);
         if (i < 0 || j < 0 || i >= view->width || j >= view->height) {
             return false;
         }
-        const float *m = view->normal + 3 * ((size_t)j * (size_t)view->width + (size_t)i);
+        size_t t = (size_t)j * (size_t)view->width + (size_t)i;
+        double own = view->depth[t];
+        if (wx_depth_is_empty(view->depth[t]) ||
+            !(fabs(uvd[2] - own) <= tolerance(view, n, uvd[2], own))) {
+            return false;
+        }
+        const float *m = view->normal + 3 * t;
         if (!(n[0] * m[0] + n[1] * m[1] + n[2] * m[2] > 0.0f)) {
             return false;
         }
@@ -92,11 +103,20 @@ bool wx_owner_sees(const wx_owner_view *view, const double p[3], const float n[3
     if (!depth_at(view->depth, view->width, view->height, x, y, &own, &between)) {
         return false;
     }
-    float c = fabsf(n[0] * view->view[0] + n[1] * view->view[1] + n[2] * view->view[2]);
-    float cs = c > MIN_SLOPE_COS ? c : MIN_SLOPE_COS;
-    double tan_view = sqrt(fmax(0.0, 1.0 - (double)c * c)) / cs;
-    double precision = view->texel_ws * (0.5 + tan_view) + 4e-6 * (fabs(uvd[2]) + fabs(own));
+    double precision = tolerance(view, n, uvd[2], own);
     return fabs(uvd[2] - own) <= precision && fabs(uvd[2] - between) <= precision;
+}
+
+bool wx_owner_sees(const wx_owner_view *view, const double p[3], const float n[3])
+{
+    // The surface must face the view (a normal map's normals face its camera).
+    float facing = n[0] * view->view[0] + n[1] * view->view[1] + n[2] * view->view[2];
+    if (view->normal == NULL && !(facing < FACING_SLACK)) {
+        return false;
+    }
+    double uvd[3];
+    wx_matrix_apply_affine(view->camera->wtc, p, uvd);
+    return sees_projected(view, uvd, n);
 }
 
 // |d - depth| of p against the texel of `view` it falls in (+inf outside).
@@ -118,11 +138,35 @@ static bool same_camera(const wx_owner_view *a, const wx_owner_view *b)
     return a->camera == b->camera || memcmp(a->camera->wtc, b->camera->wtc, sizeof a->camera->wtc) == 0;
 }
 
+// p projected into the map space of the views of one camera: the layers of a
+// camera share it (wx_owner_of tests each of them).
+typedef struct projection {
+    const wx_camera *camera;
+    double uvd[3];
+} projection;
+
+static bool sees_cached(const wx_owner_view *view, const double p[3], const float n[3],
+                        projection *cache)
+{
+    float facing = n[0] * view->view[0] + n[1] * view->view[1] + n[2] * view->view[2];
+    if (view->normal == NULL && !(facing < FACING_SLACK)) {
+        return false;
+    }
+    if (cache->camera == NULL ||
+        (cache->camera != view->camera &&
+         memcmp(cache->camera->wtc, view->camera->wtc, sizeof view->camera->wtc) != 0)) {
+        wx_matrix_apply_affine(view->camera->wtc, p, cache->uvd);
+        cache->camera = view->camera;
+    }
+    return sees_projected(view, cache->uvd, n);
+}
+
 int wx_owner_of(const wx_owner_view *views, int count, const double p[3], const float n[3],
                 int known)
 {
     int best = -1;
     float best_cos = -1.0f;
+    projection cache = { NULL, { 0.0, 0.0, 0.0 } };
     for (int k = 0; k < count; ++k) {
         const wx_owner_view *v = &views[k];
         float c = fabsf(n[0] * v->view[0] + n[1] * v->view[1] + n[2] * v->view[2]);
@@ -132,13 +176,13 @@ int wx_owner_of(const wx_owner_view *views, int count, const double p[3], const 
             // the depth tolerance of each other) to the layer whose surface p
             // is on.
             if (best >= 0 && v->normal != NULL && c >= best_cos - TIE_COSINE &&
-                same_camera(v, &views[best]) && (k == known || wx_owner_sees(v, p, n)) &&
+                same_camera(v, &views[best]) && (k == known || sees_cached(v, p, n, &cache)) &&
                 (k == known || depth_error(v, p) < depth_error(&views[best], p))) {
                 best = k;
             }
             continue;
         }
-        if (k == known || wx_owner_sees(v, p, n)) {
+        if (k == known || sees_cached(v, p, n, &cache)) {
             best = k;
             best_cos = c;
         }

@@ -122,7 +122,7 @@ wx_result wx_gather_frame(const wx_scene *scene, const wx_run_def *opts, const w
     wx_layer_scene layered;
     memset(&layered, 0, sizeof layered);
     if (r == WX_OK) {
-        r = wx_layer_scene_init(scene, in_maps, &layered, err);
+        r = wx_layer_scene_init(scene, in_maps, opts->threads, &layered, err);
     }
     if (r == WX_OK && has_output) {
         int every = scene->cameras[scene->output_index].every;

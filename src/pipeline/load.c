@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include "core/progress.h"
+#include "gather/gather.h"
 #include "io/exr.h"
 #include "io/maps_file.h"
 
@@ -118,55 +119,79 @@ wx_result wx_load_gather_maps(const wx_scene *scene, const wx_run_def *opts, wx_
     return WX_OK;
 }
 
-wx_result wx_layer_scene_init(const wx_scene *scene, const wx_maps *maps, wx_layer_scene *out,
-                              wx_error *err)
+wx_result wx_layer_scene_init(const wx_scene *scene, const wx_maps *maps, int threads,
+                              wx_layer_scene *out, wx_error *err)
 {
     memset(out, 0, sizeof *out);
     out->scene = *scene;
-    out->maps = (wx_maps *)maps;
-    int extra = 0;
+    int views = 0;
     for (int k = 0; k < scene->input_count; ++k) {
-        extra += wx_maps_layers(&maps[k]) - 1;
+        views += wx_maps_layers(&maps[k]);
     }
-    if (extra == 0) {
-        return WX_OK;
-    }
-    int count = scene->camera_count + extra;
-    wx_scene_camera *cameras = calloc((size_t)count, sizeof *cameras);
-    wx_maps *views = calloc((size_t)(scene->input_count + extra), sizeof *views);
-    if (cameras == NULL || views == NULL) {
+    bool layered = views > scene->input_count;
+    int count = scene->camera_count + views - scene->input_count;
+    wx_scene_camera *cameras = layered ? calloc((size_t)count, sizeof *cameras) : NULL;
+    out->maps = calloc((size_t)views + 1, sizeof *out->maps);
+    wx_gather_view *gather = calloc((size_t)views + 1, sizeof *gather);
+    if ((layered && cameras == NULL) || out->maps == NULL || gather == NULL) {
         free(cameras);
-        free(views);
+        free(gather);
+        free(out->maps);
+        out->maps = NULL;
         return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (layers)");
     }
     int n = 0, v = 0, k = 0;
     for (int c = 0; c < scene->camera_count; ++c) {
         const wx_scene_camera *cam = &scene->cameras[c];
         if (cam->is_output) {
-            out->scene.output_index = n;
-            cameras[n++] = *cam;
+            if (layered) {
+                out->scene.output_index = n;
+                cameras[n++] = *cam;
+            }
             continue;
         }
         for (int layer = 0; layer < wx_maps_layers(&maps[k]); ++layer) {
-            cameras[n] = *cam;
-            cameras[n++].layers = 1;
-            wx_maps_layer_view(&maps[k], layer, &views[v++]);
+            if (layered) {
+                cameras[n] = *cam;
+                cameras[n++].layers = 1;
+                wx_maps_layer_view(&maps[k], layer, &out->maps[v]);
+            } else {
+                out->maps[v] = maps[k];
+            }
+            gather[v] = wx_gather_view_from_maps(&cam->camera, &out->maps[v]);
+            v++;
         }
         k++;
     }
-    out->scene.cameras = cameras;
-    out->scene.camera_count = n;
-    out->scene.input_count = v;
-    out->maps = views;
-    out->owned = true;
-    return WX_OK;
+    if (layered) {
+        out->scene.cameras = cameras;
+        out->scene.camera_count = n;
+        out->scene.input_count = v;
+        out->own_cameras = true;
+    }
+    // Each view's share of its texels, once for the mask, every texture and
+    // every substance of the frame.
+    wx_result r = wx_gather_owned(gather, v, threads, &out->owned, err);
+    size_t at = 0;
+    for (int j = 0; r == WX_OK && out->owned != NULL && j < v; ++j) {
+        if (out->maps[j].owned == NULL) {
+            out->maps[j].owned = out->owned + at;
+            at += (size_t)out->maps[j].width * (size_t)out->maps[j].height;
+        }
+    }
+    free(gather);
+    if (r != WX_OK) {
+        wx_layer_scene_free(out);
+    }
+    return r;
 }
 
 void wx_layer_scene_free(wx_layer_scene *layered)
 {
-    if (layered->owned) {
+    if (layered->own_cameras) {
         free(layered->scene.cameras);
-        free(layered->maps);
     }
+    free(layered->maps);
+    free(layered->owned);
     memset(layered, 0, sizeof *layered);
 }

@@ -27,17 +27,20 @@ wx_result wx_load_gather_maps(const wx_scene *scene, const wx_run_def *opts, wx_
 /// The scene and maps as the gather reads them (docs/design.md section 14):
 /// every layer of an input camera is an input camera of its own, with the
 /// camera's matrices and a view of that layer's planes (wx_maps_layer_view),
-/// in the scene's order, layer 0 first. The cameras array is new (its strings
-/// are borrowed from `scene`); everything else is shared. When no camera has
-/// more than one layer the result is `scene` and `maps` themselves.
+/// in the scene's order, layer 0 first. The cameras array is new when some
+/// camera has layers (its strings are borrowed from `scene`); the maps are
+/// shallow copies whose `owned` planes (the share of each texel's surface each
+/// view owns, model/ownership.h) are computed here once for every gather of
+/// the frame, on `threads` workers.
 typedef struct wx_layer_scene {
     wx_scene scene;
     wx_maps *maps;
-    bool owned; ///< the cameras and maps arrays are this struct's
+    bool own_cameras; ///< the cameras array is this struct's
+    float *owned;     ///< the views' owned planes, one after the other
 } wx_layer_scene;
 
-wx_result wx_layer_scene_init(const wx_scene *scene, const wx_maps *maps, wx_layer_scene *out,
-                              wx_error *err);
+wx_result wx_layer_scene_init(const wx_scene *scene, const wx_maps *maps, int threads,
+                              wx_layer_scene *out, wx_error *err);
 void wx_layer_scene_free(wx_layer_scene *layered);
 
 #endif
