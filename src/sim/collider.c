@@ -644,6 +644,13 @@ typedef struct march {
     int hit_k;
     uint8_t role[WX_MAX_LAYERS];
     double LA[WX_MAX_LAYERS], LB[WX_MAX_LAYERS], LC[WX_MAX_LAYERS];
+    /// The crossings' functions are made when the segment can reach them
+    /// (layers_first): `near` bounds every crossing's depth in the cell from
+    /// below (the least first crossing of the four texels around it), and
+    /// `ready` says the functions are made.
+    double near;
+    bool ready;
+    const wx_collider *collider;
 } march;
 
 // Parameter interval where lo <= P0 + s*dP < hi, intersected into [*a, *b);
@@ -671,6 +678,7 @@ static void march_init(march *m, const wx_collider_camera *cam, const double p0[
                        const double d[3])
 {
     m->cam = cam;
+    m->ready = false;
     m->X0 = p0[0] * cam->mx[0] + p0[1] * cam->mx[1] + p0[2] * cam->mx[2] + cam->mx[3];
     m->Y0 = p0[0] * cam->my[0] + p0[1] * cam->my[1] + p0[2] * cam->my[2] + cam->my[3];
     m->D0 = p0[0] * cam->md[0] + p0[1] * cam->md[1] + p0[2] * cam->md[2] + cam->md[3];
@@ -706,13 +714,43 @@ static double next_boundary(double P0, double r, int h)
 }
 
 // The cell's functions f_k for a camera with layers.
+// The cell's crossings: how many, and a bound below their depths anywhere in
+// the cell. Every crossing's depth in the cell is bilinear between the four
+// texels around it or the cell texel's own (one of the four), and each
+// texel's crossings lie at or behind its first, so none lies nearer than the
+// least first crossing of the four: a segment in front of that bound (by a
+// sheet's thickness) meets nothing in the cell, and the crossings' functions
+// are not made (make_layers).
 static void cell_layers(const wx_collider *collider, march *m)
 {
     const wx_collider_camera *cam = m->cam;
     size_t texels = (size_t)cam->width * (size_t)cam->height;
     size_t t = (size_t)(m->hy >> 1) * (size_t)cam->width + (size_t)(m->hx >> 1);
+    (void)collider;
     int n = 0;
-    for (; n < cam->layers; ++n) {
+    while (n < cam->layers && isfinite(cam->depth[(size_t)n * texels + t])) {
+        n++;
+    }
+    int W = cam->width, H = cam->height;
+    int i0 = m->hx / 2 - 1 + (m->hx & 1), j0 = m->hy / 2 - 1 + (m->hy & 1);
+    int ia = clampi(i0, 0, W - 1), ib = clampi(i0 + 1, 0, W - 1);
+    int ja = clampi(j0, 0, H - 1), jb = clampi(j0 + 1, 0, H - 1);
+    const float *ra = cam->depth + (size_t)ja * (size_t)W, *rb = cam->depth + (size_t)jb * (size_t)W;
+    m->near = fmin(fmin(ra[ia], ra[ib]), fmin(rb[ia], rb[ib]));
+    m->count = n;
+    m->surface = n > 0;
+    m->ready = false;
+}
+
+// The functions f_k of the cell's crossings (cell_layers).
+static void make_layers(march *m)
+{
+    const wx_collider *collider = m->collider;
+    const wx_collider_camera *cam = m->cam;
+    size_t texels = (size_t)cam->width * (size_t)cam->height;
+    size_t t = (size_t)(m->hy >> 1) * (size_t)cam->width + (size_t)(m->hx >> 1);
+    int n = 0;
+    for (; n < m->count; ++n) {
         float own = cam->depth[(size_t)n * texels + t];
         if (!isfinite(own)) {
             break;
@@ -729,8 +767,7 @@ static void cell_layers(const wx_collider *collider, march *m)
         m->LB[n] = m->dD - c1;
         m->LC[n] = -c2;
     }
-    m->count = n;
-    m->surface = n > 0;
+    m->ready = true;
 }
 
 static void cell_function(const wx_collider *collider, march *m)
@@ -862,6 +899,15 @@ static double layers_first(march *m, double lo, double hi)
 {
     double best = INFINITY;
     double sheet = m->cam->sheet;
+    if (!m->ready) {
+        // In front of every crossing of the cell over [lo, hi] (d is linear
+        // in s): nothing to meet here.
+        double d_far = fmax(m->D0 + lo * m->dD, m->D0 + hi * m->dD);
+        if (d_far < m->near - 2.0 * sheet) {
+            return INFINITY;
+        }
+        make_layers(m);
+    }
     for (int k = 0; k < m->count; ++k) {
         int kind = m->role[k] & WX_ROLE_KIND;
         double r;
@@ -1097,6 +1143,7 @@ bool wx_collider_sweep(const wx_collider *collider, const float p0[3], const flo
     double d[3] = { (double)p1[0] - p0[0], (double)p1[1] - p0[1], (double)p1[2] - p0[2] };
     for (int c = 0; c < K; ++c) {
         march_init(&m[c], &collider->cameras[c], a, d);
+        m[c].collider = collider;
     }
     // Leapfrog: raise s until every camera agrees that P(s) may collide and at
     // least one camera sees it (docs/design.md section 4, thesis 4.8.4.1).

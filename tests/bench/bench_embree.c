@@ -221,9 +221,10 @@ static bool maps_world_finish(maps_world *w)
         if (sc->is_output) {
             continue;
         }
-        if (wx_maps_load(&w->maps[w->count], WX_MAPS_DEPTH | WX_MAPS_NORMAL | WX_MAPS_IMPACT, 1,
-                         sc->depth_path, sc->normal_path, sc->impact_path, NULL,
-                         &err) != WX_OK) {
+        if (wx_maps_load_layers(&w->maps[w->count],
+                                WX_MAPS_DEPTH | WX_MAPS_NORMAL | WX_MAPS_IMPACT, 1, &w->scene,
+                                sc->layers, sc->depth_path, sc->normal_path, sc->impact_path,
+                                NULL, &err) != WX_OK) {
             fprintf(stderr, "bench_embree: %s\n", err.message);
             return false;
         }
@@ -247,7 +248,8 @@ static bool maps_world_finish(maps_world *w)
 }
 
 // Loads a scene and bakes what it needs baking into `out_dir`.
-static bool maps_world_load(maps_world *w, const char *scene_path, const char *out_dir)
+static bool maps_world_load(maps_world *w, const char *scene_path, const char *out_dir,
+                            int layers)
 {
     memset(w, 0, sizeof *w);
     wx_error err;
@@ -256,6 +258,11 @@ static bool maps_world_load(maps_world *w, const char *scene_path, const char *o
         return false;
     }
     w->scene_loaded = true;
+    for (int c = 0; layers > 0 && c < w->scene.camera_count; ++c) {
+        if (!w->scene.cameras[c].is_output) {
+            w->scene.cameras[c].layers = layers; // docs/design.md section 14
+        }
+    }
     wx_run_def opts;
     opts = wx_default_run_def(&w->scene);
     snprintf(opts.out_dir, sizeof opts.out_dir, "%s", out_dir);
@@ -713,7 +720,7 @@ static bool speed_for_sphere(const char *dir, int stacks, int slices, segments *
         return false;
     }
     maps_world w;
-    if (!maps_world_load(&w, scene, out)) {
+    if (!maps_world_load(&w, scene, out, 0)) {
         maps_world_free(&w);
         return false;
     }
@@ -806,7 +813,7 @@ static bool accuracy_scene(const char *name, const char *scene_path, const char 
     maps_world w;
     exact e;
     memset(&e, 0, sizeof e);
-    bool ok = maps_world_load(&w, scene_path, out);
+    bool ok = maps_world_load(&w, scene_path, out, 0);
     float lo[3], hi[3];
     if (ok && w.scene.mesh_count > 0) {
         ok = exact_init(&e);
@@ -918,7 +925,7 @@ static int64_t triangle_at(const exact *e, const float point[3], float texel, fl
 // (its box emitter as it is, without the wind and the turbulence), every drop
 // absorbed where it first lands; the collider's and Embree's first hits on the
 // same step segments, counted per surface (material and facing).
-static bool rain_per_surface(const char *out, int n)
+static bool rain_per_surface(const char *out, int n, int layers)
 {
     maps_world w;
     exact e;
@@ -926,7 +933,7 @@ static bool rain_per_surface(const char *out, int n)
     wx_mesh_data m;
     memset(&m, 0, sizeof m);
     wx_error err;
-    bool ok = maps_world_load(&w, "xml_scenes/building.xml", out) && exact_init(&e);
+    bool ok = maps_world_load(&w, "xml_scenes/building.xml", out, layers) && exact_init(&e);
     if (ok && (wx_mesh_import(w.scene.meshes[0].path, &m, &err) != WX_OK)) {
         fprintf(stderr, "bench_embree: %s\n", err.message);
         ok = false;
@@ -1028,12 +1035,17 @@ static bool rain_per_surface(const char *out, int n)
            "within 4 texels; %lld recorded with a normal more than 45 degrees off the face's)\n",
            n, (long long)exact_total, (long long)maps_total, (long long)unattributed,
            (long long)misrecorded);
-    bench_row("embree", "rain recorded on another face", 100.0 * (double)misrecorded /
+    char what[96];
+    snprintf(what, sizeof what, "rain recorded on another face, %d layer%s", layers,
+             layers > 1 ? "s" : "");
+    bench_row("embree", what, 100.0 * (double)misrecorded /
               (double)(maps_total > 0 ? maps_total : 1), "% of hits", NULL, false,
               "building.xml rain without wind; %d drops", n);
-    bench_row("embree", "rain per surface: worst |ours/Embree - 1|", 100.0 * worst, "%",
-              "<= 5", worst <= 0.05, "building.xml rain without wind; %d drops; %d surfaces "
-              "with 100 exact hits or more", n, surfaces);
+    snprintf(what, sizeof what, "rain per surface: worst |ours/Embree - 1|, %d layer%s", layers,
+             layers > 1 ? "s" : "");
+    bench_row("embree", what, 100.0 * worst, "%", "<= 5", worst <= 0.05,
+              "building.xml rain without wind; %d drops; %d surfaces with 100 exact hits or more",
+              n, surfaces);
     exact_free(&e);
     maps_world_free(&w);
     wx_mesh_data_free(&m);
@@ -1072,9 +1084,14 @@ int main(void)
     printf("embree (c): where the shipped house's rain lands (no wind, no turbulence, every "
            "drop absorbed at its first hit), %ld drops\n",
            drops);
-    snprintf(out, sizeof out, "%s/rain", dir);
-    if (!rain_per_surface(out, (int)drops)) {
-        return 1;
+    // With the shipped cameras as they are, then with 4 layers each (docs/design.md
+    // section 14): what the layers change in where hits are recorded.
+    for (int layers = 1; layers <= 4; layers += 3) {
+        snprintf(out, sizeof out, "%s/rain%d", dir, layers);
+        printf("%d layer%s:\n", layers, layers > 1 ? "s" : "");
+        if (!rain_per_surface(out, (int)drops, layers)) {
+            return 1;
+        }
     }
 
     printf("embree (b): %ld segments around a UV sphere in a 2.2 m frame (1024 px: 2.1 mm "
