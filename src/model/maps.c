@@ -1,6 +1,7 @@
 // maps.c: the memory of a camera's maps (maps.h).
 #include "model/maps.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -83,4 +84,115 @@ void wx_maps_layer_view(const wx_maps *maps, int layer, wx_maps *view)
     WX_LAYER_PLANE(area, 1);
     WX_LAYER_PLANE(owned, 1);
 #undef WX_LAYER_PLANE
+}
+
+int wx_layers_outline(const bool *entering, int n, int K, uint8_t *kind, uint8_t *from)
+{
+    int partner[WX_MAX_LAYERS], stack[WX_MAX_LAYERS], top = 0, tail = -1;
+    bool sheet[WX_MAX_LAYERS];
+    for (int k = 0; k < n; ++k) {
+        partner[k] = -1;
+        sheet[k] = false;
+        if (entering[k]) {
+            stack[top++] = k;
+        } else if (top > 0) {
+            int e = stack[--top];
+            partner[e] = k;
+            partner[k] = e;
+        } else {
+            sheet[k] = true;
+        }
+    }
+    if (top > 0 && n == K) {
+        tail = stack[0]; // the outermost solid left open
+    }
+    for (int i = 0; i < top; ++i) {
+        sheet[stack[i]] = stack[i] != tail && n < K;
+    }
+    int m = 0, start = -1, end = -1;
+    for (int k = 0; k < n; ++k) {
+        if (start >= 0 && k > end) { // the union of solids so far ends before k
+            kind[m] = WX_OUTLINE_ENTER, from[m++] = (uint8_t)start;
+            kind[m] = WX_OUTLINE_LEAVE, from[m++] = (uint8_t)end;
+            start = -1;
+        }
+        if (k == tail) {
+            kind[m] = WX_OUTLINE_TAIL, from[m++] = (uint8_t)(start >= 0 ? start : k);
+            return m;
+        }
+        if (entering[k] && partner[k] > k) {
+            if (start < 0) {
+                start = k;
+                end = partner[k];
+            } else if (partner[k] > end) {
+                end = partner[k];
+            }
+        } else if (sheet[k] && start < 0) {
+            kind[m] = WX_OUTLINE_SHEET, from[m++] = (uint8_t)k;
+        }
+    }
+    if (start >= 0) {
+        kind[m] = WX_OUTLINE_ENTER, from[m++] = (uint8_t)start;
+        kind[m] = WX_OUTLINE_LEAVE, from[m++] = (uint8_t)end;
+    }
+    if (n == K && m > 0) {
+        if (kind[m - 1] == WX_OUTLINE_LEAVE) {
+            m--;
+            kind[m - 1] = WX_OUTLINE_TAIL;
+        } else {
+            kind[m - 1] = WX_OUTLINE_TAIL;
+        }
+    }
+    return m;
+}
+
+
+void wx_maps_bury(const wx_maps *maps, const float view[3], float sheet, float *depth)
+{
+    int K = wx_maps_layers(maps);
+    size_t texels = (size_t)maps->width * (size_t)maps->height;
+    memcpy(depth, maps->depth, (size_t)K * texels * sizeof *depth);
+    if (K < 2 || maps->normal == NULL) {
+        return;
+    }
+    for (size_t t = 0; t < texels; ++t) {
+        bool entering[WX_MAX_LAYERS], keep[WX_MAX_LAYERS];
+        int n = 0;
+        while (n < K && !wx_depth_is_empty(maps->depth[(size_t)n * texels + t])) {
+            const float *nv = maps->normal + 3 * ((size_t)n * texels + t);
+            entering[n] = !(nv[0] * view[0] + nv[1] * view[1] + nv[2] * view[2] > 0.0f);
+            keep[n] = false;
+            n++;
+        }
+        // What lies behind the last layer does not matter here: a face
+        // between two crossings that close around it is buried whatever
+        // follows (an outline of n + 1 layers: no tail), and a solid left open
+        // buries nothing (its crossings read as sheets: kept).
+        uint8_t kind[WX_MAX_LAYERS + 1], from[WX_MAX_LAYERS + 1];
+        int m = wx_layers_outline(entering, n, n + 1, kind, from);
+        for (int k = 0; k < m; ++k) {
+            keep[from[k]] = true;
+        }
+        // Faces in contact are sealed: a solid's face within a sheet's
+        // thickness behind another solid's (a wall behind the glass pane
+        // that touches it, a house's underside on the ground it stands on),
+        // or behind a pane facing the camera.
+        for (int k = 1; k < m; ++k) {
+            float gap = maps->depth[(size_t)from[k] * texels + t] -
+                        maps->depth[(size_t)from[k - 1] * texels + t];
+            if (kind[k] != WX_OUTLINE_ENTER || !(gap < sheet)) {
+                continue;
+            }
+            if (kind[k - 1] == WX_OUTLINE_LEAVE) {
+                keep[from[k]] = keep[from[k - 1]] = false;
+            } else if (kind[k - 1] == WX_OUTLINE_SHEET && entering[from[k - 1]]) {
+                keep[from[k]] = false;
+            }
+        }
+        for (int k = 0; k < n; ++k) {
+            if (!keep[k]) {
+                depth[(size_t)k * texels + t] = INFINITY;
+            }
+        }
+    }
 }

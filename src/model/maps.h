@@ -8,6 +8,7 @@
 #define WX_MAPS_H
 
 #include <stdbool.h>
+#include <stdint.h>
 
 #include "core/error.h"
 #include "core/limits.h"
@@ -97,6 +98,37 @@ static inline int wx_maps_layers(const wx_maps *maps)
 /// into that layer's blocks (borrowed: never pass it to wx_maps_free; it lives
 /// as long as `maps`). The header attributes are shared too.
 void wx_maps_layer_view(const wx_maps *maps, int layer, wx_maps *view);
+
+/// What a crossing of a layered texel bounds, once its crossings are reduced
+/// to the outline of its solids (wx_layers_outline).
+enum {
+    WX_OUTLINE_NONE = 0,
+    WX_OUTLINE_ENTER = 1, ///< enters a solid the next kept crossing (LEAVE) leaves
+    WX_OUTLINE_LEAVE = 2,
+    WX_OUTLINE_SHEET = 3, ///< one-sided: nothing closes it (a pane, an open sheet)
+    WX_OUTLINE_TAIL = 4,  ///< solid from here on: behind the last layer is unknown
+};
+
+/// The outline of one texel's solids from its n crossings, nearest first, of
+/// K layers (docs/physics.md, "Layered maps"): each leaving crossing closes
+/// the nearest entering one still open (solids nest: a roof's slab inside a
+/// wall, a sill through a facade); what no crossing closes is a sheet or,
+/// when every layer holds a crossing, the start of a solid whose end lies
+/// beyond them (TAIL; then also a last crossing that leaves: what is behind it
+/// is unknown, so solid, as one layer's map says). Nested and overlapping
+/// solids merge into one interval; the faces and sheets inside it are
+/// dropped. Writes the kept crossings' kinds and indices into kind[], from[]
+/// (nearest first); returns how many.
+int wx_layers_outline(const bool *entering, int n, int K, uint8_t *kind, uint8_t *from);
+
+/// The depth planes of `maps` (every layer) into `depth`, with the crossings
+/// buried inside a solid (those wx_layers_outline drops: a slab's face inside
+/// the wall it runs into) or sealed by contact (two solids' faces less than
+/// `sheet`, in d, apart: a wall behind the glass that touches it, a house's
+/// underside on the ground; a solid's face that close behind a pane facing
+/// the camera) made +inf, so that no view sees them: nothing can reach them. `view` is the camera's unit
+/// viewing direction. One layer: a copy.
+void wx_maps_bury(const wx_maps *maps, const float view[3], float sheet, float *depth);
 
 /// The file channel of `channel` in layer `layer` (docs/design.md section 14):
 /// the name itself in layer 0, "layerK.NAME" in layer K >= 1. Returns false

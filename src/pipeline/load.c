@@ -2,6 +2,7 @@
 // the input cameras' maps.
 #include "pipeline/load.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -150,11 +151,34 @@ wx_result wx_layer_scene_init(const wx_scene *scene, const wx_maps *maps, int th
             }
             continue;
         }
-        for (int layer = 0; layer < wx_maps_layers(&maps[k]); ++layer) {
+        // A layered camera's views see no crossing buried in a solid or sealed
+        // behind a pane (wx_maps_bury): nothing reaches those.
+        float *buried = NULL;
+        int K = wx_maps_layers(&maps[k]);
+        size_t texels = (size_t)maps[k].width * (size_t)maps[k].height;
+        if (K > 1 && out->buried_count < WX_MAX_INPUT_CAMERAS) {
+            buried = malloc((size_t)K * texels * sizeof *buried + 1);
+            if (buried == NULL) {
+                free(gather);
+                wx_layer_scene_free(out);
+                free(cameras);
+                return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (layers)");
+            }
+            out->buried[out->buried_count++] = buried;
+            float view[3], fw, fh;
+            wx_camera_view_dir(&cam->camera, view);
+            wx_camera_frame_size(&cam->camera, &fw, &fh);
+            float texel = fminf(fw / (float)maps[k].width, fh / (float)maps[k].height);
+            wx_maps_bury(&maps[k], view, 0.25f * texel, buried);
+        }
+        for (int layer = 0; layer < K; ++layer) {
             if (layered) {
                 cameras[n] = *cam;
                 cameras[n++].layers = 1;
                 wx_maps_layer_view(&maps[k], layer, &out->maps[v]);
+                if (buried != NULL) {
+                    out->maps[v].depth = buried + (size_t)layer * texels;
+                }
             } else {
                 out->maps[v] = maps[k];
             }
@@ -193,5 +217,8 @@ void wx_layer_scene_free(wx_layer_scene *layered)
     }
     free(layered->maps);
     free(layered->owned);
+    for (int k = 0; k < layered->buried_count; ++k) {
+        free(layered->buried[k]);
+    }
     memset(layered, 0, sizeof *layered);
 }

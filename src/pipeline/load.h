@@ -37,6 +37,10 @@ typedef struct wx_layer_scene {
     wx_maps *maps;
     bool own_cameras; ///< the cameras array is this struct's
     float *owned;     ///< the views' owned planes, one after the other
+    /// Per layered camera, its depth planes with the buried crossings made
+    /// +inf (wx_maps_bury), which its views read.
+    float *buried[WX_MAX_INPUT_CAMERAS];
+    int buried_count;
 } wx_layer_scene;
 
 wx_result wx_layer_scene_init(const wx_scene *scene, const wx_maps *maps, int threads,

@@ -159,84 +159,14 @@ static bool border_is_empty(const float *depth, int W, int H)
 //    every layer holds a crossing.
 // The FACING bit is set where the crossing enters (n . view <= 0).
 enum {
-    WX_ROLE_NONE = 0,
-    WX_ROLE_ENTER = 1,
-    WX_ROLE_LEAVE = 2,
-    WX_ROLE_SHEET = 3,
-    WX_ROLE_TAIL = 4,
+    WX_ROLE_NONE = WX_OUTLINE_NONE,
+    WX_ROLE_ENTER = WX_OUTLINE_ENTER,
+    WX_ROLE_LEAVE = WX_OUTLINE_LEAVE,
+    WX_ROLE_SHEET = WX_OUTLINE_SHEET,
+    WX_ROLE_TAIL = WX_OUTLINE_TAIL,
     WX_ROLE_KIND = 7,
     WX_ROLE_FACING = 8,
 };
-
-// The outline of one texel's solids from its n crossings (nearest first; K
-// layers): each leaving crossing closes the nearest entering one still open
-// (solids nest: a roof's slab inside a wall, a sill through a facade); what
-// no crossing closes is a sheet, or, when every layer holds a crossing, the
-// start of a solid whose end lies beyond them (TAIL; then also a last
-// crossing that leaves: what is behind it is unknown, so solid, as one
-// layer's map says, and the other cameras decide by the point rule). Nested
-// and overlapping solids merge into one interval; the faces and sheets inside
-// it are dropped. Writes the kept crossings' roles and original layers into
-// kind[], from[]; returns how many.
-static int outline(const bool *entering, int n, int K, uint8_t *kind, uint8_t *from)
-{
-    int partner[WX_MAX_LAYERS], stack[WX_MAX_LAYERS], top = 0, tail = -1;
-    bool sheet[WX_MAX_LAYERS];
-    for (int k = 0; k < n; ++k) {
-        partner[k] = -1;
-        sheet[k] = false;
-        if (entering[k]) {
-            stack[top++] = k;
-        } else if (top > 0) {
-            int e = stack[--top];
-            partner[e] = k;
-            partner[k] = e;
-        } else {
-            sheet[k] = true;
-        }
-    }
-    if (top > 0 && n == K) {
-        tail = stack[0]; // the outermost solid left open
-    }
-    for (int i = 0; i < top; ++i) {
-        sheet[stack[i]] = stack[i] != tail && n < K;
-    }
-    int m = 0, start = -1, end = -1;
-    for (int k = 0; k < n; ++k) {
-        if (start >= 0 && k > end) { // the union of solids so far ends before k
-            kind[m] = WX_ROLE_ENTER, from[m++] = (uint8_t)start;
-            kind[m] = WX_ROLE_LEAVE, from[m++] = (uint8_t)end;
-            start = -1;
-        }
-        if (k == tail) {
-            kind[m] = WX_ROLE_TAIL, from[m++] = (uint8_t)(start >= 0 ? start : k);
-            return m;
-        }
-        if (entering[k] && partner[k] > k) {
-            if (start < 0) {
-                start = k;
-                end = partner[k];
-            } else if (partner[k] > end) {
-                end = partner[k];
-            }
-        } else if (sheet[k] && start < 0) {
-            kind[m] = WX_ROLE_SHEET, from[m++] = (uint8_t)k;
-        }
-    }
-    if (start >= 0) {
-        kind[m] = WX_ROLE_ENTER, from[m++] = (uint8_t)start;
-        kind[m] = WX_ROLE_LEAVE, from[m++] = (uint8_t)end;
-    }
-    if (n == K && m > 0) {
-        if (kind[m - 1] == WX_ROLE_LEAVE) {
-            m--;
-            kind[m - 1] = WX_ROLE_TAIL;
-        } else {
-            kind[m - 1] = WX_ROLE_TAIL;
-        }
-    }
-    return m;
-}
 
 // The roles of every texel's crossings (depth already copied, normals set):
 // each texel's crossings are replaced by their outline (outline above),
@@ -263,7 +193,7 @@ static void classify_layers(wx_collider_camera *cam)
             entering[k] = !(dot < 0.0f);
         }
         uint8_t kind[WX_MAX_LAYERS], from[WX_MAX_LAYERS];
-        int m = outline(entering, n, K, kind, from);
+        int m = wx_layers_outline(entering, n, K, kind, from);
         for (int k = 0; k < K; ++k) {
             size_t at = (size_t)k * texels + t;
             if (k < m) {
