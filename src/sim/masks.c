@@ -48,7 +48,7 @@ int wx_mask_rays(const wx_mask_def *mask)
 typedef struct job {
     const wx_masks_def *def;
     float *const *out;
-    float offset;   // start this far along the normal
+    float offset;   // first start this far above the surface (ray_start)
     double first;   // length of a ray's first segment
     int mask;       // the mask being computed
     double suns[3][3];
@@ -175,25 +175,30 @@ static bool ray_free(const wx_collider *collider, const double p[3], const doubl
 }
 
 // Where a ray from surface point p along unit dir starts: on the ray itself
-// (so that a shadow's edge does not move), `offset` above the surface, or at
-// most 2 offsets along the ray for rays at grazing angles; 1.5 times further
-// along where that is still inside what the maps record.
+// (so that a shadow's edge does not move), within one of the collider's finest
+// texels of p: at a height of 1/8, then 1/4, then 1/2 of that texel above the
+// surface (along the ray: the height over max(cos, 1/2)), then a whole texel
+// along the ray, the first start the collider's point rule says is free. The
+// maps record a surface to about half a texel where a camera sees it edge-on or
+// at a silhouette, so a low start may read as inside it and the next one up is
+// taken. Starts two texels up (four along grazing rays) skipped a sill's edge
+// or the far side of a crease nearer than that and left those texels bright.
 // Returns the distance skipped, or -1 when every start lies inside (the ray is
 // closed: the point lies within what the maps record as solid).
 static double ray_start(const job *jb, const double p[3], const float n[3], const double dir[3],
                         double out[3])
 {
     double c = n[0] * dir[0] + n[1] * dir[1] + n[2] * dir[2];
-    double skip = jb->offset / fmax(c, 0.5);
-    static const double factors[2] = { 1.0, 1.5 };
-    for (int tries = 0; tries < 2; ++tries) {
+    double texel = 8.0 * jb->offset;
+    for (int tries = 0; tries < 4; ++tries) {
+        double skip = fmin(texel, jb->offset * (double)(1 << tries) / fmax(c, 0.5));
         float f[3];
         for (int k = 0; k < 3; ++k) {
-            out[k] = p[k] + dir[k] * skip * factors[tries];
+            out[k] = p[k] + dir[k] * skip;
             f[k] = (float)out[k];
         }
         if (jb->def->collider == NULL || !wx_collider_point_collides(jb->def->collider, f)) {
-            return skip * factors[tries];
+            return skip;
         }
     }
     return -1.0;
@@ -364,13 +369,15 @@ wx_result wx_masks_compute(const wx_masks_def *def, float *const *out, wx_error 
     memset(&jb, 0, sizeof jb);
     jb.def = def;
     jb.out = out;
-    // Rays start two of the collider's texels off the surface; their first
-    // segment is four texels long.
-    float texel = def->points.texel;
+    // Rays start within one of the collider's finest texels of the surface
+    // (ray_start: an eighth of it up first); their first segment is four of
+    // its coarsest texels (the target's, when they are coarser) long.
+    float texel = def->points.texel, finest = INFINITY;
     for (int c = 0; def->collider != NULL && c < def->collider->camera_count; ++c) {
         texel = fmaxf(texel, def->collider->cameras[c].texel_ws);
+        finest = fminf(finest, def->collider->cameras[c].texel_ws);
     }
-    jb.offset = 2.0f * texel;
+    jb.offset = (isfinite(finest) ? finest : def->points.texel) / 8.0f;
     jb.first = 4.0 * texel;
     wx_progress progress;
     wx_progress_begin(&progress, "masks", (int64_t)scene->mask_count * def->points.height,

@@ -5,8 +5,10 @@
 //
 // Accessibility and exposure march rays through the projected-maps collider
 // (collider.h), the very geometry the particles hit: a ray from a point
-// starts just off the surface (on the ray, two texels above the surface, so
-// that a surface never shadows itself and a shadow's edge stays put), and is cut into segments of doubling length, each
+// starts just off the surface (on the ray, within one of the collider's finest
+// texels: the lowest of 1/8, 1/4, 1/2 texel up that the collider says is free,
+// so that a surface never shadows itself, a crease stays dark and a shadow's
+// edge stays put), and is cut into segments of doubling length, each
 // cleared by the collider's coarse pyramid when it can be and swept otherwise.
 // Directions are stratified per point (a Hammersley set rotated by a hash of
 // the seed, the mask and the point), so the result is the same for any thread

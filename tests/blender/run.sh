@@ -8,7 +8,9 @@
 # test_mask_recipe.py, which runs the recipe's blocks from docs/mask.md on
 # building.obj and compares each render with its mask.exr and mask.png; then
 # Blender on test_addon.py, which runs the add-on blender/weathering/ headless
-# (docs/blender.md) on a cube and a sphere.
+# (docs/blender.md) on a cube and a sphere; then Blender on test_ao_peer.py, which
+# compares the accessibility of a scene `weathering init` writes for the house
+# with Cycles' AO bake of its UV layout (and times both).
 # The last line is "N passed, M failed"; the exit status is non-zero on failure.
 set -u
 cd "$(dirname "$0")/../.."
@@ -62,6 +64,11 @@ blender_test tests/blender/test_mask_recipe.py -- \
 # cube and a sphere into $build/blender-test/addon/.
 echo "== the Blender add-on"
 blender_test tests/blender/test_addon.py -- "$(cd "$build" && pwd)"
+# Accessibility against Cycles' AO bake on the default house with init's
+# cameras (issue 26, item 4; docs/masks.md, "Against Blender's AO bake"), into
+# $build/blender-test/ao_peer/.
+echo "== accessibility against Blender's AO bake"
+blender_test tests/blender/test_ao_peer.py -- "$build" xml_scenes/meshes/building.obj "$out/ao_peer"
 echo "== test-blender took $((SECONDS - t0)) s"
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]
