@@ -187,3 +187,19 @@ double wx_length3(const double a[3])
 {
     return sqrt(wx_dot3(a, a));
 }
+
+void wx_perpendicular_basis(const double d[3], double e1[3], double e2[3])
+{
+    double u[3] = { 0.0, 0.0, 0.0 };
+    u[fabs(d[0]) < 0.9 ? 0 : 1] = 1.0; // any vector not along d
+    e1[0] = d[1] * u[2] - d[2] * u[1];
+    e1[1] = d[2] * u[0] - d[0] * u[2];
+    e1[2] = d[0] * u[1] - d[1] * u[0];
+    double l1 = sqrt(e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]);
+    for (int k = 0; k < 3; ++k) {
+        e1[k] /= l1;
+    }
+    e2[0] = d[1] * e1[2] - d[2] * e1[1];
+    e2[1] = d[2] * e1[0] - d[0] * e1[2];
+    e2[2] = d[0] * e1[1] - d[1] * e1[0];
+}

@@ -49,4 +49,9 @@ float wx_matrix_inverse_error(const float a[16], const float b[16]);
 double wx_dot3(const double a[3], const double b[3]);
 double wx_length3(const double a[3]);
 
+/// Two unit vectors e1, e2 across the unit vector d, (d, e1, e2) right-handed:
+/// e1 = unit(d x u) with u the x axis, or the y axis when d lies within 26
+/// degrees of x; e2 = d x e1.
+void wx_perpendicular_basis(const double d[3], double e1[3], double e2[3]);
+
 #endif

@@ -6,6 +6,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/matrix.h"
+
 void wx_mesh_data_release_arrays(wx_mesh_data *mesh)
 {
     free(mesh->positions);
@@ -642,20 +644,8 @@ int wx_mesh_depth_complexity(const wx_mesh_data *mesh, const double axis[3], int
         return 0;
     }
     // A basis (a, b) of the plane across the axis.
-    double helper[3] = { 1.0, 0.0, 0.0 };
-    if (fabs(axis[0]) > 0.9) {
-        helper[0] = 0.0;
-        helper[1] = 1.0;
-    }
-    double a[3] = { axis[1] * helper[2] - axis[2] * helper[1],
-                    axis[2] * helper[0] - axis[0] * helper[2],
-                    axis[0] * helper[1] - axis[1] * helper[0] };
-    double al = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
-    for (int k = 0; k < 3; ++k) {
-        a[k] /= al;
-    }
-    double b[3] = { axis[1] * a[2] - axis[2] * a[1], axis[2] * a[0] - axis[0] * a[2],
-                    axis[0] * a[1] - axis[1] * a[0] };
+    double a[3], b[3];
+    wx_perpendicular_basis(axis, a, b);
     double lo[2] = { INFINITY, INFINITY }, hi[2] = { -INFINITY, -INFINITY };
     for (int64_t v = 0; v < mesh->vertex_count; ++v) {
         const float *p = &mesh->positions[3 * v];

@@ -9,6 +9,7 @@
 #include <strings.h>
 
 #include "core/limits.h"
+#include "core/matrix.h"
 #include "gather/texture.h"
 #include "io/mesh_import.h"
 #include "io/scene_xml.h"
@@ -258,16 +259,8 @@ static double first_time(const double p0[3], const double v0[3], const double a[
 // with d itself first: five launch directions.
 static void cone_rim(const double d[3], double spread_deg, double out[5][3])
 {
-    double u[3] = { 0.0, 0.0, 0.0 };
-    u[fabs(d[0]) < 0.9 ? 0 : 1] = 1.0; // any vector not along d
-    double e1[3] = { d[1] * u[2] - d[2] * u[1], d[2] * u[0] - d[0] * u[2],
-                     d[0] * u[1] - d[1] * u[0] };
-    double l1 = sqrt(e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]);
-    for (int k = 0; k < 3; ++k) {
-        e1[k] /= l1;
-    }
-    double e2[3] = { d[1] * e1[2] - d[2] * e1[1], d[2] * e1[0] - d[0] * e1[2],
-                     d[0] * e1[1] - d[1] * e1[0] };
+    double e1[3], e2[3];
+    wx_perpendicular_basis(d, e1, e2);
     double c = cos(spread_deg * DEG), sn = sin(spread_deg * DEG);
     const double *side[4] = { e1, e2, e1, e2 };
     for (int k = 0; k < 3; ++k) {
