@@ -54,12 +54,15 @@ static inline fx_solid *fx_box(fx_world *w, float x0, float y0, float z0, float 
     return s;
 }
 
-// Ray o + t*d against a convex solid: entry distance and the entry plane's normal.
-static inline bool fx_hit_solid(const fx_solid *s, const double o[3], const double d[3],
-                                double *t_out, float n[3])
+// Ray o + t*d through a convex solid: the entry distance t0 and plane p0, the
+// exit distance t1 and plane p1 (-1: none). False when the ray misses it or
+// enters it behind o.
+static inline bool fx_cross_solid(const fx_solid *s, const double o[3], const double d[3],
+                                  double *t0, int *p0, double *t1, int *p1)
 {
-    double t0 = -1e30, t1 = 1e30;
-    int plane = -1;
+    *t0 = -1e30;
+    *t1 = 1e30;
+    *p0 = *p1 = -1;
     for (int k = 0; k < s->plane_count; ++k) {
         double nd = s->n[k][0] * d[0] + s->n[k][1] * d[1] + s->n[k][2] * d[2];
         double no = s->n[k][0] * o[0] + s->n[k][1] * o[1] + s->n[k][2] * o[2];
@@ -71,18 +74,27 @@ static inline bool fx_hit_solid(const fx_solid *s, const double o[3], const doub
         }
         double t = (s->c[k] - no) / nd;
         if (nd < 0) {
-            if (t > t0) {
-                t0 = t;
-                plane = k;
+            if (t > *t0) {
+                *t0 = t;
+                *p0 = k;
             }
-        } else if (t < t1) {
-            t1 = t;
+        } else if (t < *t1) {
+            *t1 = t;
+            *p1 = k;
         }
     }
-    if (plane < 0 || t0 > t1 || t0 < 0) {
+    return *p0 >= 0 && *t0 <= *t1 && *t0 >= 0;
+}
+
+// Ray o + t*d against a convex solid: entry distance and the entry plane's normal.
+static inline bool fx_hit_solid(const fx_solid *s, const double o[3], const double d[3],
+                                double *t_out, float n[3])
+{
+    double t1;
+    int plane, exit;
+    if (!fx_cross_solid(s, o, d, t_out, &plane, &t1, &exit)) {
         return false;
     }
-    *t_out = t0;
     memcpy(n, s->n[plane], sizeof(float) * 3);
     return true;
 }

@@ -1414,8 +1414,8 @@ TEST(layers_hold_every_substance_the_surface_and_the_area)
         "<?xml version=\"1.0\"?>\n<Weathering>\n"
         "  <Substances><Substance name=\"water\"/><Substance name=\"dirt\"/></Substances>\n"
         "  <Collider><ProjectedMaps>\n"
-        "    <Ortho cameraName=\"front\"><View eye=\"0 0 5\" target=\"0 0 0\" up=\"0 1 0\" "
-        "width=\"4\" height=\"4\" resolution=\"64\"/></Ortho>\n"
+        "    <Ortho cameraName=\"front\" layers=\"2\"><View eye=\"0 0 5\" target=\"0 0 0\" "
+        "up=\"0 1 0\" width=\"4\" height=\"4\" resolution=\"64\"/></Ortho>\n"
         "    <Ortho cameraName=\"shot\" out=\"true\"><View eye=\"0 0 5\" target=\"0 0 0\" "
         "up=\"0 1 0\" width=\"4\" height=\"4\" resolution=\"32\"/>\n"
         "      <OutputMap file=\"mask.exr\" width=\"32\" height=\"32\"/></Ortho>\n"
@@ -1434,7 +1434,7 @@ TEST(layers_hold_every_substance_the_surface_and_the_area)
         fprintf(stderr, "%s\n", err.message);
     }
     ENSURE(r == WX_OK);
-    s.cameras[0].layers = 2; // the scene file's attribute is not read yet
+    ENSURE(s.cameras[0].layers == 2);
     wx_run_def o;
     options_for(&o, "layers_substances");
     r = wx_bake_scene(&s, &o, &err);

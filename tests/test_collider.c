@@ -362,27 +362,9 @@ typedef struct crossing {
 static bool cross_solid(const fx_solid *s, const double o[3], const double d[3], crossing *in,
                         crossing *out)
 {
-    double t0 = -1e30, t1 = 1e30;
-    int p0 = -1, p1 = -1;
-    for (int k = 0; k < s->plane_count; ++k) {
-        double nd = s->n[k][0] * d[0] + s->n[k][1] * d[1] + s->n[k][2] * d[2];
-        double no = s->n[k][0] * o[0] + s->n[k][1] * o[1] + s->n[k][2] * o[2];
-        if (fabs(nd) < 1e-12) {
-            if (no > s->c[k]) {
-                return false;
-            }
-            continue;
-        }
-        double t = (s->c[k] - no) / nd;
-        if (nd < 0 && t > t0) {
-            t0 = t;
-            p0 = k;
-        } else if (nd > 0 && t < t1) {
-            t1 = t;
-            p1 = k;
-        }
-    }
-    if (p0 < 0 || p1 < 0 || t0 > t1 || t0 < 0) {
+    double t0, t1;
+    int p0, p1;
+    if (!fx_cross_solid(s, o, d, &t0, &p0, &t1, &p1) || p1 < 0) {
         return false;
     }
     in->t = t0;

@@ -1112,9 +1112,10 @@ static bool write_layered_maps(const char *dir, const char *cam, int size, int l
 }
 
 // A scene with a layered camera "a" (layers="2", from above: its layers at y
-// = 3 and 2) and a camera "b" of one layer (from +z), with a Height mask, with the maps a bake that peels layers writes,
-// made by hand in `out_dir` (this branch's bake does not peel yet), newer
-// than the scene and the mesh. NULL when they cannot be written.
+// = 3 and 2) and a camera "b" of one layer (from +z), with a Height mask, with
+// the maps a bake that peels layers writes made by hand in `out_dir` (exact
+// values, independent of the bake), newer than the scene and the mesh. NULL
+// when they cannot be written.
 static const char *layered_scene(char out_dir[4200])
 {
     const char *tmp = ensure_tmpdir();

@@ -349,6 +349,19 @@ typedef struct cell_depth {
     double ox, oy;
 } cell_depth;
 
+// The bilinear depth over the cell whose corners are the centres of texels
+// (i0, j0), (i0+1, j0), (i0, j0+1), (i0+1, j0+1), of depths d00, d10, d01, d11.
+static void bilinear_cell(cell_depth *cd, int i0, int j0, double d00, double d10, double d01,
+                          double d11)
+{
+    cd->ox = i0 + 0.5;
+    cd->oy = j0 + 0.5;
+    cd->k0 = d00;
+    cd->k1 = d10 - d00;
+    cd->k2 = d01 - d00;
+    cd->k3 = d00 - d10 - d01 + d11;
+}
+
 static bool cell_surface(const wx_collider *collider, const wx_collider_camera *cam, int hx,
                          int hy, cell_depth *cd)
 {
@@ -374,12 +387,7 @@ static bool cell_surface(const wx_collider *collider, const wx_collider_camera *
     if (!isfinite(d00) || !isfinite(d10) || !isfinite(d01) || !isfinite(d11)) {
         return true; // silhouette: the texel's own depth
     }
-    cd->ox = i0 + 0.5;
-    cd->oy = j0 + 0.5;
-    cd->k0 = d00;
-    cd->k1 = d10 - d00;
-    cd->k2 = d01 - d00;
-    cd->k3 = d00 - d10 - d01 + d11;
+    bilinear_cell(cd, i0, j0, d00, d10, d01, d11);
     return true;
 }
 
@@ -415,12 +423,7 @@ static void layer_cell(const wx_collider *collider, const wx_collider_camera *ca
     if (differ & WX_ROLE_FACING) {
         return;
     }
-    cd->ox = i0 + 0.5;
-    cd->oy = j0 + 0.5;
-    cd->k0 = d00;
-    cd->k1 = d10 - d00;
-    cd->k2 = d01 - d00;
-    cd->k3 = d00 - d10 - d01 + d11;
+    bilinear_cell(cd, i0, j0, d00, d10, d01, d11);
 }
 
 static inline double cell_value(const cell_depth *cd, double X, double Y)

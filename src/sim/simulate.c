@@ -1027,13 +1027,15 @@ wx_result wx_sim_create(const wx_scene *scene, const wx_sim_def *config, wx_sim 
                         sim->substances);
             break;
         }
+        // The collider's copy of a one-layer camera's depth (empty texels
+        // +inf); a layered camera's copy is reordered (its solids' outline),
+        // so its views read their own planes.
+        int cam = view_camera(sim, c);
+        const float *depth = wx_maps_layers(&sim->maps[cam]) > 1 ? m->depth
+                                                                 : sim->collider.cameras[cam].depth;
         r = wx_dirt_map_init(&sim->dirt[c], m->width, m->height, sim->substances, m->dirt,
                              m->deposit, m->erosion, scene->collider.deposit,
-                             scene->collider.erosion,
-                             sim->views[c].layers == 1 && sim->maps[view_camera(sim, c)].layers <= 1
-                                 ? sim->collider.cameras[view_camera(sim, c)].depth
-                                 : m->depth,
-                             err);
+                             scene->collider.erosion, depth, err);
         if (r == WX_OK) {
             for (int s = 0; s < sim->substances; ++s) {
                 sim->stats.substance[s].initial_surface += wx_dirt_map_total(&sim->dirt[c], s);
