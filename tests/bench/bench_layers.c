@@ -364,10 +364,10 @@ static bool memory(int px)
            "    estimate %.0f MiB, peak %.0f MiB (%.2fx; target estimate >= peak: %s); "
            "with layers=\"1\" the peak is %.0f MiB\n"
            "    its simulation: %.1f M steps/s over %.0f M particle-steps; with layers=\"1\" "
-           "%.1f M steps/s over %.0f M (one run each)\n",
+           "%.1f M steps/s over %.0f M (%.2fx; one run each)\n",
            px, layered, seconds, estimate, peak, estimate / peak,
            estimate >= peak ? "met" : "MISSED", peak_one, rate / 1e6, steps / 1e6,
-           rate_one / 1e6, steps_one / 1e6);
+           rate_one / 1e6, steps_one / 1e6, rate / rate_one);
     bench_row("layers", "memory estimate", estimate, "MiB", NULL, false,
               "init house %d px %d cams 4 layers (weathering info)", px, layered);
     bench_row("layers", "peak RSS", peak, "MiB", NULL, false,
@@ -380,6 +380,9 @@ static bool memory(int px)
               "init house %d px %d cams 4 layers (weathering run; one run)", px, layered);
     bench_row("layers", "M steps/s", rate_one / 1e6, "M/s", NULL, false,
               "init house %d px %d cams 1 layer (weathering run; one run)", px, layered);
+    bench_row("layers", "layered speed ratio", rate / rate_one, "x", NULL, false,
+              "init house %d px %d cams 4 layers / 1 layer (weathering run; one run each)", px,
+              layered);
     return true;
 }
 
