@@ -37,7 +37,7 @@ const float COLORS_DIRT = 2.0;
 // The peeling key of a crossing at d with outward normal n (above).
 float peel_key(float d, vec3 n)
 {
-    return dot(n, u_view_dir) < 0.0 ? d + 2e-5 * (1.0 + abs(d)) : d;
+    return dot(n, u_view_dir) < 0.0 ? d + 4e-6 * (1.0 + abs(d)) : d;
 }
 
 void main()
@@ -64,7 +64,7 @@ void main()
             // 1 mm apart at d = 50: two layers; one surface met twice: one.
             vec4 previous = texelFetch(u_previous, ivec2(gl_FragCoord.xy), 0);
             float before = peel_key(previous.r, previous.gba);
-            if (!(key > before + 1e-5 * (1.0 + abs(previous.r)))) {
+            if (!(key > before + 2e-6 * (1.0 + abs(previous.r)))) {
                 discard;
             }
         }
