@@ -84,6 +84,30 @@ void wx_maps_layer_view(const wx_maps *maps, int layer, wx_maps *view)
     WX_LAYER_PLANE(area, 1);
     WX_LAYER_PLANE(owned, 1);
 #undef WX_LAYER_PLANE
+    view->crossing_depth = maps->depth;
+    view->crossing_normal = maps->normal;
+    view->crossing_layers = wx_maps_layers(maps);
+    view->crossing_layer = (int)k;
+}
+
+bool wx_crossing_nearer(const float *depth, const float *normal, int layers, int layer,
+                        size_t texels, size_t t, float dp, const float n[3])
+{
+    if (depth == NULL || normal == NULL || layers < 2) {
+        return false;
+    }
+    float own = fabsf(dp - depth[(size_t)layer * texels + t]);
+    for (int k = 0; k < layers; ++k) {
+        size_t at = (size_t)k * texels + t;
+        if (k == layer || wx_depth_is_empty(depth[at])) {
+            continue;
+        }
+        const float *m = normal + 3 * at;
+        if (fabsf(dp - depth[at]) < own && n[0] * m[0] + n[1] * m[1] + n[2] * m[2] > 0.0f) {
+            return true;
+        }
+    }
+    return false;
 }
 
 int wx_layers_outline(const bool *entering, int n, int K, uint8_t *kind, uint8_t *from)
@@ -147,6 +171,21 @@ int wx_layers_outline(const bool *entering, int n, int K, uint8_t *kind, uint8_t
 }
 
 
+// The outermost solid a texel's crossings leave open (bracket matching, as
+// wx_layers_outline): its entering crossing, or -1 when every solid closes.
+static int outermost_open(const bool *entering, int n)
+{
+    int stack[WX_MAX_LAYERS], top = 0;
+    for (int k = 0; k < n; ++k) {
+        if (entering[k]) {
+            stack[top++] = k;
+        } else if (top > 0) {
+            top--;
+        }
+    }
+    return top > 0 ? stack[0] : -1;
+}
+
 void wx_maps_bury(const wx_maps *maps, const float view[3], float sheet, float *depth)
 {
     int K = wx_maps_layers(maps);
@@ -164,14 +203,21 @@ void wx_maps_bury(const wx_maps *maps, const float view[3], float sheet, float *
             keep[n] = false;
             n++;
         }
-        // What lies behind the last layer does not matter here: a face
-        // between two crossings that close around it is buried whatever
-        // follows (an outline of n + 1 layers: no tail), and a solid left open
-        // buries nothing (its crossings read as sheets: kept).
+        // A face between two crossings that close around it is buried
+        // whatever follows (an outline of n + 1 layers: no tail). A solid left
+        // open is a sheet while the stack has room (its crossings are kept);
+        // in a full stack it runs on behind the last layer, as the collider
+        // reads it (its tail), and every crossing after its entering face lies
+        // inside it: buried too, else a face the collider calls solid (the
+        // back of a facade box against the house's core) would be seen.
         uint8_t kind[WX_MAX_LAYERS + 1], from[WX_MAX_LAYERS + 1];
         int m = wx_layers_outline(entering, n, n + 1, kind, from);
         for (int k = 0; k < m; ++k) {
             keep[from[k]] = true;
+        }
+        int open = n == K ? outermost_open(entering, n) : -1;
+        for (int k = open + 1; open >= 0 && k < n; ++k) {
+            keep[k] = false;
         }
         // Faces in contact are sealed: a solid's face within a sheet's
         // thickness behind another solid's (a wall behind the glass pane
@@ -180,7 +226,8 @@ void wx_maps_bury(const wx_maps *maps, const float view[3], float sheet, float *
         for (int k = 1; k < m; ++k) {
             float gap = maps->depth[(size_t)from[k] * texels + t] -
                         maps->depth[(size_t)from[k - 1] * texels + t];
-            if (kind[k] != WX_OUTLINE_ENTER || !(gap < sheet)) {
+            bool enters = kind[k] == WX_OUTLINE_ENTER || (int)from[k] == open;
+            if (!enters || !(gap < sheet)) {
                 continue;
             }
             if (kind[k - 1] == WX_OUTLINE_LEAVE) {
