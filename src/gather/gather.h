@@ -56,6 +56,10 @@ typedef struct wx_gather_view {
     /// A layer of a layered camera (model/maps.h `outward`): its normals point
     /// out of the solid, so ownership reads them (model/ownership.h).
     bool outward;
+    /// A layer view's texels' other crossings, as baked (model/maps.h
+    /// crossing_depth...): a point nearer one of those is not this view's.
+    const float *crossing_depth, *crossing_normal;
+    int crossing_layers, crossing_layer;
 } wx_gather_view;
 
 /// The share of each texel's surface every input camera owns

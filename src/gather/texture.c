@@ -546,6 +546,8 @@ typedef struct view_sampler {
     const float *depth, *normal;
     float ray[3];
     float tol_world;
+    const float *crossing_depth, *crossing_normal; // a layer view's (gather.h)
+    int crossing_layers, crossing_layer;
 } view_sampler;
 
 typedef struct sample_job {
@@ -587,7 +589,10 @@ static bool sample_view(const sample_job *job, int v, const double p[3], const f
         float agree = wx_visible_agreement(s->depth[t], &s->normal[3 * t], s->ray, s->tol_world,
                                            WX_GATHER_TOL_MIN_COS, dp, n, &cos_view);
         float w = weights[k] * agree;
-        if (!(w > 0.0f)) {
+        if (!(w > 0.0f) ||
+            wx_crossing_nearer(s->crossing_depth, s->crossing_normal, s->crossing_layers,
+                               s->crossing_layer, (size_t)s->width * (size_t)s->height, t, dp,
+                               n)) {
             continue;
         }
         den += w;
@@ -665,6 +670,10 @@ static bool prepare_view(const wx_gather_view *view, view_sampler *s)
     s->height = view->height;
     s->depth = view->depth;
     s->normal = view->normal;
+    s->crossing_depth = view->crossing_depth;
+    s->crossing_normal = view->crossing_normal;
+    s->crossing_layers = view->crossing_layers;
+    s->crossing_layer = view->crossing_layer;
     return true;
 }
 

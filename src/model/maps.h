@@ -58,6 +58,12 @@ typedef struct wx_maps {
     /// the gather divides by. Computed in memory once the maps are read
     /// (pipeline/load.c), never written; NULL until then.
     float *owned;   ///< width*height
+    /// A layer view of a layered camera (wx_maps_layer_view): the camera's
+    /// depth and normal planes of every layer as baked (before wx_maps_bury),
+    /// borrowed, and which of them this view is, so a point is told from the
+    /// other crossings of its texel (wx_crossing_nearer). NULL otherwise.
+    const float *crossing_depth, *crossing_normal;
+    int crossing_layers, crossing_layer;
     /// The dirt map file's header attributes (camera matrices, name), kept so
     /// that the simulated dirt map is written with them without reading the
     /// file again.
@@ -128,6 +134,15 @@ int wx_layers_outline(const bool *entering, int n, int K, uint8_t *kind, uint8_t
 /// underside on the ground; a solid's face that close behind a pane facing
 /// the camera) made +inf, so that no view sees them: nothing can reach them. `view` is the camera's unit
 /// viewing direction. One layer: a copy.
+/// Whether a point at depth dp of surface normal n, which layer `layer` of
+/// texel t holds within its tolerance, lies strictly nearer another crossing
+/// of that texel whose normal is on the same side as n (depth and normal:
+/// `layers` planes of `texels`, as baked): then it is that crossing's surface
+/// (the wall 1 mm behind a pane, not the pane), and the layer does not hold
+/// it. False without crossings.
+bool wx_crossing_nearer(const float *depth, const float *normal, int layers, int layer,
+                        size_t texels, size_t t, float dp, const float n[3]);
+
 void wx_maps_bury(const wx_maps *maps, const float view[3], float sheet, float *depth);
 
 /// The file channel of `channel` in layer `layer` (docs/design.md section 14):

@@ -91,6 +91,16 @@ static bool rules_grow(const wx_rule *rules, int count)
     return false;
 }
 
+bool wx_scene_has_layers(const wx_scene *scene)
+{
+    for (int c = 0; c < scene->camera_count; ++c) {
+        if (!scene->cameras[c].is_output && scene->cameras[c].layers > 1) {
+            return true;
+        }
+    }
+    return false;
+}
+
 bool wx_scene_has_grow(const wx_scene *scene)
 {
     if (rules_grow(scene->rules, scene->rule_count)) {

@@ -359,6 +359,9 @@ bool wx_scene_has_surface_rules(const wx_scene *scene);
 /// True when some rule (global or per surface) grows a substance.
 bool wx_scene_has_grow(const wx_scene *scene);
 
+/// Whether an input camera holds more than one layer (docs/design.md section 14).
+bool wx_scene_has_layers(const wx_scene *scene);
+
 /// Total number of <Surface>s over all meshes; surface k of mesh m has the
 /// global index wx_scene_surface_base(scene, m) + k.
 int wx_scene_surface_count(const wx_scene *scene);

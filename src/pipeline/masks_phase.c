@@ -33,10 +33,16 @@ wx_result wx_mask_context_init(const wx_scene *scene, const wx_maps *in_maps, bo
                                wx_mask_context *ctx, wx_error *err)
 {
     memset(ctx, 0, sizeof *ctx);
-    if (scene->mask_count == 0) {
+    const int n = scene->input_count;
+    // Without masks the collider still tells, with layers, which faces the
+    // layers hold are enclosed (the TextureMap's seen: wx_masks_unsee_enclosed).
+    bool layered = false;
+    for (int k = 0; k < n; ++k) {
+        layered = layered || wx_maps_layers(&in_maps[k]) > 1;
+    }
+    if (scene->mask_count == 0 && !layered) {
         return WX_OK;
     }
-    const int n = scene->input_count;
     wx_camera *cams = calloc((size_t)n + 1, sizeof *cams);
     wx_maps *maps = calloc((size_t)n + 1, sizeof *maps);
     size_t largest = 0;

@@ -227,11 +227,13 @@ void wx_memory_estimate_geometry(const wx_scene *scene, unsigned phases,
     if (scene->mask_count > 0) {
         gather_out += WX_PLANE_BYTES_PER_TEXEL * scene->mask_count + 25.0;
     }
+    // With layers a TextureMap's gather builds that collider too (the faces it
+    // encloses are not seen: wx_masks_unsee_enclosed).
+    bool textures = scene->texture_count > 0 && (phases & (WX_PHASE_SIMULATE | WX_PHASE_GATHER));
     const double collider =
-        scene->mask_count > 0
+        scene->mask_count > 0 || (textures && wx_scene_has_layers(scene))
             ? WX_MASK_COLLIDER_BYTES_PER_TEXEL * input_texels + 8.0 * largest_input
             : 0.0;
-    bool textures = scene->texture_count > 0 && (phases & (WX_PHASE_SIMULATE | WX_PHASE_GATHER));
     bool texture_frames = false;
     for (int t = 0; textures && t < scene->texture_count; ++t) {
         const wx_texture_map *tm = &scene->textures[t];

@@ -404,7 +404,8 @@ static wx_result write_texture(const wx_scene *scene, const wx_run_def *opts,
     const size_t texels = (size_t)def->width * (size_t)def->height;
     double *position = NULL;
     float *normal = NULL;
-    if (r == WX_OK && scene->mask_count > 0) {
+    const bool enclosing = masks != NULL && masks->ready;
+    if (r == WX_OK && (scene->mask_count > 0 || enclosing)) {
         position = calloc(3 * texels, sizeof *position);
         normal = calloc(3 * texels, sizeof *normal);
         if (position == NULL || normal == NULL) {
@@ -423,6 +424,20 @@ static wx_result write_texture(const wx_scene *scene, const wx_run_def *opts,
                               .position = position,
                               .normal = normal };
         r = wx_texture_sample(&td, image->channels, image->channels[channels - 1], NULL, err);
+    }
+    // With layers, faces the collider encloses are not seen (nor their values).
+    if (r == WX_OK && enclosing) {
+        float *seen = image->channels[channels - 1];
+        wx_mask_points points = { .width = ras->width,
+                                  .height = ras->height,
+                                  .position = position,
+                                  .normal = normal };
+        wx_masks_unsee_enclosed(&masks->collider, &points, seen, opts->threads);
+        for (size_t i = 0; i < texels; ++i) {
+            for (int c = 0; c + 1 < channels && !(seen[i] > 0.0f); ++c) {
+                image->channels[c][i] = 0.0f;
+            }
+        }
     }
     // The derived masks at the texels whose point is seen, then the padding of
     // every channel.
@@ -558,8 +573,10 @@ int64_t wx_texture_bytes(const wx_scene *scene, const wx_texture_map *t, int64_t
     // channels and the preview's alpha; the compressed chunks written (at most
     // the image again); every channel but seen on every input camera, and the
     // gather's planes for one of them (the adaptive pass's 14 floats a texel).
-    // The derived masks' points: a double position, a normal and a flag.
-    const int64_t points = scene->mask_count > 0 ? texels * (24 + 12 + 1) : 0;
+    // The derived masks' points (and with layers the enclosed faces' test's):
+    // a double position, a normal and a flag.
+    const int64_t points =
+        scene->mask_count > 0 || wx_scene_has_layers(scene) ? texels * (24 + 12 + 1) : 0;
     return points + texels * (4 + 4 + 1) + texels * 4 * (channels + 1) + texels * 4 * channels +
            camera_texels * 4 * (channels - 1) + camera_texels / (scene->input_count > 0 ?
                                                                  scene->input_count : 1) * 4 * 14;

@@ -204,6 +204,70 @@ static double ray_start(const job *jb, const double p[3], const float n[3], cons
     return -1.0;
 }
 
+static float finest_texel(const wx_collider *collider)
+{
+    float finest = INFINITY;
+    for (int c = 0; collider != NULL && c < collider->camera_count; ++c) {
+        finest = fminf(finest, collider->cameras[c].texel_ws);
+    }
+    return finest;
+}
+
+typedef struct enclosed_job {
+    const wx_collider *collider;
+    const double *position;
+    const float *normal;
+    float *seen;
+    int width;
+    double offset;
+} enclosed_job;
+
+static void enclosed_rows(int64_t begin, int64_t end, int worker, void *context)
+{
+    (void)worker;
+    const enclosed_job *ej = context;
+    for (int64_t j = begin; j < end; ++j) {
+        for (int i = 0; i < ej->width; ++i) {
+            size_t t = (size_t)j * (size_t)ej->width + (size_t)i;
+            if (!(ej->seen[t] > 0.5f)) {
+                continue;
+            }
+            const double *p = &ej->position[3 * t];
+            const float *n = &ej->normal[3 * t];
+            bool inside = true;
+            for (int tries = 0; tries < 4 && inside; ++tries) {
+                double h = ej->offset * (double)(1 << tries);
+                float f[3] = { (float)(p[0] + n[0] * h), (float)(p[1] + n[1] * h),
+                               (float)(p[2] + n[2] * h) };
+                inside = wx_collider_point_collides(ej->collider, f);
+            }
+            if (inside) {
+                ej->seen[t] = 0.0f;
+            }
+        }
+    }
+}
+
+void wx_masks_unsee_enclosed(const wx_collider *collider, const wx_mask_points *points,
+                             float *seen, int threads)
+{
+    bool layered = false;
+    for (int c = 0; collider != NULL && c < collider->camera_count; ++c) {
+        layered = layered || collider->cameras[c].layers > 1;
+    }
+    float finest = finest_texel(collider);
+    if (!layered || !isfinite(finest)) {
+        return;
+    }
+    enclosed_job ej = { .collider = collider,
+                        .position = points->position,
+                        .normal = points->normal,
+                        .seen = seen,
+                        .width = points->width,
+                        .offset = finest / 8.0 };
+    wx_parallel_for(threads, points->height, 16, enclosed_rows, &ej);
+}
+
 // Distance from p along dir to the exit of the solver's bounding box (0 when p
 // lies outside it).
 static double box_exit(const wx_scene *scene, const double p[3], const double dir[3])
@@ -372,10 +436,9 @@ wx_result wx_masks_compute(const wx_masks_def *def, float *const *out, wx_error 
     // Rays start within one of the collider's finest texels of the surface
     // (ray_start: an eighth of it up first); their first segment is four of
     // its coarsest texels (the target's, when they are coarser) long.
-    float texel = def->points.texel, finest = INFINITY;
+    float texel = def->points.texel, finest = finest_texel(def->collider);
     for (int c = 0; def->collider != NULL && c < def->collider->camera_count; ++c) {
         texel = fmaxf(texel, def->collider->cameras[c].texel_ws);
-        finest = fminf(finest, def->collider->cameras[c].texel_ws);
     }
     jb.offset = (isfinite(finest) ? finest : def->points.texel) / 8.0f;
     jb.first = 4.0 * texel;

@@ -63,6 +63,16 @@ wx_result wx_masks_compute(const wx_masks_def *def, float *const *out, wx_error 
 /// substance): its values at a set of points are the same in every frame.
 bool wx_mask_is_geometric(const wx_scene *scene, int m);
 
+/// Clears seen[t] (width*height of `points`, 1 where a layer of some camera
+/// holds the point) where the surface is enclosed: the collider's point rule
+/// puts every start a ray from it would take along its normal (1/8, 1/4, 1/2
+/// and 1 of the collider's finest texel up) inside a solid, as for a face
+/// buried in another solid or sealed against one, which no particle or ray
+/// reaches (docs/texture.md, "seen"). Reads points' position and normal. Only
+/// with a layered camera: one layer records no face behind another.
+void wx_masks_unsee_enclosed(const wx_collider *collider, const wx_mask_points *points,
+                             float *seen, int threads);
+
 /// Riihiaho's sigmoid (his eq. 3.7): (x - o) / (2 sqrt(1/s + (x - o)^2)) + 1/2
 /// for steepness s > 0; x itself for s = 0.
 double wx_sigmoid(double x, double offset, double steepness);

@@ -12,7 +12,9 @@ TextureMap's `ao` channel with the bake over the texels both have (ours `seen`
 > 0 and covered by the bake) and checks docs/masks.md's figures: Pearson r at
 least 0.97, mean absolute difference at most 0.012, our `seen` on at least 90%
 of the texels Blender covers, and our whole run at most half of Blender's bake
-process (wall clock). Prints the numbers and ends with "N passed, M failed".
+process (wall clock). r and the mean difference are checked (counted); the
+coverage and the time, still open, are printed as met or unmet and not
+counted. Prints the numbers and ends with "N passed, M failed".
 
 Only Blender's Python (Debian's Blender has no numpy): the EXR channels are
 split into files of their own with `weathering split` and read with
@@ -220,8 +222,8 @@ def main(build, obj_path, out):
     # marked "unmet", neither passed nor failed, until the work lands.
     report(coverage >= MIN_COVERAGE, "we see %.1f%% of the texels Blender covers (at least %g%%)"
            % (100.0 * coverage, 100.0 * MIN_COVERAGE))
-    report(r >= MIN_R, "r %.4f over the texels both have (at least %g)" % (r, MIN_R))
-    report(mad <= MAX_MAD, "mean absolute difference %.4f (at most %g; mean difference %+.4f)"
+    check(r >= MIN_R, "r %.4f over the texels both have (at least %g)" % (r, MIN_R))
+    check(mad <= MAX_MAD, "mean absolute difference %.4f (at most %g; mean difference %+.4f)"
            % (mad, MAX_MAD, bias))
     report(ours <= MAX_TIME_RATIO * theirs,
            "our whole run %.1f s, Blender's bake process %.1f s: %.2f of it (at most %g)"
