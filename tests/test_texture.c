@@ -1381,11 +1381,9 @@ TEST(texture_sees_and_wets_the_floor_under_a_roof_through_layers)
 // while the pane and the wall's face around it are seen. One layer marks the
 // wall seen through the pane (the "hidden face marked seen"; printed).
 //
-// Known defect, so skipped rather than failed: the pane's own layer (layer 0)
-// still vouches for the wall's points 1 mm behind it, which lie within its
-// depth tolerance (1.5 texels) with the same normal (gather/visibility.h);
-// burying only blanks the wall's own layer. The skip turns into a pass when
-// the texture's sampling stops seeing a face through the layer in front of it.
+// The pane's own layer (layer 0) holds the wall's points 1 mm behind it within
+// its depth tolerance (1.5 texels) with the same normal; it must not vouch for
+// them (wx_crossing_nearer: the wall's crossing, buried, is nearer).
 TEST(texture_does_not_see_a_wall_through_the_pane_touching_it)
 {
     const wx_image *one = layered_texture(1), *four = layered_texture(4);
@@ -1406,9 +1404,6 @@ TEST(texture_does_not_see_a_wall_through_the_pane_touching_it)
     ENSURE(behind4.texels > 50 && left4.texels > 50 && right4.texels > 50);
     ENSURE(pane1.seen == pane1.texels && pane4.seen == pane4.texels);
     ENSURE(left4.seen == left4.texels && right4.seen == right4.texels);
-    if (behind4.seen > 0) {
-        SKIP("known defect: the pane's layer sees the wall 1 mm behind it (see the comment)");
-    }
     ENSURE(behind4.seen == 0);
 }
 
