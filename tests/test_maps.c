@@ -214,6 +214,78 @@ TEST(a_bad_file_frees_the_maps_already_loaded)
     ENSURE(ensure_contains(err.message, "none.exr: cannot open"));
 }
 
+// One texel of a camera looking along -z with `n` crossings (K = 4 layers) at
+// depths d[], entering (normal +z, towards the camera) where enter[] says.
+static void one_texel(wx_maps *m, float *depth, float *normal, const float *d, const bool *enter,
+                      int n)
+{
+    memset(m, 0, sizeof *m);
+    m->width = 1;
+    m->height = 1;
+    m->layers = 4;
+    m->outward = true;
+    m->depth = depth;
+    m->normal = normal;
+    for (int k = 0; k < 4; ++k) {
+        depth[k] = k < n ? d[k] : INFINITY;
+        normal[3 * k] = normal[3 * k + 1] = 0.0f;
+        normal[3 * k + 2] = k < n ? (enter[k] ? 1.0f : -1.0f) : 0.0f;
+    }
+}
+
+// wx_maps_bury (docs/texture.md, `seen`): a full stack whose outermost solid
+// stays open buries every crossing after its entering face, as the collider's
+// tail reads it; closed solids keep their outline, contact faces are sealed;
+// with room left an open crossing is a sheet and kept.
+TEST(bury_reads_a_full_stack_as_the_collider_does)
+{
+    const float view[3] = { 0.0f, 0.0f, -1.0f };
+    float depth[4], normal[12], out[4];
+    wx_maps m;
+    // A facade box entered at 30.6, a trim inside it from 30.799, the box's
+    // back on the core's front at 30.8: the core runs on past the fourth layer.
+    const float d1[4] = { 30.6f, 30.799f, 30.8f, 30.8f };
+    const bool e1[4] = { true, true, false, true };
+    one_texel(&m, depth, normal, d1, e1, 4);
+    wx_maps_bury(&m, view, 0.004f, out);
+    ENSURE(out[0] == 30.6f && isinf(out[1]) && isinf(out[2]) && isinf(out[3]));
+    // Two closed solids touching at 30.8: the contact pair is sealed, the
+    // outline's faces stay.
+    const float d2[4] = { 30.6f, 30.8f, 30.8f, 36.6f };
+    const bool e2[4] = { true, false, true, false };
+    one_texel(&m, depth, normal, d2, e2, 4);
+    wx_maps_bury(&m, view, 0.004f, out);
+    ENSURE(out[0] == 30.6f && isinf(out[1]) && isinf(out[2]) && out[3] == 36.6f);
+    // Room left: an entering crossing nothing closes is a sheet, kept.
+    const float d3[3] = { 10.0f, 11.0f, 12.0f };
+    const bool e3[3] = { true, false, true };
+    one_texel(&m, depth, normal, d3, e3, 3);
+    wx_maps_bury(&m, view, 0.004f, out);
+    ENSURE(out[0] == 10.0f && out[1] == 11.0f && out[2] == 12.0f && isinf(out[3]));
+}
+
+// wx_crossing_nearer: a pane at 10 m and the wall 1 mm behind it, both facing
+// the camera: the wall's point is not the pane's layer's, whatever the pane's
+// tolerance; a point facing the other way ignores the wall's crossing.
+TEST(a_layer_does_not_hold_a_point_nearer_another_crossing)
+{
+    float depth[4], normal[12];
+    wx_maps m;
+    const float d[2] = { 10.0f, 10.001f };
+    const bool e[2] = { true, true };
+    one_texel(&m, depth, normal, d, e, 2);
+    const float toward[3] = { 0.0f, 0.0f, 1.0f }, away[3] = { 0.0f, 0.0f, -1.0f };
+    ENSURE(wx_crossing_nearer(depth, normal, 4, 0, 1, 0, 10.001f, toward));
+    ENSURE(!wx_crossing_nearer(depth, normal, 4, 1, 1, 0, 10.001f, toward));
+    ENSURE(!wx_crossing_nearer(depth, normal, 4, 0, 1, 0, 10.0f, toward));
+    ENSURE(!wx_crossing_nearer(depth, normal, 4, 0, 1, 0, 10.001f, away));
+    ENSURE(!wx_crossing_nearer(NULL, NULL, 1, 0, 1, 0, 10.001f, toward));
+    // A layer view made by wx_maps_layer_view carries the crossings.
+    wx_maps view;
+    wx_maps_layer_view(&m, 1, &view);
+    ENSURE(view.crossing_depth == depth && view.crossing_layers == 4 && view.crossing_layer == 1);
+}
+
 int main(void)
 {
     RUN(four_maps_load_in_simulation_layout);
@@ -222,5 +294,7 @@ int main(void)
     RUN(mismatched_sizes_name_both_files);
     RUN(missing_channels_are_errors);
     RUN(a_bad_file_frees_the_maps_already_loaded);
+    RUN(bury_reads_a_full_stack_as_the_collider_does);
+    RUN(a_layer_does_not_hold_a_point_nearer_another_crossing);
     return ensure_summary();
 }
