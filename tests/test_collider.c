@@ -3,6 +3,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "model/ownership.h"
 #include "sim/collider.h"
 #include "ensure.h"
 #include "sim/particles.h"
@@ -751,6 +752,68 @@ TEST(one_layer_is_todays_collider)
     ENSURE(hits > 20);
 }
 
+// A block seen by two cameras facing each other, both with layers: each sees
+// its near face from outside (layer 0) and the far face through the block
+// (layer 1), equally head-on. A drop flying into the front face is recorded by
+// the camera outside it (ownership's tie rule), though the back camera is
+// listed first: else a surface's deposits follow where its layer index
+// changes, which turning the model moves (docs/physics.md, "Layered maps").
+TEST(facing_cameras_tie_to_the_one_outside_the_surface)
+{
+    lay_world world = { 0 };
+    fx_box(&world.solids, -1, 0, -0.5f, 1, 1, 0.5f);
+    wx_camera cams[2] = { fx_camera(0, 0, -10, 0, 0, 0, 0, 1, 0, 6.4f, 64),
+                          fx_camera(0, 0, 10, 0, 0, 0, 0, 1, 0, 6.4f, 64) };
+    wx_maps maps[2];
+    wx_collider col;
+    ENSURE(build_layers(&col, cams, maps, 2, &world, 4));
+    float f0[3] = { 0.13f, 0.47f, 2.0f }, f1[3] = { 0.13f, 0.47f, 0.0f };
+    float b0[3] = { -0.21f, 0.53f, -2.0f }, b1[3] = { -0.21f, 0.53f, 0.0f };
+    wx_hit front, back;
+    bool hf = wx_collider_sweep(&col, f0, f1, &front);
+    bool hb = wx_collider_sweep(&col, b0, b1, &back);
+    release(&col, maps, 2);
+    ENSURE(hf && hb);
+    ENSURE_NEAR(front.point[2], 0.5, 1e-5);
+    ENSURE(front.camera == 1 && front.layer == 0);
+    ENSURE_NEAR(back.point[2], -0.5, 1e-5);
+    ENSURE(back.camera == 0 && back.layer == 0);
+}
+
+// The same block: its front face is owned by the front camera's first layer,
+// not by the back camera's second, which is listed first (model/ownership.h).
+TEST(ownership_ties_go_to_the_view_outside_the_surface)
+{
+    lay_world world = { 0 };
+    fx_box(&world.solids, -1, 0, -0.5f, 1, 1, 0.5f);
+    wx_camera cams[2] = { fx_camera(0, 0, -10, 0, 0, 0, 0, 1, 0, 6.4f, 64),
+                          fx_camera(0, 0, 10, 0, 0, 0, 0, 1, 0, 6.4f, 64) };
+    wx_maps maps[2];
+    for (int c = 0; c < 2; ++c) {
+        render_layers(&cams[c], &world, 4, &maps[c]);
+    }
+    wx_owner_view views[4];
+    size_t texels = (size_t)maps[0].width * (size_t)maps[0].height;
+    for (int c = 0; c < 2; ++c) {
+        for (int k = 0; k < 2; ++k) {
+            wx_owner_view *v = &views[2 * c + k];
+            wx_owner_view_init(v, &cams[c], maps[c].depth + (size_t)k * texels, maps[c].width,
+                               maps[c].height);
+            v->normal = maps[c].normal + 3 * (size_t)k * texels;
+        }
+    }
+    const double on_front[3] = { 0.13, 0.47, 0.5 }, on_back[3] = { -0.21, 0.53, -0.5 };
+    const float out_front[3] = { 0, 0, 1 }, out_back[3] = { 0, 0, -1 };
+    int owner_front = wx_owner_of(views, 4, on_front, out_front, -1);
+    int owner_back = wx_owner_of(views, 4, on_back, out_back, -1);
+    bool back_sees_front = wx_owner_sees(&views[1], on_front, out_front);
+    wx_maps_free(&maps[0]);
+    wx_maps_free(&maps[1]);
+    ENSURE(back_sees_front); // the tie is real: the back camera's layer 1 holds it
+    ENSURE(owner_front == 2);
+    ENSURE(owner_back == 0);
+}
+
 TEST(projective_cameras_are_refused)
 {
     fx_world world = { 0 };
@@ -786,5 +849,7 @@ int main(void)
     RUN(pane_is_a_thin_sheet_hit_from_either_side);
     RUN(layered_sweep_agrees_with_the_point_rule);
     RUN(one_layer_is_todays_collider);
+    RUN(facing_cameras_tie_to_the_one_outside_the_surface);
+    RUN(ownership_ties_go_to_the_view_outside_the_surface);
     return ensure_summary();
 }

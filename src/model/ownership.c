@@ -166,10 +166,27 @@ int wx_owner_of(const wx_owner_view *views, int count, const double p[3], const 
 {
     int best = -1;
     float best_cos = -1.0f;
+    bool best_outside = true;
     projection cache = { NULL, { 0.0, 0.0, 0.0 } };
     for (int k = 0; k < count; ++k) {
         const wx_owner_view *v = &views[k];
-        float c = fabsf(n[0] * v->view[0] + n[1] * v->view[1] + n[2] * v->view[2]);
+        float along = n[0] * v->view[0] + n[1] * v->view[1] + n[2] * v->view[2];
+        float c = fabsf(along);
+        // Two cameras facing each other see every surface equally head-on;
+        // with layers one sees it from outside (its normal towards the
+        // camera), the other through the solid, in a layer whose index
+        // changes wherever another part crosses its rays: the tie goes to the
+        // one outside (the collider's pick_camera agrees).
+        bool outside = v->normal == NULL || along < 0.0f;
+        if (best >= 0 && outside != best_outside && c >= best_cos - TIE_COSINE &&
+            c <= best_cos + TIE_COSINE) {
+            if (outside && (k == known || sees_cached(v, p, n, &cache))) {
+                best = k;
+                best_cos = c;
+                best_outside = true;
+            }
+            continue;
+        }
         if (!(c > best_cos + TIE_COSINE)) {
             // Ties go to the view listed first, but between two layers of one
             // camera that both see p (a pane 1 mm in front of a wall: within
@@ -185,6 +202,7 @@ int wx_owner_of(const wx_owner_view *views, int count, const double p[3], const 
         if (k == known || sees_cached(v, p, n, &cache)) {
             best = k;
             best_cos = c;
+            best_outside = outside;
         }
     }
     return best;

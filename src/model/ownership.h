@@ -48,7 +48,10 @@ void wx_owner_view_init(wx_owner_view *view, const wx_camera *camera, const floa
 bool wx_owner_sees(const wx_owner_view *view, const double p[3], const float n[3]);
 
 /// The view that owns p: of the views that see it, the one that sees it most
-/// head-on (largest |n . view|), ties within 1e-4 to the one listed first; -1
+/// head-on (largest |n . view|), ties within 1e-4 to a view outside the
+/// surface (a layer whose camera n faces, n . view < 0, over one that sees it
+/// through the solid: two cameras facing each other always tie), then to the
+/// one listed first; -1
 /// when no view sees it. `known` (-1: none) is a view known to see p (its
 /// test is skipped).
 int wx_owner_of(const wx_owner_view *views, int count, const double p[3], const float n[3],

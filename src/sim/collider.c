@@ -951,10 +951,15 @@ static double march_entry(const wx_collider *collider, march *m, double s)
 // the hit texel's own depth), the most head-on one (largest |N.view|,
 // the camera `bake` gives initial dirt to) gives the hit; without any, the
 // smallest d - depth. -1 when no camera sees a surface at s.
+// Ties of |N.view| within this go to the camera outside the surface
+// (model/ownership.c's TIE_COSINE).
+#define PICK_TIE_COSINE 1e-4
+
 static int pick_camera(const wx_collider *collider, const march *m, double s)
 {
     int best = -1, closest = -1;
     double best_cos = -1.0, closest_f = INFINITY;
+    bool best_facing = true;
     for (int c = 0; c < collider->camera_count; ++c) {
         if (!march_inside(&m[c], s) || !m[c].surface) {
             continue;
@@ -995,9 +1000,21 @@ static int pick_camera(const wx_collider *collider, const march *m, double s)
         // and a point behind it (on the ground between them) is not seen there.
         double d = m[c].D0 + s * m[c].dD;
         double off = fabs(d - ((double)cam->depth[texel] + face_depth)) * bl;
-        if (f * bl <= precision && off <= precision && cos_view > best_cos) {
+        // Two cameras facing each other see every surface equally head-on;
+        // with layers one sees it from outside, the other through the solid,
+        // in a layer whose index changes wherever another part crosses its
+        // rays. The one outside takes the tie (as ownership does), so a
+        // surface's deposits do not follow those patches.
+        bool facing = cam->layers <= 1 ||
+                      n[0] * cam->back[0] + n[1] * cam->back[1] + n[2] * cam->back[2] > 0.0f;
+        bool better = cos_view > best_cos;
+        if (facing != best_facing && fabs(cos_view - best_cos) <= PICK_TIE_COSINE) {
+            better = facing;
+        }
+        if (f * bl <= precision && off <= precision && better) {
             best = c;
             best_cos = cos_view;
+            best_facing = facing;
         }
     }
     return best >= 0 ? best : closest;
