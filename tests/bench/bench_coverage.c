@@ -23,6 +23,11 @@
 //   at all). The import turns closed parts outwards, so inside is > 0; any
 //   non-zero sum counts as inside (an open part gives sums that depend on the
 //   direction: the vote settles those, and they are counted as "ambiguous").
+//   The texel's point lies on the smooth (Phong) surface the bake draws
+//   (wx_uv_raster_point), up to a few texels off the flat triangle where the
+//   mesh curves: it is put back on the triangle (projected onto its plane)
+//   and steps off along the triangle's normal, else on Spot every concave
+//   texel read as inside (7% of its area).
 // - Each texel weighs the world area it stands for: its triangle's world area
 //   over its UV area, times one texel's UV area.
 //
@@ -30,7 +35,14 @@
 // of it that is reachable, the share of the reachable area that is `seen`
 // (the figure of item 3: >= 0.90 on the default house, >= 0.95 on the other
 // shipped models) and the share of the seen area that is unreachable (should
-// be about 0). Figures go to $WX_BENCH_CSV (bench_report.h); exit status 1
+// be about 0). Also that share with the mesh's bottom left out (reachable
+// faces turned down, -y against init's gravity, within 10 eps of the mesh's
+// lowest point: the house's ground slab underside, which no generated camera
+// looks at and rain does not reach), and the area reachable but unseen, and
+// seen but unreachable, by the face's outward axis.
+//
+// WX_BENCH_COVERAGE_REUSE=1 measures the runs the last call left in
+// $WX_BUILD/tmp/bench_coverage instead of running them again. Figures go to $WX_BENCH_CSV (bench_report.h); exit status 1
 // only on errors.
 #define _XOPEN_SOURCE 700 // realpath
 #include <dirent.h>
@@ -211,12 +223,29 @@ typedef struct tally {
 
 typedef struct coverage {
     tally covered, reachable, seen, seen_reachable, seen_unreachable;
+    /// The mesh's bottom: reachable texels on faces turned down (-y, against
+    /// init's gravity) at the mesh's lowest level, where no camera looks.
+    tally bottom, seen_bottom;
     int64_t ambiguous;   ///< texels whose three rays did not agree
     int64_t winding_neg; ///< texels with a negative sum on a majority of rays
     int64_t flipped;     ///< texels whose shading normal faces away from their triangle's winding
+    /// By the face's outward axis (+x, -x, +y, -y, +z, -z): the area reachable
+    /// but not seen, and seen but not reachable.
+    double unseen_by_axis[6], unreachable_by_axis[6];
     bool overflow;
     double seconds;
 } coverage;
+
+static const char *const AXES[6] = { "+x", "-x", "+y", "-y", "+z", "-z" };
+
+static int outward_axis(const double fn[3], double side)
+{
+    int best = 0;
+    for (int k = 1; k < 3; ++k) {
+        best = fabs(fn[k]) > fabs(fn[best]) ? k : best;
+    }
+    return 2 * best + (side * fn[best] < 0);
+}
 
 static void add(tally *t, double area)
 {
@@ -226,7 +255,7 @@ static void add(tally *t, double area)
 
 // Measures the texture file `file` of target `t` against `e`.
 static bool measure_file(const exact *e, const wx_texture_target *t, const wx_texture_file *file,
-                         const char *path, double eps, coverage *c)
+                         const char *path, double eps, double floor_y, coverage *c)
 {
     const wx_uv_raster *ras = &file->raster;
     const wx_mesh_data *mesh = &t->mesh;
@@ -321,6 +350,16 @@ static bool measure_file(const exact *e, const wx_texture_target *t, const wx_te
             add(&c->seen, area);
             add(reachable ? &c->seen_reachable : &c->seen_unreachable, area);
         }
+        if (reachable && outward_axis(fn, side) == 3 && p[1] < floor_y + 10 * eps) {
+            add(&c->bottom, area);
+            if (seen) {
+                add(&c->seen_bottom, area);
+            }
+        }
+        if (seen != reachable) {
+            double *by = seen ? c->unreachable_by_axis : c->unseen_by_axis;
+            by[outward_axis(fn, side)] += area;
+        }
     }
     free(ratio);
     wx_image_free(&image);
@@ -383,7 +422,7 @@ static bool measure(const char *out_dir, coverage *c)
                 snprintf(own, sizeof own, "%s", t->def->file);
             }
             ok = snprintf(path, sizeof path, "%s/%s", out_dir, own) < (int)sizeof path &&
-                 measure_file(&e, t, &t->files[f], path, eps, c);
+                 measure_file(&e, t, &t->files[f], path, eps, lo[1], c);
         }
     }
     exact_free(&e);
@@ -454,6 +493,18 @@ static bool one_mesh(const char *program, const char *dir, const char *mesh_path
            "winding: %lld%s\n",
            (long long)c.ambiguous, (long long)c.winding_neg, (long long)c.flipped,
            c.overflow ? "; SOME RAY CROSSED MORE THAN 4096 TRIANGLES" : "");
+    double above_a = share(c.seen_reachable.a - c.seen_bottom.a, c.reachable.a - c.bottom.a);
+    double above_n = share(c.seen_reachable.n - c.seen_bottom.n, c.reachable.n - c.bottom.n);
+    printf("    the mesh's bottom (turned down at its lowest level): %.4f of the reachable area, "
+           "%.4f of it seen; the rest seen %.4f by area, %.4f by texels\n",
+           share(c.bottom.a, c.reachable.a), share(c.seen_bottom.a, c.bottom.a), above_a, above_n);
+    printf("    reachable unseen / seen unreachable, by the face's outward axis (share of "
+           "the reachable / seen area):");
+    for (int k = 0; k < 6; ++k) {
+        printf(" %s %.4f/%.4f", AXES[k], share(c.unseen_by_axis[k], c.reachable.a),
+               share(c.unreachable_by_axis[k], c.seen.a));
+    }
+    printf("\n");
     fflush(stdout);
     const char *b = "coverage";
     bench_row(b, "covered area", c.covered.a, "mesh unit^2", NULL, false, "%s %d px", name, px);
@@ -466,6 +517,12 @@ static bool one_mesh(const char *program, const char *dir, const char *mesh_path
               seen_reach_a >= goal, "%s %d px", name, px);
     bench_row(b, "seen share of reachable texels", seen_reach_n, "ratio", NULL, false, "%s %d px",
               name, px);
+    bench_row(b, "bottom share of reachable area", share(c.bottom.a, c.reachable.a), "ratio",
+              NULL, false, "%s %d px", name, px);
+    bench_row(b, "seen share of reachable area above the bottom", above_a, "ratio", NULL, false,
+              "%s %d px", name, px);
+    bench_row(b, "seen share of reachable texels above the bottom", above_n, "ratio", NULL,
+              false, "%s %d px", name, px);
     bench_row(b, "seen but unreachable share of seen area", share(c.seen_unreachable.a, c.seen.a),
               "ratio", NULL, false, "%s %d px", name, px);
     bench_row(b, "seen but unreachable share of seen texels",
