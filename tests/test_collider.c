@@ -758,12 +758,20 @@ TEST(one_layer_is_todays_collider)
 // the camera outside it (ownership's tie rule), though the back camera is
 // listed first: else a surface's deposits follow where its layer index
 // changes, which turning the model moves (docs/physics.md, "Layered maps").
+// The block (x -1..1, y 0..1, z -0.5..0.5) and its back and front cameras.
+static void facing_block(lay_world *world, wx_camera cams[2])
+{
+    memset(world, 0, sizeof *world);
+    fx_box(&world->solids, -1, 0, -0.5f, 1, 1, 0.5f);
+    cams[0] = fx_camera(0, 0, -10, 0, 0, 0, 0, 1, 0, 6.4f, 64);
+    cams[1] = fx_camera(0, 0, 10, 0, 0, 0, 0, 1, 0, 6.4f, 64);
+}
+
 TEST(facing_cameras_tie_to_the_one_outside_the_surface)
 {
-    lay_world world = { 0 };
-    fx_box(&world.solids, -1, 0, -0.5f, 1, 1, 0.5f);
-    wx_camera cams[2] = { fx_camera(0, 0, -10, 0, 0, 0, 0, 1, 0, 6.4f, 64),
-                          fx_camera(0, 0, 10, 0, 0, 0, 0, 1, 0, 6.4f, 64) };
+    lay_world world;
+    wx_camera cams[2];
+    facing_block(&world, cams);
     wx_maps maps[2];
     wx_collider col;
     ENSURE(build_layers(&col, cams, maps, 2, &world, 4));
@@ -784,10 +792,9 @@ TEST(facing_cameras_tie_to_the_one_outside_the_surface)
 // not by the back camera's second, which is listed first (model/ownership.h).
 TEST(ownership_ties_go_to_the_view_outside_the_surface)
 {
-    lay_world world = { 0 };
-    fx_box(&world.solids, -1, 0, -0.5f, 1, 1, 0.5f);
-    wx_camera cams[2] = { fx_camera(0, 0, -10, 0, 0, 0, 0, 1, 0, 6.4f, 64),
-                          fx_camera(0, 0, 10, 0, 0, 0, 0, 1, 0, 6.4f, 64) };
+    lay_world world;
+    wx_camera cams[2];
+    facing_block(&world, cams);
     wx_maps maps[2];
     for (int c = 0; c < 2; ++c) {
         render_layers(&cams[c], &world, 4, &maps[c]);
