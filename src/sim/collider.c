@@ -391,6 +391,19 @@ static bool cell_surface(const wx_collider *collider, const wx_collider_camera *
     return true;
 }
 
+// Whether crossing k at index `at` (planes of one layer) lies strictly between
+// crossings k-1 and k+1 of the texel at index `of` (k-1 none for k = 0, k+1
+// none past the last layer or an empty one).
+static inline bool crossing_between(const wx_collider_camera *cam, int k, size_t at, size_t of)
+{
+    size_t layer = (size_t)cam->width * (size_t)cam->height;
+    double d = cam->depth[at];
+    if (k > 0 && !(d > cam->depth[of - layer])) {
+        return false;
+    }
+    return k + 1 >= cam->layers || !(d >= cam->depth[of + layer]);
+}
+
 // Layer k's depth over half-texel cell (hx, hy) of a camera with layers, whose
 // own texel holds crossing `own` with role `own_role`: the bilinear cell when
 // the four texels around hold layer k facing the same way (the silhouette rule
@@ -422,6 +435,20 @@ static void layer_cell(const wx_collider *collider, const wx_collider_camera *ca
                       (unsigned)(cam->role[rb + ib] ^ own_role);
     if (differ & WX_ROLE_FACING) {
         return;
+    }
+    // Nor across a jump from one surface to another that happen to be the
+    // k-th crossing of neighbouring texels (a handrail's front and the glass
+    // behind it, in the row where the handrail ends): each corner's crossing
+    // must lie between the own texel's crossings k-1 and k+1, and the own one
+    // between the corner's. Else the ramp between them is a thin solid slab
+    // sweeping through the free space between the two (drops stopped in mid
+    // air above a sill behind a balcony's handrail).
+    const size_t corners[4] = { ra + ia, ra + ib, rb + ia, rb + ib };
+    size_t at = plane + (size_t)(hy >> 1) * (size_t)W + (size_t)(hx >> 1);
+    for (int c = 0; c < 4; ++c) {
+        if (!crossing_between(cam, k, corners[c], at) || !crossing_between(cam, k, at, corners[c])) {
+            return;
+        }
     }
     bilinear_cell(cd, i0, j0, d00, d10, d01, d11);
 }

@@ -957,6 +957,11 @@ static bool rain_per_surface(const char *out, int n, int layers)
         wx_emitter_sample(em, w.scene.seed, wx_particle_id(0, (uint64_t)i), p, v);
         int64_t found[2] = { -1, -1 };
         bool done[2] = { false, false };
+        float exact_point[3] = { 0, 0, 0 };
+        wx_hit hit_last, ours_hit;
+        memset(&hit_last, 0, sizeof hit_last);
+        memset(&ours_hit, 0, sizeof ours_hit);
+        bool ours_kept = false;
         for (int step = 0; step < w.scene.steps && !(done[0] && done[1]); ++step) {
             for (int k = 0; k < 3; ++k) {
                 v[k] += dt * w.forces.gravity[k]; // mass 1; no wind, no turbulence
@@ -966,6 +971,7 @@ static bool rain_per_surface(const char *out, int n, int layers)
             float s;
             if (!done[0] && maps_hit(&w, p, q, &hit)) {
                 done[0] = true;
+                hit_last = hit;
                 float distance;
                 found[0] = triangle_at(&e, hit.point, texel, &distance);
                 maps_total++;
@@ -992,6 +998,13 @@ static bool rain_per_surface(const char *out, int n, int layers)
             if (!done[1] && exact_hit_triangle(&e, p, q, &s, &found[1])) {
                 done[1] = true;
                 exact_total++;
+                for (int k = 0; k < 3; ++k) {
+                    exact_point[k] = p[k] + s * (q[k] - p[k]);
+                }
+            }
+            if (done[0] && !ours_kept) {
+                ours_kept = true;
+                ours_hit = hit_last;
             }
             bool in_box = true;
             for (int k = 0; k < 3; ++k) {
@@ -1001,6 +1014,19 @@ static bool rain_per_surface(const char *out, int n, int layers)
                 break;
             }
             memcpy(p, q, sizeof p);
+        }
+        if (getenv("WX_BENCH_EMBREE_DEBUG") != NULL && found[1] >= 0 &&
+            strcmp(m.material_names[m.materials[found[1]]], "sill") == 0) {
+            float tn[3];
+            triangle_normal(&m, (uint32_t)found[1], tn);
+            bool ours_same = found[0] >= 0 && m.materials[found[0]] == m.materials[found[1]];
+            if (facing_of(tn) == 2 && !ours_same) {
+                fprintf(stderr, "sill top miss: exact (%.4f %.4f %.4f) ours cam %d layer %d (%.4f %.4f %.4f) n (%.2f %.2f %.2f) tri %s\n",
+                        exact_point[0], exact_point[1], exact_point[2], ours_hit.camera, ours_hit.layer,
+                        ours_hit.point[0], ours_hit.point[1], ours_hit.point[2], ours_hit.normal[0],
+                        ours_hit.normal[1], ours_hit.normal[2],
+                        found[0] >= 0 ? m.material_names[m.materials[found[0]]] : "none");
+            }
         }
         for (int side = 0; side < 2; ++side) {
             if (found[side] >= 0) {
