@@ -831,13 +831,12 @@ TEST(ownership_ties_go_to_the_view_outside_the_surface)
 TEST(layer_ramp_does_not_jump_from_a_handrail_to_the_wall_behind)
 {
     lay_world world = { 0 };
-    fx_box(&world.solids, -3, -1, -3, 3, 0, 3);             // floor
-    fx_box(&world.solids, -3, 0, -1, 3, 3.5f, 0);           // wall
-    fx_box(&world.solids, -2, 1.0f, 1.3f, 2, 1.12f, 1.4f);  // handrail
-    fx_box(&world.solids, -2, 2.0f, 0, 2, 2.1f, 1.5f);      // two slabs above
+    fx_box(&world.solids, -3, -1, -3, 3, 0, 3);            // floor
+    fx_box(&world.solids, -3, 0, -1, 3, 3.5f, 0);          // wall
+    fx_box(&world.solids, -2, 1.0f, 1.3f, 2, 1.12f, 1.4f); // handrail
+    fx_box(&world.solids, -2, 2.0f, 0, 2, 2.1f, 1.5f);     // two slabs above
     fx_box(&world.solids, -2, 3.0f, 0, 2, 3.1f, 1.5f);
-    wx_camera cams[2] = { fx_camera(0, 0, 10, 0, 0, 0, 0, 1, 0, 6.4f, 128),
-                          top_camera(6.4f, 128) };
+    wx_camera cams[2] = { fx_camera(0, 0, 10, 0, 0, 0, 0, 1, 0, 6.4f, 128), top_camera(6.4f, 128) };
     wx_maps maps[2];
     wx_collider col;
     ENSURE(build_layers(&col, cams, maps, 2, &world, 4));

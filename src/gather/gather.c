@@ -441,10 +441,16 @@ wx_gather_def wx_default_gather_def(void)
 
 wx_gather_view wx_gather_view_from_maps(const wx_camera *camera, const wx_maps *maps)
 {
-    wx_gather_view view = { .camera = camera, .width = maps->width, .height = maps->height,
-                            .depth = maps->depth, .normal = maps->normal, .dirt = maps->dirt,
-                            .initial = maps->initial_dirt, .hits = maps->hits,
-                            .owned = maps->owned, .outward = maps->outward,
+    wx_gather_view view = { .camera = camera,
+                            .width = maps->width,
+                            .height = maps->height,
+                            .depth = maps->depth,
+                            .normal = maps->normal,
+                            .dirt = maps->dirt,
+                            .initial = maps->initial_dirt,
+                            .hits = maps->hits,
+                            .owned = maps->owned,
+                            .outward = maps->outward,
                             .crossing_depth = maps->crossing_depth,
                             .crossing_normal = maps->crossing_normal,
                             .crossing_layers = maps->crossing_layers,

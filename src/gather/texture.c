@@ -591,8 +591,7 @@ static bool sample_view(const sample_job *job, int v, const double p[3], const f
         float w = weights[k] * agree;
         if (!(w > 0.0f) ||
             wx_crossing_nearer(s->crossing_depth, s->crossing_normal, s->crossing_layers,
-                               s->crossing_layer, (size_t)s->width * (size_t)s->height, t, dp,
-                               n)) {
+                               s->crossing_layer, (size_t)s->width * (size_t)s->height, t, dp, n)) {
             continue;
         }
         den += w;

@@ -170,7 +170,6 @@ int wx_layers_outline(const bool *entering, int n, int K, uint8_t *kind, uint8_t
     return m;
 }
 
-
 // The outermost solid a texel's crossings leave open (bracket matching, as
 // wx_layers_outline): its entering crossing, or -1 when every solid closes.
 static int outermost_open(const bool *entering, int n)

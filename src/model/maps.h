@@ -127,13 +127,6 @@ enum {
 /// (nearest first); returns how many.
 int wx_layers_outline(const bool *entering, int n, int K, uint8_t *kind, uint8_t *from);
 
-/// The depth planes of `maps` (every layer) into `depth`, with the crossings
-/// buried inside a solid (those wx_layers_outline drops: a slab's face inside
-/// the wall it runs into) or sealed by contact (two solids' faces less than
-/// `sheet`, in d, apart: a wall behind the glass that touches it, a house's
-/// underside on the ground; a solid's face that close behind a pane facing
-/// the camera) made +inf, so that no view sees them: nothing can reach them. `view` is the camera's unit
-/// viewing direction. One layer: a copy.
 /// Whether a point at depth dp of surface normal n, which layer `layer` of
 /// texel t holds within its tolerance, lies strictly nearer another crossing
 /// of that texel whose normal is on the same side as n (depth and normal:
@@ -143,6 +136,15 @@ int wx_layers_outline(const bool *entering, int n, int K, uint8_t *kind, uint8_t
 bool wx_crossing_nearer(const float *depth, const float *normal, int layers, int layer,
                         size_t texels, size_t t, float dp, const float n[3]);
 
+/// The depth planes of `maps` (every layer) into `depth`, with the crossings
+/// buried inside a solid (those wx_layers_outline drops: a slab's face inside
+/// the wall it runs into; in a full stack, every crossing after the entering
+/// face of a solid left open, which runs on behind the last layer) or sealed
+/// by contact (two solids' faces less than `sheet`, in d, apart: a wall
+/// behind the glass that touches it, a house's underside on the ground; a
+/// solid's face that close behind a pane facing the camera) made +inf, so
+/// that no view sees them: nothing can reach them. `view` is the camera's
+/// unit viewing direction. One layer: a copy.
 void wx_maps_bury(const wx_maps *maps, const float view[3], float sheet, float *depth);
 
 /// The file channel of `channel` in layer `layer` (docs/design.md section 14):

@@ -428,10 +428,9 @@ static wx_result write_texture(const wx_scene *scene, const wx_run_def *opts,
     // With layers, faces the collider encloses are not seen (nor their values).
     if (r == WX_OK && enclosing) {
         float *seen = image->channels[channels - 1];
-        wx_mask_points points = { .width = ras->width,
-                                  .height = ras->height,
-                                  .position = position,
-                                  .normal = normal };
+        wx_mask_points points = {
+            .width = ras->width, .height = ras->height, .position = position, .normal = normal
+        };
         wx_masks_unsee_enclosed(&masks->collider, &points, seen, opts->threads);
         for (size_t i = 0; i < texels; ++i) {
             for (int c = 0; c + 1 < channels && !(seen[i] > 0.0f); ++c) {

@@ -446,7 +446,8 @@ static void layer_cell(const wx_collider *collider, const wx_collider_camera *ca
     const size_t corners[4] = { ra + ia, ra + ib, rb + ia, rb + ib };
     size_t at = plane + (size_t)(hy >> 1) * (size_t)W + (size_t)(hx >> 1);
     for (int c = 0; c < 4; ++c) {
-        if (!crossing_between(cam, k, corners[c], at) || !crossing_between(cam, k, at, corners[c])) {
+        if (!crossing_between(cam, k, corners[c], at) ||
+            !crossing_between(cam, k, at, corners[c])) {
             return;
         }
     }

@@ -248,8 +248,8 @@ static void enclosed_rows(int64_t begin, int64_t end, int worker, void *context)
     }
 }
 
-void wx_masks_unsee_enclosed(const wx_collider *collider, const wx_mask_points *points,
-                             float *seen, int threads)
+void wx_masks_unsee_enclosed(const wx_collider *collider, const wx_mask_points *points, float *seen,
+                             int threads)
 {
     bool layered = false;
     for (int c = 0; collider != NULL && c < collider->camera_count; ++c) {

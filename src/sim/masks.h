@@ -70,8 +70,8 @@ bool wx_mask_is_geometric(const wx_scene *scene, int m);
 /// buried in another solid or sealed against one, which no particle or ray
 /// reaches (docs/texture.md, "seen"). Reads points' position and normal. Only
 /// with a layered camera: one layer records no face behind another.
-void wx_masks_unsee_enclosed(const wx_collider *collider, const wx_mask_points *points,
-                             float *seen, int threads);
+void wx_masks_unsee_enclosed(const wx_collider *collider, const wx_mask_points *points, float *seen,
+                             int threads);
 
 /// Riihiaho's sigmoid (his eq. 3.7): (x - o) / (2 sqrt(1/s + (x - o)^2)) + 1/2
 /// for steepness s > 0; x itself for s = 0.

@@ -45,8 +45,8 @@
 // seen but unreachable, by the face's outward axis.
 //
 // WX_BENCH_COVERAGE_REUSE=1 measures the runs the last call left in
-// $WX_BUILD/tmp/bench_coverage instead of running them again. Figures go to $WX_BENCH_CSV (bench_report.h); exit status 1
-// only on errors.
+// $WX_BUILD/tmp/bench_coverage instead of running them again. Figures go to $WX_BENCH_CSV
+// (bench_report.h); exit status 1 only on errors.
 #define _XOPEN_SOURCE 700 // realpath
 #include <dirent.h>
 #include <embree3/rtcore.h>
@@ -415,8 +415,9 @@ static bool measure(const char *out_dir, coverage *c)
     }
     const char *eps_env = getenv("WX_BENCH_COVERAGE_EPS");
     const double eps_rel = eps_env != NULL && atof(eps_env) > 0 ? atof(eps_env) : 1e-5;
-    double eps = eps_rel * sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
-                             (hi[2] - lo[2]) * (hi[2] - lo[2]));
+    double eps =
+        eps_rel * sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                       (hi[2] - lo[2]) * (hi[2] - lo[2]));
     for (int i = 0; ok && i < textures.count; ++i) {
         const wx_texture_target *t = &textures.items[i];
         for (int f = 0; ok && f < t->file_count; ++f) {
@@ -450,8 +451,8 @@ static double share(double part, double whole)
     return whole > 0 ? part / whole : 0.0;
 }
 
-static bool one_mesh(const char *program, const char *dir, const char *mesh_path,
-                     const char *name, int px)
+static bool one_mesh(const char *program, const char *dir, const char *mesh_path, const char *name,
+                     int px)
 {
     char abs[PATH_MAX], args[PATH_MAX + 512], out[PATH_MAX + 512];
     if (realpath(mesh_path, abs) == NULL ||
@@ -488,8 +489,8 @@ static bool one_mesh(const char *program, const char *dir, const char *mesh_path
            c.covered.n, c.covered.a, run_s, c.seconds);
     printf("    reachable of covered: %.4f by area, %.4f by texels\n",
            share(c.reachable.a, c.covered.a), share(c.reachable.n, c.covered.n));
-    printf("    seen of covered:      %.4f by area, %.4f by texels\n",
-           share(c.seen.a, c.covered.a), share(c.seen.n, c.covered.n));
+    printf("    seen of covered:      %.4f by area, %.4f by texels\n", share(c.seen.a, c.covered.a),
+           share(c.seen.n, c.covered.n));
     printf("    seen of reachable:    %.4f by area, %.4f by texels (target %s)\n", seen_reach_a,
            seen_reach_n, target);
     printf("    seen but unreachable: %.4f of the seen area, %.4f of the seen texels\n",
@@ -522,16 +523,16 @@ static bool one_mesh(const char *program, const char *dir, const char *mesh_path
               seen_reach_a >= goal, "%s %d px", name, px);
     bench_row(b, "seen share of reachable texels", seen_reach_n, "ratio", NULL, false, "%s %d px",
               name, px);
-    bench_row(b, "bottom share of reachable area", share(c.bottom.a, c.reachable.a), "ratio",
-              NULL, false, "%s %d px", name, px);
+    bench_row(b, "bottom share of reachable area", share(c.bottom.a, c.reachable.a), "ratio", NULL,
+              false, "%s %d px", name, px);
     bench_row(b, "seen share of reachable area above the bottom", above_a, "ratio", NULL, false,
               "%s %d px", name, px);
-    bench_row(b, "seen share of reachable texels above the bottom", above_n, "ratio", NULL,
-              false, "%s %d px", name, px);
+    bench_row(b, "seen share of reachable texels above the bottom", above_n, "ratio", NULL, false,
+              "%s %d px", name, px);
     bench_row(b, "seen but unreachable share of seen area", share(c.seen_unreachable.a, c.seen.a),
               "ratio", NULL, false, "%s %d px", name, px);
-    bench_row(b, "seen but unreachable share of seen texels",
-              share(c.seen_unreachable.n, c.seen.n), "ratio", NULL, false, "%s %d px", name, px);
+    bench_row(b, "seen but unreachable share of seen texels", share(c.seen_unreachable.n, c.seen.n),
+              "ratio", NULL, false, "%s %d px", name, px);
     bench_row(b, "texels whose rays disagree", (double)c.ambiguous, "texels", NULL, false,
               "%s %d px", name, px);
     return !c.overflow;

@@ -1021,10 +1021,12 @@ static bool rain_per_surface(const char *out, int n, int layers)
             triangle_normal(&m, (uint32_t)found[1], tn);
             bool ours_same = found[0] >= 0 && m.materials[found[0]] == m.materials[found[1]];
             if (facing_of(tn) == 2 && !ours_same) {
-                fprintf(stderr, "sill top miss: exact (%.4f %.4f %.4f) ours cam %d layer %d (%.4f %.4f %.4f) n (%.2f %.2f %.2f) tri %s\n",
-                        exact_point[0], exact_point[1], exact_point[2], ours_hit.camera, ours_hit.layer,
-                        ours_hit.point[0], ours_hit.point[1], ours_hit.point[2], ours_hit.normal[0],
-                        ours_hit.normal[1], ours_hit.normal[2],
+                fprintf(stderr,
+                        "sill top miss: exact (%.4f %.4f %.4f) ours cam %d layer %d (%.4f %.4f "
+                        "%.4f) n (%.2f %.2f %.2f) tri %s\n",
+                        exact_point[0], exact_point[1], exact_point[2], ours_hit.camera,
+                        ours_hit.layer, ours_hit.point[0], ours_hit.point[1], ours_hit.point[2],
+                        ours_hit.normal[0], ours_hit.normal[1], ours_hit.normal[2],
                         found[0] >= 0 ? m.material_names[m.materials[found[0]]] : "none");
             }
         }

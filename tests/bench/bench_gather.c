@@ -169,8 +169,12 @@ int main(int argc, char **argv)
         }
         wx_gather_view inputs[3];
         for (int c = 0; c < 3; ++c) {
-            inputs[c] = (wx_gather_view){ &maps[c].cam, n, n, maps[c].depth, maps[c].normal,
-                                          maps[c].dirt, NULL, NULL };
+            inputs[c] = (wx_gather_view){ .camera = &maps[c].cam,
+                                          .width = n,
+                                          .height = n,
+                                          .depth = maps[c].depth,
+                                          .normal = maps[c].normal,
+                                          .dirt = maps[c].dirt };
         }
         wx_gather_def def = wx_default_gather_def();
         def.target = (wx_target){ .kind = WX_TARGET_CAMERA, .camera = &maps[3].cam, .width = n,

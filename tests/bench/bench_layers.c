@@ -27,8 +27,8 @@
 // Environment: WX_BENCH_PARTICLES (1000000; 250000 with WX_BENCH_QUICK=1),
 // WX_BENCH_STEPS (40), WX_BENCH_LAYERS_PX (the resolution of (b)).
 // Figures go to $WX_BENCH_CSV (bench_report.h); exit status 1 only on errors.
-#define _XOPEN_SOURCE 700 // realpath
-#define _DEFAULT_SOURCE   // wait4
+#define _XOPEN_SOURCE   700 // realpath
+#define _DEFAULT_SOURCE     // wait4
 #include <fcntl.h>
 #include <limits.h>
 #include <stdint.h>
@@ -270,8 +270,7 @@ static bool speed(long particles, long steps)
 
 // Runs `weathering run SCENE --out OUT --stats OUT.json` in `dir` and returns its
 // peak resident memory in MiB (wait4's ru_maxrss), or -1.
-static double run_peak_mib(const char *program, const char *dir, const char *scene,
-                           const char *out)
+static double run_peak_mib(const char *program, const char *dir, const char *scene, const char *out)
 {
     char stats[64];
     snprintf(stats, sizeof stats, "%s.json", out);
@@ -366,8 +365,8 @@ static bool memory(int px)
            "    its simulation: %.1f M steps/s over %.0f M particle-steps; with layers=\"1\" "
            "%.1f M steps/s over %.0f M (%.2fx; one run each)\n",
            px, layered, seconds, estimate, peak, estimate / peak,
-           estimate >= peak ? "met" : "MISSED", peak_one, rate / 1e6, steps / 1e6,
-           rate_one / 1e6, steps_one / 1e6, rate / rate_one);
+           estimate >= peak ? "met" : "MISSED", peak_one, rate / 1e6, steps / 1e6, rate_one / 1e6,
+           steps_one / 1e6, rate / rate_one);
     bench_row("layers", "memory estimate", estimate, "MiB", NULL, false,
               "init house %d px %d cams 4 layers (weathering info)", px, layered);
     bench_row("layers", "peak RSS", peak, "MiB", NULL, false,
