@@ -35,12 +35,12 @@ wx_result wx_mask_context_init(const wx_scene *scene, const wx_maps *in_maps, bo
     memset(ctx, 0, sizeof *ctx);
     const int n = scene->input_count;
     // Without masks the collider still tells, with layers, which faces the
-    // layers hold are enclosed (the TextureMap's seen: wx_masks_unsee_enclosed).
+    // layers hold are enclosed (a TextureMap's seen: wx_masks_unsee_enclosed).
     bool layered = false;
     for (int k = 0; k < n; ++k) {
         layered = layered || wx_maps_layers(&in_maps[k]) > 1;
     }
-    if (scene->mask_count == 0 && !layered) {
+    if (scene->mask_count == 0 && !(layered && scene->texture_count > 0)) {
         return WX_OK;
     }
     wx_camera *cams = calloc((size_t)n + 1, sizeof *cams);

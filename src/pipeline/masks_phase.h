@@ -38,7 +38,9 @@ typedef struct wx_mask_context {
 int wx_mask_slot_texture(const wx_scene *scene, int t, int f);
 
 /// Builds the context from the input cameras' maps (depth and normal), when the
-/// scene has masks (else leaves it not ready). Height's default range is the
+/// scene has masks, or a TextureMap and a layered camera (its collider tells
+/// the faces the layers hold but nothing reaches: wx_masks_unsee_enclosed);
+/// else leaves it not ready. Height's default range is the
 /// geometry's bounds when the run imported it (scene->has_bounds), else the y
 /// range of the surfaces the input cameras record. With `keep`, the context
 /// keeps the geometric masks of each target after their first computation and
