@@ -18,6 +18,10 @@
 //     chunks' events are left when the stepping ends;
 //  3. dead particles are removed, highest index first (swap with the last);
 //  4. emitters emit up to the new time.
+//
+// The step kernel (phase 1) is in step.c, the ageing rules in ageing.c; this
+// file runs the pool, applies the events in order, emits, and creates the
+// solver.
 #include "sim/simulate.h"
 
 #include <math.h>
@@ -27,12 +31,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "sim/collider.h"
-#include "sim/emitter.h"
-#include "sim/force_field.h"
-#include "sim/particles.h"
-#include "core/array.h"
-#include "core/parallel.h"
+#include "sim/simulate_internal.h"
 
 enum {
     DEFAULT_HIT_CAPACITY = 4096,
@@ -40,412 +39,6 @@ enum {
     DEFAULT_CHUNK = 8192,    ///< particles a thread takes at a time (a multiple of the block)
     CHUNKS_PER_THREAD = 4,   ///< the fewest chunks a thread gets while the particles allow
 };
-
-// Event flags: the impact kind in the low bits.
-enum {
-    EVENT_KIND_MASK = 3,
-    EVENT_LINE = 4, ///< slide after a slide: spread over the Bresenham line
-    EVENT_DIES = 8, ///< absorbed or at maxCollisions: deposits all it carries
-};
-
-// One collision, applied to the dirt maps in the serial phase.
-typedef struct sim_event {
-    int64_t index;  ///< particle
-    uint32_t texel; ///< hit texel
-    uint32_t from;  ///< previous slide texel (EVENT_LINE)
-    float point[3];
-    uint16_t camera; ///< the view (camera and layer) whose dirt map holds the texel
-    uint8_t flags;
-} sim_event;
-
-// A lane the first pass could not settle: its segment was not cleared by the
-// first camera, or it ends out of the box. The other cameras' coarse test runs
-// on these, 16 at a time; what is left goes to the swept test, in particle
-// order, with the maps' lines prefetched a few candidates ahead.
-typedef struct sim_candidate {
-    int64_t index;
-    float p0[3], p1[3], v[3];
-    uint32_t flags;
-} sim_candidate;
-
-enum {
-    CAND_CLEAR = 1,  ///< certainly no collision
-    CAND_OUT_A = 2,  ///< outside the first camera's frame
-    CAND_OUTBOX = 4, ///< ends outside the bounding box
-};
-
-static const uint32_t lane_bit[WX_PARTICLE_BLOCK] = {
-    1u << 0, 1u << 1, 1u << 2,  1u << 3,  1u << 4,  1u << 5,  1u << 6,  1u << 7,
-    1u << 8, 1u << 9, 1u << 10, 1u << 11, 1u << 12, 1u << 13, 1u << 14, 1u << 15,
-};
-
-// The record of one chunk of particles in one step: written by the thread that
-// stepped it, read by the one that applies it once `done` says it may.
-typedef struct sim_chunk {
-    sim_event *events; ///< in increasing particle order
-    int64_t event_count, event_capacity;
-    int64_t *dead; ///< index << 1 | escaped, in increasing index order
-    int64_t dead_count, dead_capacity;
-    atomic_int done; ///< set (release) when the chunk's records are complete
-} sim_chunk;
-
-// The state of one worker of the pool (wx_pool worker index = array index).
-typedef struct sim_worker {
-    sim_chunk *chunk; ///< the chunk being stepped
-    sim_candidate *cands;
-    int64_t cand_count, cand_capacity;
-    bool failed; ///< out of memory in this step
-    uint32_t credit[WX_MAX_INPUT_CAMERAS]; ///< lanes each camera cleared first
-} sim_worker;
-
-struct wx_sim {
-    const wx_scene *scene;
-    // Configuration.
-    uint64_t seed;
-    double dt;
-    float bbox_lo[3], bbox_hi[3];
-    wx_collider_def params;
-    int emitter_count;
-    const wx_emitter *emitters;
-    int64_t *emitted; ///< per emitter
-    uint64_t spawned;
-    // World.
-    wx_forces forces;
-    wx_collider collider;
-    int input_count;
-    int *input_camera; ///< scene camera index of each input camera
-    const wx_maps *maps; ///< per input camera, every layer (the collider's)
-    /// Views: one per layer of each input camera, camera by camera (layer k of
-    /// input camera c is view view_base[c] + k; docs/design.md section 14).
-    /// Every array below that is "per view" is indexed by them; with one layer
-    /// a camera's view is the camera.
-    int view_count;
-    int view_base[WX_MAX_INPUT_CAMERAS + 1];
-    wx_maps *views; ///< borrowed layer views of `maps` (wx_maps_layer_view)
-    wx_dirt_map *dirt; ///< per view
-    int substances;     ///< loads per particle, substances per texel
-    /// Ageing (docs/design.md section 9): per input camera, the amounts the
-    /// surface would hold without the particles, aged like the real ones
-    /// (NULL without rules: the initial planes are that), and the area each
-    /// texel grows on (NULL without Grow rules).
-    double **baseline;
-    float **grow_area;
-    const float **surface_of; ///< the maps' surface planes (NULL entries: none)
-    const wx_surface **surfaces; ///< the scene's <Surface>s by global index (the rules')
-    int64_t iterations_done;
-    int camera_order[WX_MAX_INPUT_CAMERAS]; ///< coarse test order (speed only)
-    /// Texel numbering for the particles' last slide: view v's texel t is
-    /// slide_base[v] + t; slide_base[view_count] is the total.
-    uint32_t slide_base[WX_MAX_INPUT_CAMERAS * WX_MAX_LAYERS + 1];
-    // State.
-    int64_t step;
-    wx_particles particles;
-    wx_sim_stats stats; ///< counters and the emitted / escaped / initial ledger
-    wx_hit_sample *hits;
-    int hit_capacity, hit_next, hit_count;
-    // Threads.
-    int thread_count;
-    sim_worker *workers;
-    sim_chunk *chunks;
-    int64_t chunk_particles;             ///< particles per chunk in this step
-    int64_t chunk_limit;                 ///< the most particles a chunk takes
-    int64_t chunk_count, chunk_capacity; ///< chunks of this step, allocated
-    int64_t applied;                     ///< chunks whose events are applied
-    wx_pool *pool; ///< the threads (core/parallel.h)
-};
-
-// --- per-thread recording -------------------------------------------------------
-
-static bool push_event(sim_worker *w, const sim_event *e)
-{
-    sim_chunk *ch = w->chunk;
-    if (!wx_array_reserve((void **)&ch->events, &ch->event_capacity, ch->event_count + 1,
-                          sizeof *ch->events, 256)) {
-        w->failed = true;
-        return false;
-    }
-    ch->events[ch->event_count++] = *e;
-    return true;
-}
-
-static void push_candidate(sim_worker *w, const sim_candidate *c)
-{
-    if (!wx_array_reserve((void **)&w->cands, &w->cand_capacity, w->cand_count + 1,
-                          sizeof *w->cands, 1024)) {
-        w->failed = true;
-        return;
-    }
-    w->cands[w->cand_count++] = *c;
-}
-
-static void push_dead(sim_worker *w, int64_t index, bool escaped)
-{
-    sim_chunk *ch = w->chunk;
-    if (!wx_array_reserve((void **)&ch->dead, &ch->dead_capacity, ch->dead_count + 1,
-                          sizeof *ch->dead, 256)) {
-        w->failed = true;
-        return;
-    }
-    ch->dead[ch->dead_count++] = index << 1 | (escaped ? 1 : 0);
-}
-
-// --- the step of one particle range ------------------------------------------
-
-static inline bool inside_box(const wx_sim *sim, const float p[3])
-{
-    return p[0] >= sim->bbox_lo[0] && p[0] <= sim->bbox_hi[0] && p[1] >= sim->bbox_lo[1] &&
-           p[1] <= sim->bbox_hi[1] && p[2] >= sim->bbox_lo[2] && p[2] <= sim->bbox_hi[2];
-}
-
-// Forces and the semi-implicit Euler step of one block (docs/design.md section 4; the
-// thesis' position formula, 3.2, has a typo): a = g + F/m, v += dt a, x += dt v.
-WX_HOT static void integrate_block(const wx_forces *restrict forces, float t, float dt,
-                                   const float *restrict x, const float *restrict y,
-                                   const float *restrict z, const float *restrict vx,
-                                   const float *restrict vy, const float *restrict vz,
-                                   const float *restrict inv_mass, float *restrict nx,
-                                   float *restrict ny, float *restrict nz, float *restrict nvx,
-                                   float *restrict nvy, float *restrict nvz,
-                                   const float *restrict lo, const float *restrict hi,
-                                   int *restrict inside)
-{
-    enum { B = WX_PARTICLE_BLOCK };
-    float fx[B], fy[B], fz[B];
-    wx_forces_block(forces, t, x, y, z, fx, fy, fz);
-    float gx = forces->gravity[0], gy = forces->gravity[1], gz = forces->gravity[2];
-    for (int k = 0; k < B; ++k) {
-        nvx[k] = vx[k] + dt * (gx + fx[k] * inv_mass[k]);
-        nvy[k] = vy[k] + dt * (gy + fy[k] * inv_mass[k]);
-        nvz[k] = vz[k] + dt * (gz + fz[k] * inv_mass[k]);
-        nx[k] = x[k] + dt * nvx[k];
-        ny[k] = y[k] + dt * nvy[k];
-        nz[k] = z[k] + dt * nvz[k];
-        inside[k] = (nx[k] >= lo[0]) & (nx[k] <= hi[0]) & (ny[k] >= lo[1]) & (ny[k] <= hi[1]) &
-                    (nz[k] >= lo[2]) & (nz[k] <= hi[2]);
-    }
-}
-
-// A segment the coarse test did not clear: the swept test, and on a hit the
-// Russian roulette, the reaction and the event.
-static void collide_one(wx_sim *sim, sim_worker *w, int64_t i, const float p0[3],
-                        const float p1[3], const float v[3])
-{
-    wx_particles *P = &sim->particles;
-    wx_hit hit;
-    hit.layer = 0;
-    if (!wx_collider_sweep(&sim->collider, p0, p1, &hit)) {
-        // The Euler step stands (already stored); a step without a hit ends a streak.
-        P->last_slide[i] = WX_NO_SLIDE;
-        if (!inside_box(sim, p1)) {
-            push_dead(w, i, true);
-        }
-        return;
-    }
-    // Russian roulette on the impact map (thesis 4.8.4.2, Algorithm 2).
-    uint32_t left = P->collisions_left[i];
-    uint64_t counter = WX_RANDOM_COLLISION + 2 * (uint64_t)left;
-    float r_absorb = wx_particle_random(sim->seed, P->id[i], counter);
-    float r_bounce = wx_particle_random(sim->seed, P->id[i], counter + 1);
-    wx_impact kind = r_absorb < hit.absorption ? WX_IMPACT_ABSORB
-                     : r_bounce < hit.bounce   ? WX_IMPACT_BOUNCE
-                                               : WX_IMPACT_SLIDE;
-    left = left > 0 ? left - 1 : 0;
-    P->collisions_left[i] = left;
-    bool dies = kind == WX_IMPACT_ABSORB || left == 0;
-
-    sim_event e = { 0 };
-    e.index = i;
-    e.texel = hit.texel;
-    int view = sim->view_base[hit.camera] + hit.layer;
-    e.camera = (uint16_t)view;
-    e.flags = (uint8_t)kind;
-    memcpy(e.point, hit.point, sizeof e.point);
-    // Streaks: a slide that follows a slide of the previous step on the same map
-    // (last_slide is reset in every step without a hit; unsigned arithmetic puts
-    // another map's texels and WX_NO_SLIDE out of range).
-    uint32_t base = sim->slide_base[view];
-    uint32_t from = P->last_slide[i] - base;
-    if (kind == WX_IMPACT_SLIDE && from < sim->slide_base[view + 1] - base) {
-        e.flags |= EVENT_LINE;
-        e.from = from;
-    }
-    P->last_slide[i] = kind == WX_IMPACT_SLIDE ? base + hit.texel : WX_NO_SLIDE;
-    if (dies) {
-        e.flags |= EVENT_DIES;
-    }
-    if (!push_event(w, &e)) {
-        return;
-    }
-    if (dies) {
-        P->x[i] = hit.point[0];
-        P->y[i] = hit.point[1];
-        P->z[i] = hit.point[2];
-        push_dead(w, i, false);
-        return;
-    }
-
-    // Mechanical reaction (thesis 4.8.4.2): v = vn + vt on the hit normal;
-    // bounce v = -R vn, slide v = F vt.
-    const float *N = hit.normal;
-    float vn = v[0] * N[0] + v[1] * N[1] + v[2] * N[2];
-    float after[3];
-    for (int k = 0; k < 3; ++k) {
-        float normal_part = vn * N[k];
-        after[k] = kind == WX_IMPACT_BOUNCE ? -sim->params.resilience * normal_part
-                                            : sim->params.friction * (v[k] - normal_part);
-    }
-    // The particle is put back on the surface, slightly in front of it, and
-    // spends the rest of the step at its new velocity (swept too; a second
-    // contact in the same step stops it there without a second event).
-    float rest = (1.0f - hit.s) * (float)sim->dt;
-    float q1[3];
-    for (int k = 0; k < 3; ++k) {
-        q1[k] = hit.front[k] + rest * after[k];
-    }
-    float final[3];
-    wx_hit again;
-    if (!wx_collider_coarse_clear(&sim->collider, hit.front, q1) &&
-        wx_collider_sweep(&sim->collider, hit.front, q1, &again)) {
-        memcpy(final, again.front, sizeof final);
-    } else {
-        memcpy(final, q1, sizeof final);
-    }
-    if (kind == WX_IMPACT_SLIDE) {
-        // Adherence pulls a sliding particle onto the surface: v -= A N dt / m.
-        float pull = sim->params.adherence * (float)sim->dt * wx_particle_inv_mass(P, i);
-        for (int k = 0; k < 3; ++k) {
-            after[k] -= pull * N[k];
-        }
-    }
-    P->x[i] = final[0];
-    P->y[i] = final[1];
-    P->z[i] = final[2];
-    P->vx[i] = after[0];
-    P->vy[i] = after[1];
-    P->vz[i] = after[2];
-    if (!inside_box(sim, final)) {
-        push_dead(w, i, true);
-    }
-}
-
-// The other cameras' coarse test on the candidates the first camera left.
-static void coarse_rest(wx_sim *sim, sim_worker *w)
-{
-    enum { B = WX_PARTICLE_BLOCK };
-    int rest = sim->input_count > 0 ? sim->input_count - 1 : 0;
-    int64_t pending[B];
-    int m = 0;
-    for (int64_t j = 0; j <= w->cand_count; ++j) {
-        if (j < w->cand_count && !(w->cands[j].flags & CAND_CLEAR)) {
-            pending[m++] = j;
-        }
-        if (m == B || (j == w->cand_count && m > 0)) {
-            float x0[B], y0[B], z0[B], x1[B], y1[B], z1[B];
-            for (int k = 0; k < B; ++k) {
-                const sim_candidate *c = &w->cands[pending[k < m ? k : 0]];
-                x0[k] = c->p0[0];
-                y0[k] = c->p0[1];
-                z0[k] = c->p0[2];
-                x1[k] = c->p1[0];
-                y1[k] = c->p1[1];
-                z1[k] = c->p1[2];
-            }
-            uint32_t outside;
-            uint32_t clear = wx_collider_coarse_block(&sim->collider, sim->camera_order + 1, rest,
-                                                      w->credit, x0, y0, z0, x1, y1, z1,
-                                                      &outside);
-            for (int k = 0; k < m; ++k) {
-                sim_candidate *c = &w->cands[pending[k]];
-                bool out_all = (c->flags & CAND_OUT_A) && ((outside >> k) & 1u);
-                if (((clear >> k) & 1u) || out_all) {
-                    c->flags |= CAND_CLEAR;
-                }
-            }
-            m = 0;
-        }
-    }
-}
-
-// Steps particles [begin, end) into the records of the worker's chunk (emptied
-// by prepare_chunks).
-static void step_range(wx_sim *sim, sim_worker *w, int64_t begin, int64_t end)
-{
-    enum { B = WX_PARTICLE_BLOCK };
-    wx_particles *P = &sim->particles;
-    float t = (float)((double)sim->step * sim->dt);
-    float dt = (float)sim->dt;
-    int first = sim->input_count > 0 ? 1 : 0;
-    w->cand_count = 0;
-    for (int64_t b = begin; b < end; b += B) {
-        float ox[B], oy[B], oz[B], nx[B], ny[B], nz[B], nvx[B], nvy[B], nvz[B];
-        int inside[B];
-        memcpy(ox, P->x + b, sizeof ox);
-        memcpy(oy, P->y + b, sizeof oy);
-        memcpy(oz, P->z + b, sizeof oz);
-        const float *inv_mass = P->inv_mass != NULL ? P->inv_mass + b : P->inv_mass_block;
-        integrate_block(&sim->forces, t, dt, ox, oy, oz, P->vx + b, P->vy + b, P->vz + b,
-                        inv_mass, nx, ny, nz, nvx, nvy, nvz, sim->bbox_lo, sim->bbox_hi, inside);
-        // The camera that cleared most last step, on every lane.
-        uint32_t out_a;
-        uint32_t clear = wx_collider_coarse_block(&sim->collider, sim->camera_order, first,
-                                                  w->credit, ox, oy, oz, nx, ny, nz, &out_a);
-        // Every lane takes its Euler step (lanes past the end are padding);
-        // the candidates below redo what the collider changes.
-        memcpy(P->x + b, nx, sizeof nx);
-        memcpy(P->y + b, ny, sizeof ny);
-        memcpy(P->z + b, nz, sizeof nz);
-        memcpy(P->vx + b, nvx, sizeof nvx);
-        memcpy(P->vy + b, nvy, sizeof nvy);
-        memcpy(P->vz + b, nvz, sizeof nvz);
-        uint32_t outbox = 0;
-        for (int k = 0; k < B; ++k) {
-            outbox |= -(uint32_t)!inside[k] & lane_bit[k];
-        }
-        int lanes = end - b < B ? (int)(end - b) : B;
-        uint32_t valid = (1u << lanes) - 1u;
-        uint32_t special = (~clear | outbox) & valid;
-        // A step without a hit ends a streak: reset every lane that cannot hit
-        // (padding lanes too); the candidates below reset their own. Written only
-        // where set, so the array's lines stay clean.
-        uint32_t *last_slide = P->last_slide + b;
-        uint32_t sliding = 0;
-        for (int k = 0; k < B; ++k) {
-            sliding |= (uint32_t)(last_slide[k] != WX_NO_SLIDE) << k;
-        }
-        sliding &= ~special;
-        while (sliding != 0) {
-            last_slide[__builtin_ctz(sliding)] = WX_NO_SLIDE;
-            sliding &= sliding - 1;
-        }
-        while (special != 0) {
-            int k = __builtin_ctz(special);
-            special &= special - 1;
-            uint32_t flags = (((clear >> k) & 1u) ? CAND_CLEAR : 0) |
-                             (((out_a >> k) & 1u) ? CAND_OUT_A : 0) |
-                             (((outbox >> k) & 1u) ? CAND_OUTBOX : 0);
-            sim_candidate c = { b + k, { ox[k], oy[k], oz[k] }, { nx[k], ny[k], nz[k] },
-                                { nvx[k], nvy[k], nvz[k] }, flags };
-            push_candidate(w, &c);
-        }
-    }
-    coarse_rest(sim, w);
-    // What is left, in particle order (so events and deaths stay sorted).
-    enum { AHEAD = 8 };
-    for (int64_t j = 0; j < w->cand_count; ++j) {
-        if (j + AHEAD < w->cand_count && !(w->cands[j + AHEAD].flags & CAND_CLEAR)) {
-            wx_collider_prefetch(&sim->collider, w->cands[j + AHEAD].p1);
-        }
-        const sim_candidate *c = &w->cands[j];
-        if (!(c->flags & CAND_CLEAR)) {
-            collide_one(sim, w, c->index, c->p0, c->p1, c->v);
-        } else {
-            P->last_slide[c->index] = WX_NO_SLIDE;
-            if (c->flags & CAND_OUTBOX) {
-                push_dead(w, c->index, true); // a free flight out of the box
-            }
-        }
-    }
-}
 
 // --- the dirt exchange -------------------------------------------------------------
 
@@ -531,7 +124,7 @@ static void step_chunks(int64_t begin, int64_t end, int worker, void *context)
         int64_t first = c * sim->chunk_particles;
         int64_t last = n - first < sim->chunk_particles ? n : first + sim->chunk_particles;
         w->chunk = &sim->chunks[c];
-        step_range(sim, w, first, last);
+        sim_step_range(sim, w, first, last);
         atomic_store_explicit(&sim->chunks[c].done, 1, memory_order_release);
         if (worker == 0) {
             apply_ready(sim, false);
@@ -705,97 +298,7 @@ static wx_result emit(wx_sim *sim, int64_t step, wx_error *err)
     return WX_OK;
 }
 
-// --- ageing -----------------------------------------------------------------------
-
-// Runs `rules` on one texel's amounts a[] (and its baseline b[], may be NULL),
-// in order, each seeing the result of the one before (docs/design.md section 9);
-// `area` is the surface the texel grows on.
-static void run_rules(const wx_rule *rules, int count, double *a, double *b, double area,
-                      wx_substance_ledger *ledger)
-{
-    for (int k = 0; k < count; ++k) {
-        const wx_rule *r = &rules[k];
-        int s = r->substance;
-        switch (r->kind) {
-        case WX_RULE_TRANSFER: {
-            double t = (double)r->rate * a[s];
-            a[s] -= t;
-            a[r->to] += t;
-            ledger[s].transferred_out += t;
-            ledger[r->to].transferred_in += t;
-            if (b != NULL) {
-                double tb = (double)r->rate * b[s];
-                b[s] -= tb;
-                b[r->to] += tb;
-            }
-            break;
-        }
-        case WX_RULE_DECAY: {
-            double d = (double)r->rate * a[s];
-            a[s] -= d;
-            ledger[s].decayed += d;
-            if (b != NULL) {
-                b[s] -= (double)r->rate * b[s];
-            }
-            break;
-        }
-        case WX_RULE_GROW: {
-            double g = (double)r->amount * area;
-            a[s] += g;
-            ledger[s].grown += g;
-            if (b != NULL) {
-                b[s] += g;
-            }
-            break;
-        }
-        }
-    }
-}
-
-// After an iteration's last step: the global rules, then the texel's own
-// surface's, on every surface texel of every input camera, in texel order (one
-// thread: the ledger's sums are the same for any thread count).
-static void age(wx_sim *sim)
-{
-    const wx_scene *scene = sim->scene;
-    bool surface_rules = wx_scene_has_surface_rules(scene);
-    if (scene->rule_count == 0 && !surface_rules) {
-        return;
-    }
-    // Surface rules by global surface index.
-    const wx_surface **by_index = sim->surfaces;
-    const int known = wx_scene_surface_count(scene);
-    int S = sim->substances;
-    for (int c = 0; c < sim->view_count; ++c) {
-        wx_dirt_map *map = &sim->dirt[c];
-        size_t n = (size_t)map->width * (size_t)map->height;
-        const float *depth = map->depth;
-        const float *surface = sim->surface_of[c];
-        const float *area = sim->grow_area[c];
-        double *baseline = sim->baseline[c];
-        for (size_t t = 0; t < n; ++t) {
-            if (depth != NULL && !isfinite(depth[t])) {
-                continue;
-            }
-            wx_dirt_texel *x = &map->texels[t * (size_t)S];
-            double a[WX_MAX_SUBSTANCES];
-            for (int s = 0; s < S; ++s) {
-                a[s] = x[s].dirt;
-            }
-            double *b = baseline != NULL ? &baseline[t * (size_t)S] : NULL;
-            double grow = area != NULL ? (double)area[t] : 0.0;
-            run_rules(scene->rules, scene->rule_count, a, b, grow, sim->stats.substance);
-            int id = surface != NULL ? (int)surface[t] - 1 : -1;
-            if (id >= 0 && id < known) {
-                run_rules(by_index[id]->rules, by_index[id]->rule_count, a, b, grow,
-                          sim->stats.substance);
-            }
-            for (int s = 0; s < S; ++s) {
-                x[s].dirt = a[s];
-            }
-        }
-    }
-}
+// --- the step ---------------------------------------------------------------------
 
 wx_result wx_sim_step(wx_sim *sim, wx_error *err)
 {
@@ -820,7 +323,7 @@ wx_result wx_sim_step(wx_sim *sim, wx_error *err)
     const wx_scene *scene = sim->scene;
     if (r == WX_OK && scene->steps > 0 && sim->step % scene->steps == 0 &&
         sim->iterations_done < (scene->iterations > 1 ? scene->iterations : 1)) {
-        age(sim);
+        sim_age(sim);
         sim->iterations_done++;
     }
     return r;
@@ -852,62 +355,6 @@ static wx_result start_pool(wx_sim *sim, wx_error *err)
     if (sim->workers == NULL) {
         return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (threads)");
     }
-    return WX_OK;
-}
-
-// The input camera of view v.
-static int view_camera(const wx_sim *sim, int v)
-{
-    int c = 0;
-    while (c + 1 < sim->input_count && sim->view_base[c + 1] <= v) {
-        c++;
-    }
-    return c;
-}
-
-// View c's ageing state: the baseline (amounts without the particles)
-// when the scene has rules, and the area Grow multiplies: the bake's record of
-// the area the camera owns or, for maps the bake did not write, the area every
-// surface texel covers (texel area / |N.view|, clamped as the bake clamps it).
-static wx_result setup_ageing(wx_sim *sim, int c, wx_error *err)
-{
-    const wx_scene *scene = sim->scene;
-    const wx_maps *m = &sim->views[c];
-    size_t n = (size_t)m->width * (size_t)m->height;
-    int S = sim->substances;
-    sim->surface_of[c] = m->surface;
-    if (scene->rule_count == 0 && !wx_scene_has_surface_rules(scene)) {
-        return WX_OK;
-    }
-    sim->baseline[c] = malloc((n > 0 ? n : 1) * (size_t)S * sizeof(double));
-    if (sim->baseline[c] == NULL) {
-        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (ageing)");
-    }
-    for (size_t t = 0; t < n * (size_t)S; ++t) {
-        sim->baseline[c][t] = sim->dirt[c].texels[t].dirt;
-    }
-    if (!wx_scene_has_grow(scene)) {
-        return WX_OK;
-    }
-    if (m->area != NULL) {
-        sim->grow_area[c] = m->area;
-        return WX_OK;
-    }
-    float *area = malloc((n > 0 ? n : 1) * sizeof *area);
-    if (area == NULL) {
-        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (ageing)");
-    }
-    const wx_camera *cam = &scene->cameras[sim->input_camera[view_camera(sim, c)]].camera;
-    float view[3], fw, fh;
-    wx_camera_view_dir(cam, view);
-    wx_camera_frame_size(cam, &fw, &fh);
-    float texel_area = (fw / (float)m->width) * (fh / (float)m->height);
-    for (size_t t = 0; t < n; ++t) {
-        const float *nn = &m->normal[3 * t];
-        float cosine = fabsf(nn[0] * view[0] + nn[1] * view[1] + nn[2] * view[2]);
-        area[t] = wx_depth_is_empty(m->depth[t]) ? 0.0f : texel_area / fmaxf(cosine, 1e-3f);
-    }
-    sim->grow_area[c] = area;
     return WX_OK;
 }
 
@@ -1022,15 +469,14 @@ wx_result wx_sim_create(const wx_scene *scene, const wx_sim_def *config, wx_sim 
         if (wx_maps_substances(m) != sim->substances) {
             r = wx_fail(err, WX_CAUSE_BAD_ARGUMENT,
                         "simulation: the maps of camera '%s' hold %d substances, the scene %d",
-                        scene->cameras[sim->input_camera[view_camera(sim, c)]].name,
-                        wx_maps_substances(m),
-                        sim->substances);
+                        scene->cameras[sim->input_camera[sim_view_camera(sim, c)]].name,
+                        wx_maps_substances(m), sim->substances);
             break;
         }
         // The collider's copy of a one-layer camera's depth (empty texels
         // +inf); a layered camera's copy is reordered (its solids' outline),
         // so its views read their own planes.
-        int cam = view_camera(sim, c);
+        int cam = sim_view_camera(sim, c);
         const float *depth = wx_maps_layers(&sim->maps[cam]) > 1 ? m->depth
                                                                  : sim->collider.cameras[cam].depth;
         r = wx_dirt_map_init(&sim->dirt[c], m->width, m->height, sim->substances, m->dirt,
@@ -1040,7 +486,7 @@ wx_result wx_sim_create(const wx_scene *scene, const wx_sim_def *config, wx_sim 
             for (int s = 0; s < sim->substances; ++s) {
                 sim->stats.substance[s].initial_surface += wx_dirt_map_total(&sim->dirt[c], s);
             }
-            r = setup_ageing(sim, c, err);
+            r = sim_setup_ageing(sim, c, err);
         }
     }
     if (r == WX_OK) {
@@ -1196,7 +642,7 @@ int wx_sim_camera_views(const wx_sim *sim, int camera, int *first)
 
 int wx_sim_view_camera(const wx_sim *sim, int view, int *layer)
 {
-    int c = view_camera(sim, view);
+    int c = sim_view_camera(sim, view);
     if (layer != NULL) {
         *layer = view - sim->view_base[c];
     }
