@@ -1,0 +1,294 @@
+// collider_build.c: the projected-maps collider's construction (thesis
+// 4.8.4.1): each camera's matrices, its copy of the maps, the coarse pyramid
+// the coarse test reads, and a layered camera's crossings reduced to the
+// outline of its solids.
+#include "sim/collider.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/matrix.h"
+#include "sim/collider_internal.h"
+
+// --- building ----------------------------------------------------------------
+
+static wx_result setup_matrices(wx_collider_camera *cam, const float wtc[16], int index,
+                                wx_error *err)
+{
+    // [x y z 1] * wtc = [u v d w]; the collider needs w constant (orthographic).
+    double w = wtc[15];
+    if (!wx_matrix_is_orthographic(wtc)) {
+        return wx_fail(err, WX_CAUSE_BAD_CAMERA,
+                       "input camera %d: projective (perspective) matrices are not "
+                       "supported by the collider; use orthographic cameras",
+                       index);
+    }
+    double W = cam->width, H = cam->height;
+    for (int r = 0; r < 4; ++r) {
+        double u = wtc[r * 4 + 0] / w, v = wtc[r * 4 + 1] / w, d = wtc[r * 4 + 2] / w;
+        cam->mx[r] = u * W;
+        cam->my[r] = -v * H;
+        cam->md[r] = d;
+    }
+    cam->my[3] += H; // Y = (1 - v) * H
+    for (int r = 0; r < 4; ++r) {
+        cam->fmx[r] = (float)cam->mx[r];
+        cam->fmy[r] = (float)cam->my[r];
+        cam->fmd[r] = (float)cam->md[r];
+    }
+    double a[9], inv[9];
+    for (int r = 0; r < 3; ++r) {
+        a[r * 3 + 0] = wtc[r * 4 + 0] / w;
+        a[r * 3 + 1] = wtc[r * 4 + 1] / w;
+        a[r * 3 + 2] = wtc[r * 4 + 2] / w;
+    }
+    if (!wx_invert3(a, inv)) {
+        return wx_fail(err, WX_CAUSE_BAD_CAMERA, "input camera %d: singular matrix", index);
+    }
+    // Row k of inv is the world displacement per unit of u, v, d.
+    for (int k = 0; k < 3; ++k) {
+        cam->back[k] = (float)-inv[6 + k];
+    }
+    double du = sqrt(inv[0] * inv[0] + inv[1] * inv[1] + inv[2] * inv[2]) / W;
+    double dv = sqrt(inv[3] * inv[3] + inv[4] * inv[4] + inv[5] * inv[5]) / H;
+    cam->texel_ws = (float)fmin(du, dv);
+    return WX_OK;
+}
+
+// The coarse pyramid: block minima per level, then the minimum over the 3x3
+// blocks around each block, lowered by a margin for float rounding.
+static wx_result build_coarse(wx_collider_camera *cam, wx_error *err)
+{
+    int W = cam->width, H = cam->height;
+    int total = 0;
+    for (int l = 0; l < WX_COARSE_LEVELS; ++l) {
+        int shift = WX_COARSE_BLOCK_SHIFT + WX_COARSE_LEVEL_SHIFT * l;
+        cam->level_width[l] = ((W - 1) >> shift) + 1;
+        cam->level_height[l] = ((H - 1) >> shift) + 1;
+        cam->level_offset[l] = total;
+        total += cam->level_width[l] * cam->level_height[l];
+    }
+    cam->levels = WX_COARSE_LEVELS;
+    cam->coarse = malloc((size_t)total * sizeof *cam->coarse);
+    float *blockmin = malloc((size_t)total * sizeof *blockmin);
+    if (cam->coarse == NULL || blockmin == NULL) {
+        free(blockmin);
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (collider pyramid)");
+    }
+    for (int i = 0; i < total; ++i) {
+        blockmin[i] = INFINITY;
+    }
+    // Level 0 from the texels, each further level from the one below.
+    float *level0 = blockmin + cam->level_offset[0];
+    for (int j = 0; j < H; ++j) {
+        const float *row = cam->depth + (size_t)j * (size_t)W;
+        float *out = level0 + (size_t)(j >> WX_COARSE_BLOCK_SHIFT) * (size_t)cam->level_width[0];
+        for (int i = 0; i < W; ++i) {
+            float d = row[i];
+            float *m = &out[i >> WX_COARSE_BLOCK_SHIFT];
+            if (d < *m) {
+                *m = d;
+            }
+        }
+    }
+    for (int l = 1; l < WX_COARSE_LEVELS; ++l) {
+        const float *below = blockmin + cam->level_offset[l - 1];
+        float *here = blockmin + cam->level_offset[l];
+        int bw = cam->level_width[l - 1], bh = cam->level_height[l - 1];
+        for (int by = 0; by < bh; ++by) {
+            for (int bx = 0; bx < bw; ++bx) {
+                float d = below[by * bw + bx];
+                float *m = &here[(by >> WX_COARSE_LEVEL_SHIFT) * cam->level_width[l] +
+                                 (bx >> WX_COARSE_LEVEL_SHIFT)];
+                if (d < *m) {
+                    *m = d;
+                }
+            }
+        }
+    }
+    double margin_base = 1e-4 * cam->texel_ws;
+    for (int l = 0; l < WX_COARSE_LEVELS; ++l) {
+        const float *src = blockmin + cam->level_offset[l];
+        float *dst = cam->coarse + cam->level_offset[l];
+        int bw = cam->level_width[l], bh = cam->level_height[l];
+        for (int by = 0; by < bh; ++by) {
+            for (int bx = 0; bx < bw; ++bx) {
+                float m = INFINITY;
+                for (int y = by - 1; y <= by + 1; ++y) {
+                    for (int x = bx - 1; x <= bx + 1; ++x) {
+                        if (x >= 0 && x < bw && y >= 0 && y < bh && src[y * bw + x] < m) {
+                            m = src[y * bw + x];
+                        }
+                    }
+                }
+                if (isfinite(m)) {
+                    m = (float)(m - margin_base - 1e-6 * fabs(m));
+                }
+                dst[by * bw + bx] = m;
+            }
+        }
+    }
+    free(blockmin);
+    return WX_OK;
+}
+
+// True when no texel of the map's outermost ring records a surface.
+static bool border_is_empty(const float *depth, int W, int H)
+{
+    for (int i = 0; i < W; ++i) {
+        if (isfinite(depth[i]) || isfinite(depth[(size_t)(H - 1) * (size_t)W + (size_t)i])) {
+            return false;
+        }
+    }
+    for (int j = 0; j < H; ++j) {
+        if (isfinite(depth[(size_t)j * (size_t)W]) ||
+            isfinite(depth[(size_t)j * (size_t)W + (size_t)(W - 1)])) {
+            return false;
+        }
+    }
+    return true;
+}
+// The roles of every texel's crossings (depth already copied, normals set):
+// each texel's crossings are replaced by their outline (outline above),
+// nearest first, with the layer each came from in `origin`.
+static void classify_layers(wx_collider_camera *cam)
+{
+    int K = cam->layers;
+    size_t texels = (size_t)cam->width * (size_t)cam->height;
+    for (size_t t = 0; t < texels; ++t) {
+        bool entering[WX_MAX_LAYERS];
+        float depth[WX_MAX_LAYERS];
+        int n = 0;
+        for (int k = 0; k < K; ++k) {
+            size_t at = (size_t)k * texels + t;
+            if (n < k || !isfinite(cam->depth[at])) {
+                continue; // a crossing after an empty layer is ignored
+            }
+            n = k + 1;
+            depth[k] = cam->depth[at];
+            const float *nv = cam->normal + 3 * at;
+            // back points towards the camera: n . view < 0 is n . back > 0. A
+            // grazing or missing normal counts as entering, as one layer's does.
+            float dot = nv[0] * cam->back[0] + nv[1] * cam->back[1] + nv[2] * cam->back[2];
+            entering[k] = !(dot < 0.0f);
+        }
+        uint8_t kind[WX_MAX_LAYERS], from[WX_MAX_LAYERS];
+        int m = wx_layers_outline(entering, n, K, kind, from);
+        for (int k = 0; k < K; ++k) {
+            size_t at = (size_t)k * texels + t;
+            if (k < m) {
+                cam->depth[at] = depth[from[k]];
+                cam->role[at] = (uint8_t)(kind[k] | (entering[from[k]] ? WX_ROLE_FACING : 0));
+                cam->origin[at] = from[k];
+            } else {
+                cam->depth[at] = INFINITY;
+                cam->role[at] = WX_ROLE_NONE;
+                cam->origin[at] = 0;
+            }
+        }
+    }
+}
+wx_result wx_collider_init(wx_collider *collider, const wx_camera *cameras, const wx_maps *maps,
+                           int count, bool nearest, wx_error *err)
+{
+    memset(collider, 0, sizeof *collider);
+    if (count > WX_MAX_INPUT_CAMERAS) {
+        return wx_fail(err, WX_CAUSE_TOO_MANY, "%d input cameras; the collider takes at most %d",
+                            count, WX_MAX_INPUT_CAMERAS);
+    }
+    collider->nearest = nearest;
+    collider->cameras = calloc(count > 0 ? (size_t)count : 1, sizeof *collider->cameras);
+    if (collider->cameras == NULL) {
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (collider)");
+    }
+    collider->camera_count = count;
+    for (int c = 0; c < count; ++c) {
+        wx_collider_camera *cam = &collider->cameras[c];
+        const wx_maps *m = &maps[c];
+        if (m->depth == NULL || m->normal == NULL || m->impact == NULL || m->width < 1 ||
+            m->height < 1) {
+            wx_collider_free(collider);
+            return wx_fail(err, WX_CAUSE_BAD_ARGUMENT,
+                           "input camera %d: the collider needs depth, normal and impact "
+                           "maps",
+                           c);
+        }
+        if ((cameras[c].width != 0 && cameras[c].width != m->width) ||
+            (cameras[c].height != 0 && cameras[c].height != m->height)) {
+            wx_collider_free(collider);
+            return wx_fail(err, WX_CAUSE_MAP_SIZE,
+                           "input camera %d: maps are %d x %d, the camera is %d x %d", c, m->width,
+                           m->height, cameras[c].width, cameras[c].height);
+        }
+        cam->width = m->width;
+        cam->height = m->height;
+        wx_result r = setup_matrices(cam, cameras[c].wtc, c, err);
+        if (r != WX_OK) {
+            wx_collider_free(collider);
+            return r;
+        }
+        int layers = wx_maps_layers(m);
+        if (layers > WX_MAX_LAYERS) {
+            wx_collider_free(collider);
+            return wx_fail(err, WX_CAUSE_BAD_ARGUMENT,
+                           "input camera %d: %d layers; the collider takes at most %d", c,
+                           layers, WX_MAX_LAYERS);
+        }
+        size_t texels = (size_t)m->width * (size_t)m->height;
+        cam->layers = layers;
+        cam->depth = malloc((size_t)layers * texels * sizeof *cam->depth);
+        if (layers > 1) {
+            cam->role = malloc((size_t)layers * texels);
+            cam->origin = malloc((size_t)layers * texels);
+        }
+        if (cam->depth == NULL || (layers > 1 && (cam->role == NULL || cam->origin == NULL))) {
+            wx_collider_free(collider);
+            return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (collider depth)");
+        }
+        for (size_t t = 0; t < (size_t)layers * texels; ++t) {
+            cam->depth[t] = wx_depth_is_empty(m->depth[t]) ? INFINITY : m->depth[t];
+        }
+        cam->frames_model = border_is_empty(cam->depth, m->width, m->height);
+        cam->normal = m->normal;
+        cam->impact = m->impact;
+        if (layers > 1) {
+            // A quarter texel (docs/physics.md, "Layered maps"): thick enough for
+            // float rounding and to bridge the steps the silhouette rule leaves
+            // along a sheet's edge, thin enough that a hit from behind lies
+            // within half the collider's precision (half a texel) of the sheet.
+            double bl = sqrt((double)cam->back[0] * cam->back[0] +
+                             (double)cam->back[1] * cam->back[1] +
+                             (double)cam->back[2] * cam->back[2]);
+            cam->sheet = 0.25 * cam->texel_ws / bl;
+            classify_layers(cam);
+        }
+        r = build_coarse(cam, err);
+        if (r != WX_OK) {
+            wx_collider_free(collider);
+            return r;
+        }
+    }
+    for (int c = 0; c < count; ++c) {
+        if (collider->cameras[c].layers > 1) {
+            for (int k = 0; k < count; ++k) {
+                collider->layered_slack =
+                    fmax(collider->layered_slack, (double)collider->cameras[k].texel_ws);
+            }
+            break;
+        }
+    }
+    return WX_OK;
+}
+
+void wx_collider_free(wx_collider *collider)
+{
+    for (int c = 0; c < collider->camera_count; ++c) {
+        free(collider->cameras[c].depth);
+        free(collider->cameras[c].role);
+        free(collider->cameras[c].origin);
+        free(collider->cameras[c].coarse);
+    }
+    free(collider->cameras);
+    memset(collider, 0, sizeof *collider);
+}
