@@ -4,9 +4,11 @@
 //   core <- model <- io, raster, sim, gather <- pipeline <- cli, viewer
 //
 // and the compute layers (raster, sim, gather) never open a file themselves:
-// they take and return memory, the pipeline reads and writes. Only the scene
-// loader includes libxml2, only the mesh importer Assimp, only io/exr.c OpenEXR,
-// only io/png_preview.c libpng.
+// they take and return memory, the pipeline reads and writes. Each third-party
+// library is included by the few files of one concept only: libxml2 by the scene
+// loader, Assimp by the mesh importer, OpenEXR by the EXR files of io/, OSMesa
+// and GL by the bake's GL side, libpng by io/png_preview.c. A folder's private
+// header (NAME_internal.h) is included by the files of that folder only.
 #include <dirent.h>
 #include <stdbool.h>
 #include <stdio.h>
@@ -105,12 +107,13 @@ static int check_no_file_io(const char *path, const char *text)
     return bad;
 }
 
-// Third-party headers that belong to one file each.
-static int check_library(const char *rel, const char *text, const char *header,
-                         const char *owner)
+// Third-party headers that belong to a few files each: `owners` lists them,
+// space-separated (a library whose code is split by concept lives in several
+// files of one folder); any other file that names the header is a violation.
+static int check_library(const char *rel, const char *text, const char *header, const char *owners)
 {
-    if (strstr(text, header) != NULL && strcmp(rel, owner) != 0) {
-        fprintf(stderr, "        %s includes %s, which only %s may\n", rel, header, owner);
+    if (strstr(text, header) != NULL && !listed(owners, rel, strlen(rel))) {
+        fprintf(stderr, "        %s includes %s, which only %s may\n", rel, header, owners);
         return 1;
     }
     return 0;
@@ -146,7 +149,7 @@ TEST(every_layer_includes_only_the_layers_below_it)
             bad += check_library(rel, text, "<libxml/", "io/scene_xml.c");
             bad += check_library(rel, text, "<assimp/", "io/mesh_import.c");
             bad += check_library(rel, text, "<openexr.h>", "io/exr.c");
-            bad += check_library(rel, text, "<GL/osmesa.h>", "raster/bake.c");
+            bad += check_library(rel, text, "<GL/", "raster/bake_internal.h");
             bad += check_library(rel, text, "<png.h>", "io/png_preview.c");
             free(text);
             files++;
@@ -166,11 +169,113 @@ TEST(a_wrong_include_is_caught)
     ENSURE(check_includes("pipeline/x.c", text, &layers[6]) == 0);
     ENSURE(check_no_file_io("sim/x.c", "f = fopen(path, \"rb\");") == 1);
     ENSURE(check_no_file_io("sim/x.c", "wx_pool_open(x);") == 0);
+    // A library's owners are whole file names of a list, nothing else.
+    const char *gl = "#include <GL/gl.h>\n";
+    ENSURE(check_library("raster/bake_gl.h", gl, "<GL/", "raster/bake.c raster/bake_gl.c") == 1);
+    ENSURE(check_library("raster/bake_gl.c", gl, "<GL/", "raster/bake.c raster/bake_gl.c") == 0);
+    ENSURE(check_library("raster/bake.c", gl, "<GL/", "raster/bake.c raster/bake_gl.c") == 0);
+    ENSURE(check_library("raster/bake.cc", gl, "<GL/", "raster/bake.c raster/bake_gl.c") == 1);
+    ENSURE(check_library("sim/bake.c", gl, "<GL/", "raster/bake.c") == 1);
 }
+
+// --- private headers ------------------------------------------------------------
+// A folder's NAME_internal.h is shared by the files of that folder only, and is
+// included by its folder-qualified name ("sim/simulate_internal.h"): a file of
+// another layer, or of cli/, viewer/ or tests/ (`folder` NULL), that includes
+// one is a violation. Returns the number of violations (printed).
+static int check_private_headers(const char *rel, const char *folder, const char *text)
+{
+    static const char suffix[] = "_internal.h";
+    const size_t suffix_len = sizeof suffix - 1;
+    int bad = 0;
+    for (const char *p = text; (p = strstr(p, "#include \"")) != NULL; p += 10) {
+        const char *name = p + 10;
+        const char *quote = strchr(name, '"');
+        const char *newline = strchr(name, '\n');
+        if (quote == NULL || (newline != NULL && newline < quote)) {
+            continue;
+        }
+        size_t len = (size_t)(quote - name);
+        if (len < suffix_len || strncmp(quote - suffix_len, suffix, suffix_len) != 0) {
+            continue;
+        }
+        const char *slash = memchr(name, '/', len);
+        size_t folder_len = slash != NULL ? (size_t)(slash - name) : 0;
+        bool own = folder != NULL && slash != NULL && folder_len == strlen(folder) &&
+                   strncmp(name, folder, folder_len) == 0 &&
+                   memchr(slash + 1, '/', (size_t)(quote - slash - 1)) == NULL;
+        if (!own) {
+            fprintf(stderr, "        %s includes \"%.*s\": a private header of %s\n", rel, (int)len,
+                    name, slash != NULL ? "another folder" : "no named folder");
+            bad++;
+        }
+    }
+    return bad;
+}
+
+// Checks every .c and .h file directly in `dir` (shown as `shown`/NAME), whose
+// own folder is `folder` (NULL: outside src/); counts the files in *files.
+static int check_private_folder(const char *dir, const char *shown, const char *folder, int *files)
+{
+    DIR *d = opendir(dir);
+    if (d == NULL) {
+        fprintf(stderr, "        cannot open %s\n", dir);
+        return 1;
+    }
+    int bad = 0;
+    struct dirent *e;
+    while ((e = readdir(d)) != NULL) {
+        size_t n = strlen(e->d_name);
+        if (n < 3 || e->d_name[n - 2] != '.' ||
+            (e->d_name[n - 1] != 'c' && e->d_name[n - 1] != 'h')) {
+            continue;
+        }
+        char path[4500], rel[300];
+        snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
+        snprintf(rel, sizeof rel, "%s/%s", shown, e->d_name);
+        char *text = source_text(path);
+        if (text == NULL) {
+            bad++;
+            continue;
+        }
+        bad += check_private_headers(rel, folder, text);
+        free(text);
+        ++*files;
+    }
+    closedir(d);
+    return bad;
+}
+
+TEST(private_headers_stay_in_their_folder)
+{
+    int files = 0, bad = 0;
+    char dir[4200];
+    for (int l = 0; l < LAYER_COUNT; ++l) {
+        snprintf(dir, sizeof dir, "%s/../src/%s", ensure_tests_dir(), layers[l].name);
+        bad += check_private_folder(dir, layers[l].name, layers[l].name, &files);
+    }
+    static const char *const outside[] = { "../cli", "../viewer", ".", "bench", "tools" };
+    for (size_t k = 0; k < sizeof outside / sizeof outside[0]; ++k) {
+        snprintf(dir, sizeof dir, "%s/%s", ensure_tests_dir(), outside[k]);
+        bad += check_private_folder(dir, outside[k], NULL, &files);
+    }
+    fprintf(stderr, "        %d files checked for private headers\n", files);
+    ENSURE(files > 80);
+    ENSURE(bad == 0);
+    // The check finds what it is meant to find.
+    const char *text = "#include \"sim/simulate_internal.h\"\n";
+    ENSURE(check_private_headers("sim/step.c", "sim", text) == 0);
+    ENSURE(check_private_headers("gather/x.c", "gather", text) == 1);
+    ENSURE(check_private_headers("cli/main.c", NULL, text) == 1);
+    ENSURE(check_private_headers("sim/x.c", "sim", "#include \"simulate_internal.h\"\n") == 1);
+    ENSURE(check_private_headers("sim/x.c", "sim", "#include \"sim/simulate.h\"\n") == 0);
+}
+// --- end of private headers ----------------------------------------------------------
 
 int main(void)
 {
     RUN(every_layer_includes_only_the_layers_below_it);
     RUN(a_wrong_include_is_caught);
+    RUN(private_headers_stay_in_their_folder);
     return ensure_summary();
 }
