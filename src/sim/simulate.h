@@ -117,9 +117,9 @@ int wx_sim_camera_views(const wx_sim *sim, int camera, int *first);
 /// The input camera (0 = the scene's first) of view `view`, and its layer.
 int wx_sim_view_camera(const wx_sim *sim, int view, int *layer);
 
-/// Adds one particle by hand (the tests and bench_simulate) carrying `load` of the first
-/// substance: it counts as emitted. Its random stream is that of a
-/// pseudo-emitter after the scene's emitters.
+/// Adds one particle by hand (the tests, bench_simulate and bench_layers)
+/// carrying `load` of the first substance: it counts as emitted. Its random
+/// stream is that of a pseudo-emitter after the scene's emitters.
 wx_result wx_sim_spawn(wx_sim *sim, const float position[3], const float velocity[3],
                        float mass, double load, int max_collisions, wx_error *err);
 
