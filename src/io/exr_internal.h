@@ -31,8 +31,8 @@ void wx_exr_stream_unbind(exr_stream *outer);
 void wx_exr_stream_on_error(exr_const_context_t ctxt, exr_result_t code, const char *msg);
 
 // The library's write callback on the stream's file.
-int64_t wx_exr_stream_write(exr_const_context_t ctxt, void *user, const void *buffer,
-                            uint64_t size, uint64_t offset, exr_stream_error_func_ptr_t error_cb);
+int64_t wx_exr_stream_write(exr_const_context_t ctxt, void *user, const void *buffer, uint64_t size,
+                            uint64_t offset, exr_stream_error_func_ptr_t error_cb);
 
 // What went wrong: errno's text, the library's message or its default for rv.
 const char *wx_exr_stream_detail(const exr_stream *s, exr_result_t rv);

@@ -32,21 +32,21 @@ static wx_result check_image(const char *path, const wx_image *image, wx_error *
         image->height > WX_MAP_MAX_SIDE ||
         (long long)image->width * image->height > WX_MAP_MAX_TEXELS) {
         return wx_fail(err, WX_CAUSE_MAP_SIZE, "%s: cannot write a %d x %d image (largest %d x %d)",
-                            path, image->width, image->height, WX_MAP_MAX_SIDE, WX_MAP_MAX_SIDE);
+                       path, image->width, image->height, WX_MAP_MAX_SIDE, WX_MAP_MAX_SIDE);
     }
     if (image->channel_count < 1 || image->channel_count > WX_IMAGE_MAX_CHANNELS) {
         return wx_fail(err, WX_CAUSE_BAD_ARGUMENT, "%s: cannot write %d channels (1 to %d)", path,
-                            image->channel_count, WX_IMAGE_MAX_CHANNELS);
+                       image->channel_count, WX_IMAGE_MAX_CHANNELS);
     }
     for (int c = 0; c < image->channel_count; c++) {
         if (image->channels[c] == NULL || image->channel_names[c][0] == '\0') {
             return wx_fail(err, WX_CAUSE_BAD_ARGUMENT, "%s: channel %d has no %s", path, c,
-                                image->channels[c] == NULL ? "pixels" : "name");
+                           image->channels[c] == NULL ? "pixels" : "name");
         }
         for (int d = 0; d < c; d++) {
             if (strcmp(image->channel_names[c], image->channel_names[d]) == 0) {
                 return wx_fail(err, WX_CAUSE_BAD_ARGUMENT, "%s: channel %s appears twice", path,
-                                    image->channel_names[c]);
+                               image->channel_names[c]);
             }
         }
     }
@@ -65,8 +65,8 @@ typedef struct chunk_encoder {
 
 // One encoded chunk, kept until it is written in file order.
 typedef struct chunk_slot {
-    int y;          ///< first scanline
-    void *data;     ///< malloc'd copy of the compressed (or raw) chunk
+    int y;      ///< first scanline
+    void *data; ///< malloc'd copy of the compressed (or raw) chunk
     uint64_t bytes;
     exr_result_t rv;
 } chunk_slot;
@@ -92,8 +92,8 @@ static exr_result_t keep_chunk(exr_encode_pipeline_t *enc)
 {
     chunk_encoder *worker = enc->encoding_user_data;
     chunk_slot *slot = worker->slot;
-    const void *bytes = enc->compressed_buffer != NULL ? enc->compressed_buffer
-                                                       : enc->packed_buffer;
+    const void *bytes =
+        enc->compressed_buffer != NULL ? enc->compressed_buffer : enc->packed_buffer;
     uint64_t size = enc->compressed_buffer != NULL ? enc->compressed_bytes : enc->packed_bytes;
     slot->data = malloc(size > 0 ? (size_t)size : 1);
     if (slot->data == NULL) {
@@ -108,7 +108,7 @@ static wx_result write_failed(const char *path, const exr_stream *s, exr_result_
                               const char *what, wx_error *err)
 {
     return wx_fail(err, WX_CAUSE_IO, "%s: cannot write%s%s (%s)", path, what[0] ? " " : "", what,
-                        wx_exr_stream_detail(s, rv));
+                   wx_exr_stream_detail(s, rv));
 }
 
 static exr_compression_t exr_compression(wx_exr_compression c)
@@ -208,8 +208,8 @@ static exr_result_t write_chunks(exr_context_t ctx, int part, int lines, const w
     chunk_batch batch = { .ctx = ctx, .part = part, .image = image };
     batch.workers = calloc((size_t)threads, sizeof *batch.workers);
     batch.slots = calloc((size_t)batch_size, sizeof *batch.slots);
-    exr_result_t rv = batch.workers != NULL && batch.slots != NULL ? EXR_ERR_SUCCESS
-                                                                   : EXR_ERR_OUT_OF_MEMORY;
+    exr_result_t rv =
+        batch.workers != NULL && batch.slots != NULL ? EXR_ERR_SUCCESS : EXR_ERR_OUT_OF_MEMORY;
     for (int first = 0; rv == EXR_ERR_SUCCESS && first < chunk_count; first += batch_size) {
         int n = chunk_count - first < batch_size ? chunk_count - first : batch_size;
         for (int k = 0; k < n; ++k) {
@@ -304,8 +304,8 @@ static wx_result write_body(exr_stream *s, const char *path, const char *tmp_pat
         }
         if (rv != EXR_ERR_SUCCESS) {
             exr_finish(&ctx);
-            return wx_fail(err, WX_CAUSE_IO, "%s: cannot write attribute %s (%s)", path,
-                                attr->name, wx_exr_stream_detail(s, rv));
+            return wx_fail(err, WX_CAUSE_IO, "%s: cannot write attribute %s (%s)", path, attr->name,
+                           wx_exr_stream_detail(s, rv));
         }
     }
     rv = exr_write_header(ctx);
@@ -353,7 +353,7 @@ wx_result wx_exr_write(const char *path, const wx_image *image, wx_error *err)
     s.fd = open(tmp_path, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
     if (s.fd < 0) {
         return wx_fail(err, WX_CAUSE_IO, "%s: cannot create %s (%s)", path, tmp_path,
-                            strerror(errno));
+                       strerror(errno));
     }
     exr_stream *outer = wx_exr_stream_bind(&s);
     result = write_body(&s, path, tmp_path, image, err);

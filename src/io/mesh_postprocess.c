@@ -33,8 +33,8 @@ enum {
 
 bool wx_mesh_is_triangle(const struct aiFace *f, unsigned vertex_count)
 {
-    return f->mNumIndices == 3 && f->mIndices[0] < vertex_count &&
-           f->mIndices[1] < vertex_count && f->mIndices[2] < vertex_count;
+    return f->mNumIndices == 3 && f->mIndices[0] < vertex_count && f->mIndices[1] < vertex_count &&
+           f->mIndices[2] < vertex_count;
 }
 
 void wx_mesh_prep_free(wx_mesh_prep *p)
@@ -194,9 +194,9 @@ static void smooth_position(const uint32_t *members, size_t count, const float *
     }
     float mean[CELLS][3];
     for (int c = 0; c < CELLS; ++c) {
-        double len = sqrt(cell_sum[3 * c] * cell_sum[3 * c] +
-                          cell_sum[3 * c + 1] * cell_sum[3 * c + 1] +
-                          cell_sum[3 * c + 2] * cell_sum[3 * c + 2]);
+        double len =
+            sqrt(cell_sum[3 * c] * cell_sum[3 * c] + cell_sum[3 * c + 1] * cell_sum[3 * c + 1] +
+                 cell_sum[3 * c + 2] * cell_sum[3 * c + 2]);
         for (int k = 0; k < 3; ++k) {
             mean[c][k] = len > 0.0 ? (float)(cell_sum[3 * c + k] / len) : 0.0f;
         }
@@ -234,7 +234,7 @@ static bool smooth_normals(const struct aiMesh *mesh, float *normal)
     const size_t V = mesh->mNumVertices;
     uint32_t *group = malloc(V * sizeof *group);       // vertex -> position
     uint32_t *distinct = malloc(V * sizeof *distinct); // vertex -> (position, normal)
-    float *face = calloc(3 * V, sizeof *face);          // vertex -> its last face's normal
+    float *face = calloc(3 * V, sizeof *face);         // vertex -> its last face's normal
     uint32_t *rep = malloc(V * sizeof *rep);           // position -> a vertex there
     float *dnormal = malloc(3 * V * sizeof *dnormal);  // distinct -> its face normal
     uint32_t *dgroup = malloc(V * sizeof *dgroup);
@@ -244,9 +244,9 @@ static bool smooth_normals(const struct aiMesh *mesh, float *normal)
     float *smoothed = malloc(3 * V * sizeof *smoothed);
     double *cell_sum = malloc(3 * 6 * PREP_CELLS * PREP_CELLS * sizeof *cell_sum);
     id_table table = { 0 };
-    bool ok = group != NULL && distinct != NULL && face != NULL && rep != NULL &&
-              dnormal != NULL && dgroup != NULL && dcount != NULL && start != NULL &&
-              members != NULL && smoothed != NULL && cell_sum != NULL && table_init(&table, V);
+    bool ok = group != NULL && distinct != NULL && face != NULL && rep != NULL && dnormal != NULL &&
+              dgroup != NULL && dcount != NULL && start != NULL && members != NULL &&
+              smoothed != NULL && cell_sum != NULL && table_init(&table, V);
     uint32_t groups = 0, distincts = 0;
     for (unsigned f = 0; ok && f < mesh->mNumFaces; ++f) {
         const struct aiFace *fc = &mesh->mFaces[f];
@@ -376,7 +376,7 @@ static bool same_vertex(const struct aiMesh *mesh, unsigned a, unsigned b, unsig
 // False when out of memory; a mesh of more corners than 32 bits hold is
 // reported through *too_many.
 bool wx_mesh_prepare(const struct aiMesh *mesh, unsigned uv_channels, wx_mesh_prep *out,
-                         bool *too_many)
+                     bool *too_many)
 {
     memset(out, 0, sizeof *out);
     out->done = true;
@@ -393,9 +393,8 @@ bool wx_mesh_prepare(const struct aiMesh *mesh, unsigned uv_channels, wx_mesh_pr
     }
     const size_t corners = 3 * tris;
     uint32_t *tri_face = malloc(tris * sizeof *tri_face);
-    float *normal = mesh->mNormals == NULL
-                        ? malloc(3 * (size_t)mesh->mNumVertices * sizeof *normal)
-                        : NULL;
+    float *normal =
+        mesh->mNormals == NULL ? malloc(3 * (size_t)mesh->mNumVertices * sizeof *normal) : NULL;
     out->corner = malloc(corners * sizeof *out->corner);
     out->source = malloc(corners * sizeof *out->source);
     out->normal = malloc(3 * corners * sizeof *out->normal);

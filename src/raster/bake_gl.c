@@ -22,14 +22,14 @@ static wx_result gl_check(const char *what, wx_error *err)
     }
     while (glGetError() != GL_NO_ERROR) {
     }
-    const char *name = e == GL_OUT_OF_MEMORY          ? "out of memory"
-                       : e == GL_INVALID_VALUE         ? "invalid value"
-                       : e == GL_INVALID_OPERATION     ? "invalid operation"
-                       : e == GL_INVALID_ENUM          ? "invalid enum"
+    const char *name = e == GL_OUT_OF_MEMORY                   ? "out of memory"
+                       : e == GL_INVALID_VALUE                 ? "invalid value"
+                       : e == GL_INVALID_OPERATION             ? "invalid operation"
+                       : e == GL_INVALID_ENUM                  ? "invalid enum"
                        : e == GL_INVALID_FRAMEBUFFER_OPERATION ? "invalid framebuffer operation"
                                                                : "error";
     return wx_fail(err, WX_CAUSE_RENDERER, "bake: OpenGL %s (0x%04x) while %s", name, (unsigned)e,
-                        what);
+                   what);
 }
 
 // ---------------------------------------------------------------------------
@@ -136,7 +136,7 @@ wx_result bake_create_context(baker *b, wx_error *err)
     glGetIntegerv(GL_MAX_DRAW_BUFFERS, &draw_buffers);
     if (draw_buffers < TARGET_COUNT) {
         return wx_fail(err, WX_CAUSE_RENDERER, "bake: the GL driver has %d draw buffers, %d needed",
-                            (int)draw_buffers, TARGET_COUNT);
+                       (int)draw_buffers, TARGET_COUNT);
     }
     wx_result r = create_program(b, err);
     if (r != WX_OK) {
@@ -165,10 +165,9 @@ static wx_result ensure_framebuffer(baker *b, int width, int height, wx_error *e
     for (int t = 0; t <= TARGET_COUNT; ++t) {
         glBindRenderbuffer(GL_RENDERBUFFER, b->renderbuffers[t]);
         glRenderbufferStorage(GL_RENDERBUFFER, formats[t], width, height);
-        GLenum attachment = t < TARGET_COUNT ? (GLenum)(GL_COLOR_ATTACHMENT0 + t)
-                                             : GL_DEPTH_ATTACHMENT;
-        glFramebufferRenderbuffer(GL_FRAMEBUFFER, attachment, GL_RENDERBUFFER,
-                                  b->renderbuffers[t]);
+        GLenum attachment =
+            t < TARGET_COUNT ? (GLenum)(GL_COLOR_ATTACHMENT0 + t) : GL_DEPTH_ATTACHMENT;
+        glFramebufferRenderbuffer(GL_FRAMEBUFFER, attachment, GL_RENDERBUFFER, b->renderbuffers[t]);
     }
     wx_result r = gl_check("allocating the float framebuffer", err);
     if (r != WX_OK) {
@@ -257,7 +256,7 @@ static GLuint upload_and_free(GLenum target, size_t bytes, void *data)
 // per-vertex attribute: every vertex belongs to triangles of one material
 // (mesh.h).
 wx_result bake_upload_mesh(baker *b, wx_mesh_data *mesh, const float *props, gpu_mesh *g,
-                             wx_error *err)
+                           wx_error *err)
 {
     size_t nv = (size_t)mesh->vertex_count, nt = (size_t)mesh->triangle_count;
     if (nt * 3 > (size_t)INT32_MAX) {
@@ -267,7 +266,7 @@ wx_result bake_upload_mesh(baker *b, wx_mesh_data *mesh, const float *props, gpu
     }
     if ((size_t)mesh->material_count * 2 > (size_t)b->max_texture_buffer) {
         return wx_fail(err, WX_CAUSE_BAD_MESH, "%d materials are more than the renderer takes",
-                            mesh->material_count);
+                       mesh->material_count);
     }
     uint16_t *vertex_material = malloc((nv > 0 ? nv : 1) * sizeof *vertex_material);
     if (vertex_material == NULL) {
@@ -300,14 +299,13 @@ wx_result bake_upload_mesh(baker *b, wx_mesh_data *mesh, const float *props, gpu
     g->materials = upload_and_free(GL_ARRAY_BUFFER, nv * sizeof(uint16_t), vertex_material);
     glVertexAttribIPointer(3, 1, GL_UNSIGNED_SHORT, 0, NULL);
     glEnableVertexAttribArray(3);
-    g->indices = upload_and_free(GL_ELEMENT_ARRAY_BUFFER, nt * 3 * sizeof(uint32_t),
-                                 mesh->indices);
+    g->indices = upload_and_free(GL_ELEMENT_ARRAY_BUFFER, nt * 3 * sizeof(uint32_t), mesh->indices);
     mesh->indices = NULL;
     g->index_count = (GLsizei)(nt * 3);
     glBindVertexArray(0);
 
-    g->material_props = upload_buffer(GL_TEXTURE_BUFFER,
-                                      (size_t)mesh->material_count * 8 * sizeof(float), props);
+    g->material_props =
+        upload_buffer(GL_TEXTURE_BUFFER, (size_t)mesh->material_count * 8 * sizeof(float), props);
     glGenTextures(1, &g->props_texture);
     glBindTexture(GL_TEXTURE_BUFFER, g->props_texture);
     glTexBuffer(GL_TEXTURE_BUFFER, GL_RGBA32F, g->material_props);
@@ -392,8 +390,7 @@ wx_result bake_draw_camera(baker *b, int c, int targets, int layer, wx_error *er
 
 // Reads colour target `target` (`channels` floats per texel) in strips and
 // scatters its channels into planes, flipping rows: GL row y is EXR row H-1-y.
-wx_result bake_read_target(baker *b, int target, int channels, const plane_out *out,
-                             wx_error *err)
+wx_result bake_read_target(baker *b, int target, int channels, const plane_out *out, wx_error *err)
 {
     int width = b->fb_width, height = b->fb_height;
     size_t row_floats = (size_t)width * (size_t)channels;

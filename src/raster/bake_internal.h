@@ -32,7 +32,7 @@ enum {
 typedef struct gpu_mesh {
     GLuint vao;
     GLuint positions, normals, colors, materials, indices; // vertex and index buffers
-    GLuint material_props; // behind props_texture
+    GLuint material_props;                                 // behind props_texture
     GLuint props_texture;
     GLsizei index_count;
     double origin[3];
@@ -40,14 +40,14 @@ typedef struct gpu_mesh {
 
 // What the bake knows of one scene camera.
 typedef struct cam_state {
-    bool bake;         // rendered here
-    double d_min;      // depth range of all vertices
+    bool bake;    // rendered here
+    double d_min; // depth range of all vertices
     double d_max;
-    int layers;        // the layers baked (cam_layers), or those of the given depth
-    float *depth;      // depth planes (one per layer, one after the other) kept for the
-                       // initial-dirt visibility test, or NULL
-    float *normal;     // with more than one layer: each layer's outward normals,
-                       // 3 interleaved floats per texel, one layer after the other
+    int layers;    // the layers baked (cam_layers), or those of the given depth
+    float *depth;  // depth planes (one per layer, one after the other) kept for the
+                   // initial-dirt visibility test, or NULL
+    float *normal; // with more than one layer: each layer's outward normals,
+                   // 3 interleaved floats per texel, one layer after the other
     int depth_width;
     int depth_height;
 } cam_state;
@@ -63,7 +63,7 @@ typedef struct baker {
     const wx_bake_def *def;
     wx_bake_stats *stats;
     OSMesaContext context;
-    bool current;    // the context is current: GL objects may be deleted
+    bool current; // the context is current: GL objects may be deleted
     unsigned char context_buffer[16 * 16 * 4];
     GLuint program;
     GLint loc_wtc, loc_depth_range, loc_depth_row, loc_view_dir, loc_outward, loc_peel;
@@ -114,8 +114,7 @@ wx_result bake_draw_camera(baker *b, int c, int targets, int layer, wx_error *er
 wx_result bake_keep_previous_layer(baker *b, wx_error *err);
 
 // bake_gl.c: reads colour target `target` back into planes, in EXR row order.
-wx_result bake_read_target(baker *b, int target, int channels, const plane_out *out,
-                           wx_error *err);
+wx_result bake_read_target(baker *b, int target, int channels, const plane_out *out, wx_error *err);
 
 // bake_gl.c: deletes the GL objects and the context.
 void bake_release_gl(baker *b);

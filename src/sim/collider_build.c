@@ -195,7 +195,7 @@ wx_result wx_collider_init(wx_collider *collider, const wx_camera *cameras, cons
     memset(collider, 0, sizeof *collider);
     if (count > WX_MAX_INPUT_CAMERAS) {
         return wx_fail(err, WX_CAUSE_TOO_MANY, "%d input cameras; the collider takes at most %d",
-                            count, WX_MAX_INPUT_CAMERAS);
+                       count, WX_MAX_INPUT_CAMERAS);
     }
     collider->nearest = nearest;
     collider->cameras = calloc(count > 0 ? (size_t)count : 1, sizeof *collider->cameras);
@@ -232,8 +232,8 @@ wx_result wx_collider_init(wx_collider *collider, const wx_camera *cameras, cons
         if (layers > WX_MAX_LAYERS) {
             wx_collider_free(collider);
             return wx_fail(err, WX_CAUSE_BAD_ARGUMENT,
-                           "input camera %d: %d layers; the collider takes at most %d", c,
-                           layers, WX_MAX_LAYERS);
+                           "input camera %d: %d layers; the collider takes at most %d", c, layers,
+                           WX_MAX_LAYERS);
         }
         size_t texels = (size_t)m->width * (size_t)m->height;
         cam->layers = layers;
@@ -257,9 +257,9 @@ wx_result wx_collider_init(wx_collider *collider, const wx_camera *cameras, cons
             // float rounding and to bridge the steps the silhouette rule leaves
             // along a sheet's edge, thin enough that a hit from behind lies
             // within half the collider's precision (half a texel) of the sheet.
-            double bl = sqrt((double)cam->back[0] * cam->back[0] +
-                             (double)cam->back[1] * cam->back[1] +
-                             (double)cam->back[2] * cam->back[2]);
+            double bl =
+                sqrt((double)cam->back[0] * cam->back[0] + (double)cam->back[1] * cam->back[1] +
+                     (double)cam->back[2] * cam->back[2]);
             cam->sheet = 0.25 * cam->texel_ws / bl;
             classify_layers(cam);
         }

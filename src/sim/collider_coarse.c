@@ -87,13 +87,13 @@ WX_INLINE int coarse_lane(const coarse_geometry *g, float x0, float y0, float z0
     int xi = (int)abs_clamped(X0, 1e9f), yi = (int)abs_clamped(Y0, 1e9f);
     // (Written out level by level: an inner loop keeps gcc from vectorising.)
     int chosen = 0, found = 0;
-#define WX_COARSE_PICK(l)                                                                  \
-    {                                                                                      \
-        int shift = WX_COARSE_BLOCK_SHIFT + WX_COARSE_LEVEL_SHIFT * (l);                   \
-        int fits = ((reach + 2) <= (1 << shift)) & !found;                                 \
-        int here = g->offset##l + (yi >> shift) * g->width##l + (xi >> shift);             \
-        chosen = fits ? here : chosen;                                                     \
-        found |= fits;                                                                     \
+#define WX_COARSE_PICK(l)                                                                          \
+    {                                                                                              \
+        int shift = WX_COARSE_BLOCK_SHIFT + WX_COARSE_LEVEL_SHIFT * (l);                           \
+        int fits = ((reach + 2) <= (1 << shift)) & !found;                                         \
+        int here = g->offset##l + (yi >> shift) * g->width##l + (xi >> shift);                     \
+        chosen = fits ? here : chosen;                                                             \
+        found |= fits;                                                                             \
     }
     WX_COARSE_PICK(0)
     WX_COARSE_PICK(1)
@@ -103,25 +103,23 @@ WX_INLINE int coarse_lane(const coarse_geometry *g, float x0, float y0, float z0
 #undef WX_COARSE_PICK
     *usable = in & found;
     *index = *usable ? chosen : 0;
-    float slack = g->slack_base + g->slack_scale * (fabsf(x0) + fabsf(y0) + fabsf(z0) +
-                                                    fabsf(x1) + fabsf(y1) + fabsf(z1));
+    float slack = g->slack_base + g->slack_scale * (fabsf(x0) + fabsf(y0) + fabsf(z0) + fabsf(x1) +
+                                                    fabsf(y1) + fabsf(z1));
     *dmax = max_arith(D0, D1) + slack;
     return out;
 }
 
 _Static_assert(WX_PARTICLE_BLOCK == 16, "lane_bit below has 16 entries");
 
-WX_HOT uint32_t wx_collider_coarse_block(const wx_collider *collider, const int *cams,
-                                         int count, uint32_t *restrict credit,
-                                         const float *restrict x0, const float *restrict y0,
-                                         const float *restrict z0, const float *restrict x1,
-                                         const float *restrict y1, const float *restrict z1,
-                                         uint32_t *restrict outside)
+WX_HOT uint32_t wx_collider_coarse_block(const wx_collider *collider, const int *cams, int count,
+                                         uint32_t *restrict credit, const float *restrict x0,
+                                         const float *restrict y0, const float *restrict z0,
+                                         const float *restrict x1, const float *restrict y1,
+                                         const float *restrict z1, uint32_t *restrict outside)
 {
     enum { B = WX_PARTICLE_BLOCK };
-    static const uint32_t lane_bit[B] = { 1u << 0,  1u << 1,  1u << 2,  1u << 3,
-                                          1u << 4,  1u << 5,  1u << 6,  1u << 7,
-                                          1u << 8,  1u << 9,  1u << 10, 1u << 11,
+    static const uint32_t lane_bit[B] = { 1u << 0,  1u << 1,  1u << 2,  1u << 3, 1u << 4,  1u << 5,
+                                          1u << 6,  1u << 7,  1u << 8,  1u << 9, 1u << 10, 1u << 11,
                                           1u << 12, 1u << 13, 1u << 14, 1u << 15 };
     const uint32_t all = (1u << B) - 1u;
     uint32_t cleared = 0, out_all = all;
@@ -132,8 +130,8 @@ WX_HOT uint32_t wx_collider_coarse_block(const wx_collider *collider, const int 
         int idx[B], usable[B], out[B];
         float dmax[B];
         for (int k = 0; k < B; ++k) {
-            out[k] = coarse_lane(&g, x0[k], y0[k], z0[k], x1[k], y1[k], z1[k], &usable[k],
-                                 &idx[k], &dmax[k]);
+            out[k] = coarse_lane(&g, x0[k], y0[k], z0[k], x1[k], y1[k], z1[k], &usable[k], &idx[k],
+                                 &dmax[k]);
         }
         float least[B];
         for (int k = 0; k < B; ++k) {
@@ -170,8 +168,7 @@ bool wx_collider_coarse_clear(const wx_collider *collider, const float p0[3], co
         coarse_geometry g = coarse_setup(cam);
         int usable, index;
         float dmax;
-        int out = coarse_lane(&g, p0[0], p0[1], p0[2], p1[0], p1[1], p1[2], &usable, &index,
-                              &dmax);
+        int out = coarse_lane(&g, p0[0], p0[1], p0[2], p1[0], p1[1], p1[2], &usable, &index, &dmax);
         outside &= out != 0;
         if ((usable && dmax < cam->coarse[index]) || (out && cam->frames_model)) {
             return true;
