@@ -5,9 +5,10 @@
 // cameras in their colours and the particles, and come out the same on every
 // run; bad input gives exit status 2 and names the file, without any display.
 //
-// The viewer's GL-free parts are compiled in here and checked against numbers
-// worked out by hand: the geometry drawn for the thesis scene, when maps must
-// be baked again, the nearest-point-per-pixel filter and the initial view.
+// The viewer's GL-free parts (linked from its library) are checked against
+// numbers worked out by hand: the geometry drawn for the thesis scene, when
+// maps must be baked again, the nearest-point-per-pixel filter and the
+// initial view.
 // With several substances (the thesis scene with <Substances> water, dirt,
 // rust): S walks through them and wraps, particles are coloured by their load
 // of the shown one (scaled by its emitter load), depth samples by its amount
@@ -23,8 +24,10 @@
 // layers darker, L's cycle, hits' views, masks per layer, and G and a reload
 // keeping every layer; with one layer per camera, nothing changes.
 #include <fcntl.h>
+#include <math.h>
 #include <png.h>
 #include <stdint.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -32,9 +35,9 @@
 #include <unistd.h>
 
 #include "../viewer/palette.h"
-#include "../viewer/points.c"
-#include "../viewer/view.c"
-#include "../viewer/world.c"
+#include "../viewer/points.h"
+#include "../viewer/view.h"
+#include "../viewer/world_internal.h"
 #include "ensure.h"
 #include "io/exr.h"
 #include "model/camera.h"
@@ -937,12 +940,12 @@ TEST(masks_cycle_and_colour_the_depth_samples)
         int k = i / 4, pair = i % 4;
         fake[i] = i >= 20000 ? NAN : pair >= 2 ? 0.0f : (float)(k + 1) * (pair ? -1.0f : 1.0f);
     }
-    ENSURE(mask_scale(&w, 2, fake) == 4900.0f);
+    ENSURE(vw_world_mask_scale(&w, 2, fake) == 4900.0f);
     for (int i = 0; i < w.point_count; ++i) {
         fake[i] = i == 5 ? -0.25f : i % 3 ? 0.0f : NAN; // one curved sample among flat ones
     }
-    ENSURE(mask_scale(&w, 2, fake) == 0.25f);
-    ENSURE(mask_scale(&w, 0, fake) == 1.0f); // not Curvature
+    ENSURE(vw_world_mask_scale(&w, 2, fake) == 0.25f);
+    ENSURE(vw_world_mask_scale(&w, 0, fake) == 1.0f); // not Curvature
     free(fake);
 
     // Colours: step's samples at the ends of the ramp, unshaded; Curvature's
@@ -1027,7 +1030,7 @@ TEST(masks_at_sparse_samples)
     free(w.camera_lines);
     free(w.camera_points);
     free(w.layer_points);
-    ENSURE(build_geometry_within(&w, 40000, &err) == WX_OK);
+    ENSURE(vw_world_build_geometry_within(&w, 40000, &err) == WX_OK);
     ENSURE(w.sample_stride == 3);
     ENSURE(vw_world_show_mask(&w, 1, &err) == WX_OK);
     ENSURE(vw_world_show_mask(&w, 2, &err) == WX_OK);
