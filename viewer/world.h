@@ -139,8 +139,10 @@ int64_t vw_world_total_steps(const vw_world *world);
 bool vw_world_finished(const vw_world *world);
 
 /// Writes <camera>_dirt.exr for every input camera and, when the scene has an
-/// output camera, gathers the mask; `saved` receives the mask's path (or the
-/// output folder when there is no output camera).
+/// output camera, gathers the mask from the simulation in memory
+/// (wx_gather_simulation: the bytes a gather of those files writes); `saved`
+/// receives the mask's path (or the output folder when there is no output
+/// camera).
 wx_result vw_world_gather(vw_world *world, char saved[WX_PATH_MAX], wx_error *err);
 
 /// Layers of scene camera c's maps (1: not layered).

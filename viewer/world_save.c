@@ -1,10 +1,10 @@
 // world_save.c: saving a world's simulation (world.h, G and --gather): the
-// dirt maps written and the mask gathered.
+// dirt maps written and the mask gathered from the simulation in memory
+// (the same bytes as a gather of the dirt maps just written).
 #include "world_internal.h"
 
 #include <stdio.h>
 
-#include "pipeline/gather_phase.h"
 #include "pipeline/outputs.h"
 #include "pipeline/simulate_phase.h"
 
@@ -19,7 +19,7 @@ wx_result vw_world_gather(vw_world *world, char saved[WX_PATH_MAX], wx_error *er
         return r;
     }
     const wx_scene_camera *out = &world->scene.cameras[world->scene.output_index];
-    r = wx_gather_scene(&world->scene, &world->opts, err);
+    r = wx_gather_simulation(&world->scene, &world->opts, world->sim, world->maps, err);
     if (r == WX_OK) {
         r = wx_output_path(&world->scene, &world->opts, out->output_file, saved, err);
     }
