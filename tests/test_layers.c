@@ -168,9 +168,97 @@ TEST(a_wrong_include_is_caught)
     ENSURE(check_no_file_io("sim/x.c", "wx_pool_open(x);") == 0);
 }
 
+// --- viewer/ --------------------------------------------------------------------------
+// The viewer sits on the library: its files may include core, model, io, sim
+// and pipeline headers (no raster: it bakes through a child `weathering bake`;
+// no gather: it gathers through the pipeline). Only viewer/gl.h includes
+// OpenGL's headers and only viewer/app.h GLFW's; none includes another
+// third-party library. Its world (world*), view, point filter and bake child
+// are GL-free: they include no GL or window header of the viewer, so that
+// test_viewer links them without a window.
+
+static const layer viewer_layer = { "viewer", "core model io sim pipeline" };
+
+// Viewer files (by name prefix) that stay GL-free, and the viewer's headers
+// that bring GL or the window in.
+static const char *const viewer_gl_free[] = { "world", "view.", "points.", "bake_child." };
+static const char *const viewer_gl_headers[] = { "#include \"gl.h\"", "#include \"app.h\"",
+                                                 "#include \"draw.h\"", "#include \"overlay.h\"",
+                                                 "#include \"screenshot.h\"" };
+
+// The violations of the viewer's rules in one of its files (`name` in viewer/).
+static int check_viewer_file(const char *name, const char *text)
+{
+    char rel[300];
+    snprintf(rel, sizeof rel, "viewer/%s", name);
+    int bad = check_includes(rel, text, &viewer_layer);
+    bad += check_library(rel, text, "<GL/", "viewer/gl.h");
+    bad += check_library(rel, text, "<GLFW/", "viewer/app.h");
+    bad += check_library(rel, text, "<libxml/", "io/scene_xml.c");
+    bad += check_library(rel, text, "<assimp/", "io/mesh_import.c");
+    bad += check_library(rel, text, "<openexr.h>", "io/exr.c");
+    bad += check_library(rel, text, "<png.h>", "io/png_preview.c");
+    for (size_t k = 0; k < sizeof viewer_gl_free / sizeof viewer_gl_free[0]; ++k) {
+        if (strncmp(name, viewer_gl_free[k], strlen(viewer_gl_free[k])) != 0) {
+            continue;
+        }
+        for (size_t h = 0; h < sizeof viewer_gl_headers / sizeof viewer_gl_headers[0]; ++h) {
+            if (strstr(text, viewer_gl_headers[h]) != NULL) {
+                fprintf(stderr, "        %s (GL-free) has %s\n", rel, viewer_gl_headers[h]);
+                bad++;
+            }
+        }
+    }
+    return bad;
+}
+
+TEST(the_viewer_includes_only_the_library_and_its_world_no_gl)
+{
+    char folder[4200];
+    snprintf(folder, sizeof folder, "%s/../viewer", ensure_tests_dir());
+    DIR *dir = opendir(folder);
+    ENSURE(dir != NULL);
+    int files = 0, bad = 0;
+    struct dirent *e;
+    while ((e = readdir(dir)) != NULL) {
+        size_t n = strlen(e->d_name);
+        if (n < 3 || e->d_name[n - 2] != '.' ||
+            (e->d_name[n - 1] != 'c' && e->d_name[n - 1] != 'h')) {
+            continue;
+        }
+        char path[4500];
+        snprintf(path, sizeof path, "%s/%s", folder, e->d_name);
+        char *text = source_text(path);
+        if (text == NULL) {
+            bad++;
+            continue;
+        }
+        bad += check_viewer_file(e->d_name, text);
+        free(text);
+        files++;
+    }
+    closedir(dir);
+    fprintf(stderr, "        %d files in viewer/\n", files);
+    ENSURE(files > 20);
+    ENSURE(bad == 0);
+}
+
+// The viewer's check finds what it is meant to find.
+TEST(a_wrong_viewer_include_is_caught)
+{
+    ENSURE(check_viewer_file("world_x.c", "#include \"gl.h\"\n") == 1);
+    ENSURE(check_viewer_file("keys.c", "#include \"gl.h\"\n#include \"app.h\"\n") == 0);
+    ENSURE(check_viewer_file("keys.c", "#include \"raster/bake.h\"\n") == 1);
+    ENSURE(check_viewer_file("keys.c", "#include <GLFW/glfw3.h>\n") == 1);
+    ENSURE(check_viewer_file("app.h", "#include <GLFW/glfw3.h>\n") == 0);
+    ENSURE(check_viewer_file("draw.c", "#include <GL/osmesa.h>\n") == 1);
+}
+
 int main(void)
 {
     RUN(every_layer_includes_only_the_layers_below_it);
     RUN(a_wrong_include_is_caught);
+    RUN(the_viewer_includes_only_the_library_and_its_world_no_gl);
+    RUN(a_wrong_viewer_include_is_caught);
     return ensure_summary();
 }
