@@ -1370,8 +1370,8 @@ static int gather_both_ways(const vw_settings *settings, const char *name, int *
 {
     static vw_world w;
     wx_error err = { 0 };
-    bool ok = vw_world_parse(&w, settings, &err) == WX_OK &&
-              vw_world_finish(&w, settings, &err) == WX_OK;
+    bool ok =
+        vw_world_parse(&w, settings, &err) == WX_OK && vw_world_finish(&w, settings, &err) == WX_OK;
     for (int s = 0; ok && s < 20; ++s) {
         ok = wx_sim_step(w.sim, &err) == WX_OK;
     }
@@ -1428,7 +1428,8 @@ static bool write_output_maps(const char *dir)
 static const char *layered_scene_with_output(char out_dir[4200])
 {
     const char *tmp = ensure_tmpdir();
-    const char *mesh = ensure_write_file(tmp, "layered.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    const char *mesh =
+        ensure_write_file(tmp, "layered.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
     const char *scene = ensure_write_file(
         tmp, "layered_output.xml",
         "<Weathering>\n"

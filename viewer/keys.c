@@ -33,7 +33,8 @@ static void toggle_camera(vw_app *a, int c)
     }
     a->camera_visible[c] = !a->camera_visible[c];
     const wx_scene_camera *cam = &a->world->scene.cameras[c];
-    vw_app_report(a, false, "camera %d '%s' %s", c + 1, cam->name, a->camera_visible[c] ? "on" : "off");
+    vw_app_report(a, false, "camera %d '%s' %s", c + 1, cam->name,
+                  a->camera_visible[c] ? "on" : "off");
 }
 
 // L: the next layer shown (every layer's samples, then each layer's alone).
@@ -41,14 +42,15 @@ static void next_layer(vw_app *a)
 {
     const vw_world *w = a->world;
     if (w->max_layers <= 1) {
-        vw_app_report(a, false, "every camera has one layer: nothing to cycle (layers=\"K\" on an "
-                         "<Ortho> bakes more)");
+        vw_app_report(a, false,
+                      "every camera has one layer: nothing to cycle (layers=\"K\" on an "
+                      "<Ortho> bakes more)");
         return;
     }
     a->show.layer = vw_world_next_layer(w, a->show.layer);
     if (a->show.layer < 0) {
         vw_app_report(a, false, "depth samples and hits of all %d layers (deeper ones darker)",
-               w->max_layers);
+                      w->max_layers);
         return;
     }
     int samples = 0, cameras = 0;
@@ -56,9 +58,9 @@ static void next_layer(vw_app *a)
         samples += vw_world_layer_points(w, c, a->show.layer).count;
         cameras += a->show.layer < vw_world_camera_layers(w, c);
     }
-    vw_app_report(a, false, "layer %d of 0-%d only: %d depth samples of %d camera%s%s", a->show.layer,
-           w->max_layers - 1, samples, cameras, cameras == 1 ? "" : "s",
-           a->show.layer == 0 ? " (the first surface each ray meets)" : "");
+    vw_app_report(a, false, "layer %d of 0-%d only: %d depth samples of %d camera%s%s",
+                  a->show.layer, w->max_layers - 1, samples, cameras, cameras == 1 ? "" : "s",
+                  a->show.layer == 0 ? " (the first surface each ray meets)" : "");
 }
 
 static void next_substance(vw_app *a)
@@ -71,8 +73,8 @@ static void next_substance(vw_app *a)
     }
     vw_world_next_substance(w);
     vw_app_report(a, false,
-           "showing substance %d/%d, %s: on particles (full colour at load %g) and deposits",
-           w->substance + 1, count, vw_world_substance_name(w), (double)w->load_scale);
+                  "showing substance %d/%d, %s: on particles (full colour at load %g) and deposits",
+                  w->substance + 1, count, vw_world_substance_name(w), (double)w->load_scale);
 }
 
 // M: the next derived mask on the depth samples (off after the last); one not

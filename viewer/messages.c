@@ -134,7 +134,7 @@ void vw_app_report_mask(vw_app *a, double seconds)
     int m = w->mask;
     if (m < 0) {
         vw_app_report(a, false, "mask off: depth samples in their cameras' colours%s",
-               vw_world_shows_deposits(w) ? ", tinted by the substance shown" : "");
+                      vw_world_shows_deposits(w) ? ", tinted by the substance shown" : "");
         return;
     }
     char took[64] = "";
@@ -143,14 +143,15 @@ void vw_app_report_mask(vw_app *a, double seconds)
     }
     const wx_mask_def *md = &w->scene.masks[m];
     if (md->kind == WX_MASK_CURVATURE) {
-        vw_app_report(a, false,
-               "mask %s %d/%d (curvature) on the depth samples: blue concave, grey flat, red "
-               "convex, full colour at |curvature| %.3g per unit (99th percentile)%s",
-               md->name, m + 1, w->scene.mask_count, (double)w->mask_scale[m], took);
+        vw_app_report(
+            a, false,
+            "mask %s %d/%d (curvature) on the depth samples: blue concave, grey flat, red "
+            "convex, full colour at |curvature| %.3g per unit (99th percentile)%s",
+            md->name, m + 1, w->scene.mask_count, (double)w->mask_scale[m], took);
     } else {
         vw_app_report(a, false,
-               "mask %s %d/%d (%s) on the depth samples: dark violet 0 to pale yellow 1%s",
-               md->name, m + 1, w->scene.mask_count, vw_world_mask_kind_name(w, m), took);
+                      "mask %s %d/%d (%s) on the depth samples: dark violet 0 to pale yellow 1%s",
+                      md->name, m + 1, w->scene.mask_count, vw_world_mask_kind_name(w, m), took);
     }
 }
 
@@ -165,7 +166,7 @@ void vw_app_report_computing(vw_app *a, const char *prefix, int m)
                  wx_mask_rays(md) == 1 ? "" : "s");
     }
     vw_app_report(a, false, "%scomputing mask %s (%s%s) at %d depth samples ...", prefix, md->name,
-           vw_world_mask_kind_name(w, m), rays, w->point_count);
+                  vw_world_mask_kind_name(w, m), rays, w->point_count);
 }
 
 // --- the overlay ----------------------------------------------------------------------------

@@ -105,7 +105,8 @@ void vw_app_reload(vw_app *a)
         return;
     }
     a->pending = world;
-    vw_app_report(a, false, "baking the maps of %s in %s ...", world->scene.path, world->opts.out_dir);
+    vw_app_report(a, false, "baking the maps of %s in %s ...", world->scene.path,
+                  world->opts.out_dir);
 }
 
 void vw_app_poll_pending(vw_app *a)
@@ -118,7 +119,7 @@ void vw_app_poll_pending(vw_app *a)
     a->pending = NULL;
     if (status != 0) {
         vw_app_report(a, true, "reload failed: `weathering bake` exited with status %d%s%s", status,
-               a->bake.last_line[0] ? ": " : "", a->bake.last_line);
+                      a->bake.last_line[0] ? ": " : "", a->bake.last_line);
         vw_world_free(world);
         free(world);
         return;

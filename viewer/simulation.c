@@ -75,9 +75,9 @@ void vw_app_advance(vw_app *a, double now)
     if (a->playing && vw_world_finished(a->world)) {
         a->playing = false;
         vw_app_report(a, false,
-               "simulation finished after %" PRId64 " steps; G saves the mask, space starts "
-               "again",
-               wx_sim_step_count(a->world->sim));
+                      "simulation finished after %" PRId64 " steps; G saves the mask, space starts "
+                      "again",
+                      wx_sim_step_count(a->world->sim));
     }
 }
 
@@ -96,11 +96,12 @@ wx_result vw_app_gather(vw_app *a)
     }
     double t = glfwGetTime() - t0;
     if (a->world->scene.output_index < 0) {
-        vw_app_report(a, false, "saved the dirt maps in %s (no output camera, so no mask) at t = %.3f s",
-               saved, wx_sim_time(a->world->sim));
+        vw_app_report(a, false,
+                      "saved the dirt maps in %s (no output camera, so no mask) at t = %.3f s",
+                      saved, wx_sim_time(a->world->sim));
     } else {
         vw_app_report(a, false, "saved the mask %s at t = %.3f s (%.1f s)", saved,
-               wx_sim_time(a->world->sim), t);
+                      wx_sim_time(a->world->sim), t);
     }
     return WX_OK;
 }

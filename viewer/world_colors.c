@@ -61,8 +61,8 @@ const char *vw_world_substance_name(const vw_world *world)
 void vw_world_substance_color(const vw_world *world, int s, float out[3])
 {
     vw_to_float_color(s == world->scene.dirt_substance ? VW_PARTICLE_DIRTY_COLOR
-                                                    : VW_SUBSTANCE_COLORS[s % 8],
-                   out);
+                                                       : VW_SUBSTANCE_COLORS[s % 8],
+                      out);
 }
 
 bool vw_world_shows_deposits(const vw_world *world)
