@@ -7,6 +7,11 @@
 // vw_world_parse reads the scene file, vw_world_finish (after any bake) loads
 // the maps and creates the simulation. The old world runs until the new one is
 // complete; a broken file never replaces it.
+//
+// Its functions live by concept: world_load.c (parsing, maps, simulation,
+// freeing), world_stale.c (when to bake), world_geometry.c (the vertex lists),
+// world_layers.c, world_colors.c (substances, deposits, ramps), world_masks.c
+// and world_save.c (G); world_internal.h is what they share.
 #ifndef VW_WORLD_H
 #define VW_WORLD_H
 
