@@ -47,6 +47,9 @@ SHADERS := $(wildcard shaders/*.glsl)
 VIEWER_SRC := $(wildcard viewer/*.c)
 VIEWER_OBJ := $(VIEWER_SRC:viewer/%.c=$(BUILD)/obj/viewer/%.o)
 VIEWER_BIN := $(if $(VIEWER_SRC),$(BUILD)/weathering-viewer)
+# Every viewer file but main.c makes the viewer's library, which the program
+# and tests/test_viewer.c link.
+VIEWER_LIB_OBJ := $(filter-out $(BUILD)/obj/viewer/main.o,$(VIEWER_OBJ))
 # The viewer draws with the system's GL (GLFW); it never links OSMesa, and runs
 # `weathering bake` in a child process when a scene's maps are still to bake.
 VIEWER_LIBS := -lglfw -lGL -lOpenEXRCore-3_1 -lxml2 -lpng -lm -lpthread
@@ -92,7 +95,13 @@ $(BUILD)/obj/viewer/%.o: viewer/%.c $(BUILD)/gen/shaders.h | deps
 	@mkdir -p $(dir $@)
 	$(CC) $(ALL_CFLAGS) -Iviewer -c $< -o $@
 
-$(BUILD)/weathering-viewer: $(VIEWER_OBJ) $(BUILD)/libweathering.a
+$(BUILD)/libweathering-viewer.a: $(VIEWER_LIB_OBJ)
+	@mkdir -p $(dir $@)
+	rm -f $@
+	ar rcs $@ $^
+
+$(BUILD)/weathering-viewer: $(BUILD)/obj/viewer/main.o $(BUILD)/libweathering-viewer.a \
+    $(BUILD)/libweathering.a
 	$(CC) $(ALL_CFLAGS) -o $@ $^ $(VIEWER_LIBS)
 
 $(BUILD)/obj/bench/%.o: tests/bench/%.c | deps bench-deps
@@ -112,6 +121,13 @@ $(BUILD)/weathering: $(CLI_OBJ) $(BUILD)/libweathering.a
 	$(CC) $(ALL_CFLAGS) -o $@ $^ $(LIBS)
 
 $(BUILD)/tests/%: $(BUILD)/obj/tests/%.o $(TEST_SUPPORT_OBJ) $(BUILD)/libweathering.a
+	@mkdir -p $(dir $@)
+	$(CC) $(ALL_CFLAGS) -o $@ $^ $(LIBS)
+
+# test_viewer checks the viewer's GL-free parts (its world, view and point
+# filter) from the viewer's library.
+$(BUILD)/tests/test_viewer: $(BUILD)/obj/tests/test_viewer.o $(TEST_SUPPORT_OBJ) \
+    $(BUILD)/libweathering-viewer.a $(BUILD)/libweathering.a
 	@mkdir -p $(dir $@)
 	$(CC) $(ALL_CFLAGS) -o $@ $^ $(LIBS)
 

@@ -181,9 +181,11 @@ TEST(a_wrong_include_is_caught)
 
 // --- private headers ------------------------------------------------------------
 // A folder's NAME_internal.h is shared by the files of that folder only, and is
-// included by its folder-qualified name ("sim/simulate_internal.h"): a file of
-// another layer, or of cli/, viewer/ or tests/ (`folder` NULL), that includes
-// one is a violation. Returns the number of violations (printed).
+// included by its folder-qualified name ("sim/simulate_internal.h"); the
+// programs' folders, cli/ and viewer/ (`folder` "cli" or "viewer"), name their
+// own by the bare name ("world_internal.h"). A file of another layer or folder,
+// or of tests/ (`folder` NULL), that includes one is a violation. Returns the
+// number of violations (printed).
 static int check_private_headers(const char *rel, const char *folder, const char *text)
 {
     static const char suffix[] = "_internal.h";
@@ -202,9 +204,12 @@ static int check_private_headers(const char *rel, const char *folder, const char
         }
         const char *slash = memchr(name, '/', len);
         size_t folder_len = slash != NULL ? (size_t)(slash - name) : 0;
-        bool own = folder != NULL && slash != NULL && folder_len == strlen(folder) &&
-                   strncmp(name, folder, folder_len) == 0 &&
-                   memchr(slash + 1, '/', (size_t)(quote - slash - 1)) == NULL;
+        bool program = folder != NULL && (strcmp(folder, "cli") == 0 || strcmp(folder, "viewer") == 0);
+        bool own = folder != NULL &&
+                   (program ? slash == NULL
+                            : slash != NULL && folder_len == strlen(folder) &&
+                                  strncmp(name, folder, folder_len) == 0 &&
+                                  memchr(slash + 1, '/', (size_t)(quote - slash - 1)) == NULL);
         if (!own) {
             fprintf(stderr, "        %s includes \"%.*s\": a private header of %s\n", rel, (int)len,
                     name, slash != NULL ? "another folder" : "no named folder");
@@ -256,9 +261,10 @@ TEST(private_headers_stay_in_their_folder)
         bad += check_private_folder(dir, layers[l].name, layers[l].name, &files);
     }
     static const char *const outside[] = { "../cli", "../viewer", ".", "bench", "tools" };
+    static const char *const owner[] = { "cli", "viewer", NULL, NULL, NULL };
     for (size_t k = 0; k < sizeof outside / sizeof outside[0]; ++k) {
         snprintf(dir, sizeof dir, "%s/%s", ensure_tests_dir(), outside[k]);
-        bad += check_private_folder(dir, outside[k], NULL, &files);
+        bad += check_private_folder(dir, outside[k], owner[k], &files);
     }
     fprintf(stderr, "        %d files checked for private headers\n", files);
     ENSURE(files > 80);
@@ -270,13 +276,105 @@ TEST(private_headers_stay_in_their_folder)
     ENSURE(check_private_headers("cli/main.c", NULL, text) == 1);
     ENSURE(check_private_headers("sim/x.c", "sim", "#include \"simulate_internal.h\"\n") == 1);
     ENSURE(check_private_headers("sim/x.c", "sim", "#include \"sim/simulate.h\"\n") == 0);
+    const char *world = "#include \"world_internal.h\"\n";
+    ENSURE(check_private_headers("viewer/world_load.c", "viewer", world) == 0);
+    ENSURE(check_private_headers("tests/test_viewer.c", NULL, "#include \"../viewer/world_internal.h\"\n") == 1);
+    ENSURE(check_private_headers("viewer/keys.c", "viewer", text) == 1);
 }
 // --- end of private headers ----------------------------------------------------------
+
+// --- viewer/ --------------------------------------------------------------------------
+// The viewer sits on the library: its files may include core, model, io, sim
+// and pipeline headers (no raster: it bakes through a child `weathering bake`;
+// no gather: it gathers through the pipeline). Only viewer/gl.h includes
+// OpenGL's headers and only viewer/app.h GLFW's; none includes another
+// third-party library. Its world (world*), view, point filter and bake child
+// are GL-free: they include no GL or window header of the viewer, so that
+// test_viewer links them without a window.
+
+static const layer viewer_layer = { "viewer", "core model io sim pipeline" };
+
+// Viewer files (by name prefix) that stay GL-free, and the viewer's headers
+// that bring GL or the window in.
+static const char *const viewer_gl_free[] = { "world", "view.", "points.", "bake_child." };
+static const char *const viewer_gl_headers[] = { "#include \"gl.h\"", "#include \"app.h\"",
+                                                 "#include \"draw.h\"", "#include \"overlay.h\"",
+                                                 "#include \"screenshot.h\"" };
+
+// The violations of the viewer's rules in one of its files (`name` in viewer/).
+static int check_viewer_file(const char *name, const char *text)
+{
+    char rel[300];
+    snprintf(rel, sizeof rel, "viewer/%s", name);
+    int bad = check_includes(rel, text, &viewer_layer);
+    bad += check_library(rel, text, "<GL/", "viewer/gl.h");
+    bad += check_library(rel, text, "<GLFW/", "viewer/app.h");
+    bad += check_library(rel, text, "<libxml/", "io/scene_xml.c");
+    bad += check_library(rel, text, "<assimp/", "io/mesh_import.c");
+    bad += check_library(rel, text, "<openexr.h>", "io/exr.c");
+    bad += check_library(rel, text, "<png.h>", "io/png_preview.c");
+    for (size_t k = 0; k < sizeof viewer_gl_free / sizeof viewer_gl_free[0]; ++k) {
+        if (strncmp(name, viewer_gl_free[k], strlen(viewer_gl_free[k])) != 0) {
+            continue;
+        }
+        for (size_t h = 0; h < sizeof viewer_gl_headers / sizeof viewer_gl_headers[0]; ++h) {
+            if (strstr(text, viewer_gl_headers[h]) != NULL) {
+                fprintf(stderr, "        %s (GL-free) has %s\n", rel, viewer_gl_headers[h]);
+                bad++;
+            }
+        }
+    }
+    return bad;
+}
+
+TEST(the_viewer_includes_only_the_library_and_its_world_no_gl)
+{
+    char folder[4200];
+    snprintf(folder, sizeof folder, "%s/../viewer", ensure_tests_dir());
+    DIR *dir = opendir(folder);
+    ENSURE(dir != NULL);
+    int files = 0, bad = 0;
+    struct dirent *e;
+    while ((e = readdir(dir)) != NULL) {
+        size_t n = strlen(e->d_name);
+        if (n < 3 || e->d_name[n - 2] != '.' ||
+            (e->d_name[n - 1] != 'c' && e->d_name[n - 1] != 'h')) {
+            continue;
+        }
+        char path[4500];
+        snprintf(path, sizeof path, "%s/%s", folder, e->d_name);
+        char *text = source_text(path);
+        if (text == NULL) {
+            bad++;
+            continue;
+        }
+        bad += check_viewer_file(e->d_name, text);
+        free(text);
+        files++;
+    }
+    closedir(dir);
+    fprintf(stderr, "        %d files in viewer/\n", files);
+    ENSURE(files > 20);
+    ENSURE(bad == 0);
+}
+
+// The viewer's check finds what it is meant to find.
+TEST(a_wrong_viewer_include_is_caught)
+{
+    ENSURE(check_viewer_file("world_x.c", "#include \"gl.h\"\n") == 1);
+    ENSURE(check_viewer_file("keys.c", "#include \"gl.h\"\n#include \"app.h\"\n") == 0);
+    ENSURE(check_viewer_file("keys.c", "#include \"raster/bake.h\"\n") == 1);
+    ENSURE(check_viewer_file("keys.c", "#include <GLFW/glfw3.h>\n") == 1);
+    ENSURE(check_viewer_file("app.h", "#include <GLFW/glfw3.h>\n") == 0);
+    ENSURE(check_viewer_file("draw.c", "#include <GL/osmesa.h>\n") == 1);
+}
 
 int main(void)
 {
     RUN(every_layer_includes_only_the_layers_below_it);
     RUN(a_wrong_include_is_caught);
     RUN(private_headers_stay_in_their_folder);
+    RUN(the_viewer_includes_only_the_library_and_its_world_no_gl);
+    RUN(a_wrong_viewer_include_is_caught);
     return ensure_summary();
 }

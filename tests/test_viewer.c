@@ -5,9 +5,10 @@
 // cameras in their colours and the particles, and come out the same on every
 // run; bad input gives exit status 2 and names the file, without any display.
 //
-// The viewer's GL-free parts are compiled in here and checked against numbers
-// worked out by hand: the geometry drawn for the thesis scene, when maps must
-// be baked again, the nearest-point-per-pixel filter and the initial view.
+// The viewer's GL-free parts (linked from its library) are checked against
+// numbers worked out by hand: the geometry drawn for the thesis scene, when
+// maps must be baked again, the nearest-point-per-pixel filter and the
+// initial view.
 // With several substances (the thesis scene with <Substances> water, dirt,
 // rust): S walks through them and wraps, particles are coloured by their load
 // of the shown one (scaled by its emitter load), depth samples by its amount
@@ -21,10 +22,15 @@
 // a layered camera (maps written by hand, as a peeling bake writes them):
 // every layer's depth samples, each naming its view of the simulation, deeper
 // layers darker, L's cycle, hits' views, masks per layer, and G and a reload
-// keeping every layer; with one layer per camera, nothing changes.
+// keeping every layer; with one layer per camera, nothing changes. G gathers
+// from the simulation in memory: every file it saves is the bytes of the dirt
+// maps written and gathered from files (wx_gather_scene), layered or not.
+#include <dirent.h>
 #include <fcntl.h>
+#include <math.h>
 #include <png.h>
 #include <stdint.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -32,12 +38,15 @@
 #include <unistd.h>
 
 #include "../viewer/palette.h"
-#include "../viewer/points.c"
-#include "../viewer/view.c"
-#include "../viewer/world.c"
+#include "../viewer/points.h"
+#include "../viewer/view.h"
+#include "../viewer/world.h"
 #include "ensure.h"
 #include "io/exr.h"
 #include "model/camera.h"
+#include "pipeline/gather_phase.h"
+#include "pipeline/outputs.h"
+#include "pipeline/simulate_phase.h"
 #include "sim/simulate.h"
 
 enum { WIDTH = 1024, HEIGHT = 640 }; // the viewer's default window size
@@ -937,12 +946,12 @@ TEST(masks_cycle_and_colour_the_depth_samples)
         int k = i / 4, pair = i % 4;
         fake[i] = i >= 20000 ? NAN : pair >= 2 ? 0.0f : (float)(k + 1) * (pair ? -1.0f : 1.0f);
     }
-    ENSURE(mask_scale(&w, 2, fake) == 4900.0f);
+    ENSURE(vw_world_mask_scale(&w, 2, fake) == 4900.0f);
     for (int i = 0; i < w.point_count; ++i) {
         fake[i] = i == 5 ? -0.25f : i % 3 ? 0.0f : NAN; // one curved sample among flat ones
     }
-    ENSURE(mask_scale(&w, 2, fake) == 0.25f);
-    ENSURE(mask_scale(&w, 0, fake) == 1.0f); // not Curvature
+    ENSURE(vw_world_mask_scale(&w, 2, fake) == 0.25f);
+    ENSURE(vw_world_mask_scale(&w, 0, fake) == 1.0f); // not Curvature
     free(fake);
 
     // Colours: step's samples at the ends of the ramp, unshaded; Curvature's
@@ -1027,7 +1036,7 @@ TEST(masks_at_sparse_samples)
     free(w.camera_lines);
     free(w.camera_points);
     free(w.layer_points);
-    ENSURE(build_geometry_within(&w, 40000, &err) == WX_OK);
+    ENSURE(vw_world_build_geometry_within(&w, 40000, &err) == WX_OK);
     ENSURE(w.sample_stride == 3);
     ENSURE(vw_world_show_mask(&w, 1, &err) == WX_OK);
     ENSURE(vw_world_show_mask(&w, 2, &err) == WX_OK);
@@ -1283,6 +1292,204 @@ TEST(layers_cycle_and_samples_name_their_views)
     vw_world_free(&w);
 }
 
+// --- G gathers from memory ------------------------------------------------------------
+
+// Bytes of the file at `path` in *data (the caller frees it), its size in
+// *size; false when it cannot be read.
+static bool read_bytes(const char *path, unsigned char **data, size_t *size)
+{
+    FILE *f = fopen(path, "rb");
+    *data = NULL;
+    *size = 0;
+    if (f == NULL) {
+        return false;
+    }
+    size_t cap = 0;
+    bool ok = true;
+    for (;;) {
+        if (*size == cap) {
+            cap = cap > 0 ? 2 * cap : 65536;
+            unsigned char *grown = realloc(*data, cap);
+            if (grown == NULL) {
+                ok = false;
+                break;
+            }
+            *data = grown;
+        }
+        size_t n = fread(*data + *size, 1, cap - *size, f);
+        *size += n;
+        if (n == 0) {
+            break;
+        }
+    }
+    fclose(f);
+    return ok;
+}
+
+// Files of folder `b` that differ from (or are missing in) folder `a`, and how
+// many were compared; -1 when `b` cannot be listed.
+static int different_files(const char *a, const char *b, int *compared)
+{
+    DIR *dir = opendir(b);
+    if (dir == NULL) {
+        return -1;
+    }
+    int differ = 0;
+    *compared = 0;
+    struct dirent *e;
+    while ((e = readdir(dir)) != NULL) {
+        if (e->d_name[0] == '.') {
+            continue;
+        }
+        char pa[8400], pb[8400];
+        snprintf(pa, sizeof pa, "%s/%s", a, e->d_name);
+        snprintf(pb, sizeof pb, "%s/%s", b, e->d_name);
+        unsigned char *da = NULL, *db = NULL;
+        size_t na, nb;
+        bool same = read_bytes(pa, &da, &na) && read_bytes(pb, &db, &nb) && na == nb &&
+                    memcmp(da, db, na) == 0;
+        free(da);
+        free(db);
+        if (!same) {
+            fprintf(stderr, "        %s differs from %s\n", pb, pa);
+        }
+        differ += !same;
+        (*compared)++;
+    }
+    closedir(dir);
+    return differ;
+}
+
+// The world of `settings` after 20 steps, saved twice: by files (the dirt maps
+// written, then wx_gather_scene reading them back) into <tmp>/<name>_files,
+// and by G (vw_world_gather: the dirt maps written, the mask gathered from the
+// simulation in memory) into <tmp>/<name>_memory. Returns the files of the
+// second that differ from the first (-1: a step failed); `compared` counts
+// them.
+static int gather_both_ways(const vw_settings *settings, const char *name, int *compared)
+{
+    static vw_world w;
+    wx_error err = { 0 };
+    bool ok =
+        vw_world_parse(&w, settings, &err) == WX_OK && vw_world_finish(&w, settings, &err) == WX_OK;
+    for (int s = 0; ok && s < 20; ++s) {
+        ok = wx_sim_step(w.sim, &err) == WX_OK;
+    }
+    // Outputs in folders of their own: the baked maps stay where they are.
+    char files[2048], memory[2048], saved[WX_PATH_MAX];
+    snprintf(files, sizeof files, "%s/%s_files", ensure_tmpdir(), name);
+    snprintf(memory, sizeof memory, "%s/%s_memory", ensure_tmpdir(), name);
+    snprintf(w.opts.out_dir, sizeof w.opts.out_dir, "%s", files);
+    ok = ok && wx_output_prepare(&w.scene, &w.opts, NULL, &err) == WX_OK &&
+         wx_write_dirt_maps(&w.scene, &w.opts, w.sim, w.maps, &err) == WX_OK &&
+         wx_gather_scene(&w.scene, &w.opts, &err) == WX_OK;
+    snprintf(w.opts.out_dir, sizeof w.opts.out_dir, "%s", memory);
+    ok = ok && vw_world_gather(&w, saved, &err) == WX_OK;
+    if (!ok) {
+        fprintf(stderr, "        %s: %s\n", name, err.message);
+    }
+    vw_world_free(&w);
+    return ok ? different_files(files, memory, compared) : -1;
+}
+
+// The output camera's maps of layered_scene_with_output: 8 x 8 texels of
+// depth 7 with normal -y (from below, the face at y = 2 is 7 away).
+static bool write_output_maps(const char *dir)
+{
+    static const char *const kinds[2] = { "depth", "normal" };
+    static const char *const rgb[3] = { "R", "G", "B" };
+    for (int k = 0; k < 2; ++k) {
+        wx_image file;
+        if (wx_image_alloc(&file, 8, 8, k == 0 ? 1 : 3, rgb, NULL) != WX_OK) {
+            return false;
+        }
+        for (int t = 0; t < 64; ++t) {
+            if (k == 0) {
+                file.channels[0][t] = 7.0f;
+            } else {
+                file.channels[0][t] = file.channels[2][t] = 0.0f;
+                file.channels[1][t] = -1.0f;
+            }
+        }
+        char path[4400];
+        snprintf(path, sizeof path, "%s/o_%s.exr", dir, kinds[k]);
+        bool ok = wx_exr_write(path, &file, NULL) == WX_OK;
+        wx_image_free(&file);
+        if (!ok) {
+            return false;
+        }
+    }
+    return true;
+}
+
+// The layered fixture (layered_scene) with an output camera "o" below, which
+// sees the back face of a's layer 1 (y = 2, its normal -y), and the maps
+// written by hand into `out_dir`.
+static const char *layered_scene_with_output(char out_dir[4200])
+{
+    const char *tmp = ensure_tmpdir();
+    const char *mesh =
+        ensure_write_file(tmp, "layered.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    const char *scene = ensure_write_file(
+        tmp, "layered_output.xml",
+        "<Weathering>\n"
+        "  <Emitters><PointEmitter centerY=\"2\" rate=\"2000\"/></Emitters>\n"
+        "  <Collider><ProjectedMaps>\n"
+        "    <Ortho cameraName=\"a\" layers=\"2\">\n"
+        "      <View eye=\"0 5 0\" target=\"0 0 0\" up=\"0 0 -1\" width=\"2\" height=\"2\"\n"
+        "            resolution=\"8\"/>\n"
+        "    </Ortho>\n"
+        "    <Ortho cameraName=\"b\">\n"
+        "      <View eye=\"0 0 5\" target=\"0 0 0\" up=\"0 1 0\" width=\"2\" height=\"2\"\n"
+        "            resolution=\"4\"/>\n"
+        "    </Ortho>\n"
+        "    <Ortho cameraName=\"o\" out=\"true\">\n"
+        "      <View eye=\"0 -5 0\" target=\"0 0 0\" up=\"0 0 1\" width=\"2\" height=\"2\"\n"
+        "            resolution=\"8\"/>\n"
+        "      <OutputMap file=\"o_mask.exr\" width=\"8\" height=\"8\" radius=\"0\"/>\n"
+        "    </Ortho>\n"
+        "  </ProjectedMaps></Collider>\n"
+        "  <Geometry><Mesh file=\"layered.obj\"><Surface material=\"*\"/></Mesh></Geometry>\n"
+        "</Weathering>\n");
+    snprintf(out_dir, 4200, "%s/layered_output_out", tmp);
+    mkdir(out_dir, 0777);
+    if (mesh == NULL || scene == NULL || !write_layered_maps(out_dir, "a", 8, 2) ||
+        !write_layered_maps(out_dir, "b", 4, 1) || !write_output_maps(out_dir)) {
+        return NULL;
+    }
+    time_t now = time(NULL);
+    set_mtime(scene, now - 100);
+    set_mtime(mesh, now - 100);
+    return scene;
+}
+
+// G gathers from the simulation in memory (wx_gather_simulation), not from the
+// dirt maps it has just written: every file it saves (dirt maps, mask,
+// previews) is the same bytes as the dirt maps and wx_gather_scene's gather of
+// them, for the thesis scene, with substances, with derived masks and with a
+// layered camera (the output camera sees the back face of its layer 1).
+TEST(gather_from_memory_is_the_gather_from_files)
+{
+    vw_settings settings = thesis_settings();
+    int compared = 0;
+    ENSURE(gather_both_ways(&settings, "gather_thesis", &compared) == 0);
+    ENSURE(compared == 4); // front and top's dirt maps, the mask, its preview
+    settings.scene_path = substance_scene();
+    ENSURE(settings.scene_path != NULL);
+    ENSURE(gather_both_ways(&settings, "gather_substances", &compared) == 0);
+    ENSURE(compared >= 4);
+    settings.scene_path = mask_scene();
+    ENSURE(settings.scene_path != NULL);
+    ENSURE(gather_both_ways(&settings, "gather_masks", &compared) == 0);
+    ENSURE(compared >= 4);
+    char out_dir[4200];
+    vw_settings layered = { .out_dir = out_dir, .threads = 1, .hit_capacity = 64 };
+    layered.scene_path = layered_scene_with_output(out_dir);
+    ENSURE(layered.scene_path != NULL);
+    ENSURE(gather_both_ways(&layered, "gather_layered", &compared) == 0);
+    ENSURE(compared == 4); // a's and b's dirt maps, the mask, its preview
+}
+
 int main(void)
 {
     RUN(thesis_scene_geometry);
@@ -1294,6 +1501,7 @@ int main(void)
     RUN(masks_cycle_and_colour_the_depth_samples);
     RUN(masks_at_sparse_samples);
     RUN(layers_cycle_and_samples_name_their_views);
+    RUN(gather_from_memory_is_the_gather_from_files);
     RUN(bad_usage_exits_2);
     RUN(bad_scene_exits_2_and_names_the_file);
     RUN(failed_bake_exits_2);

@@ -7,6 +7,11 @@
 // vw_world_parse reads the scene file, vw_world_finish (after any bake) loads
 // the maps and creates the simulation. The old world runs until the new one is
 // complete; a broken file never replaces it.
+//
+// Its functions live by concept: world_load.c (parsing, maps, simulation,
+// freeing), world_stale.c (when to bake), world_geometry.c (the vertex lists),
+// world_layers.c, world_colors.c (substances, deposits, ramps), world_masks.c
+// and world_save.c (G); world_internal.h is what they share.
 #ifndef VW_WORLD_H
 #define VW_WORLD_H
 
@@ -139,8 +144,10 @@ int64_t vw_world_total_steps(const vw_world *world);
 bool vw_world_finished(const vw_world *world);
 
 /// Writes <camera>_dirt.exr for every input camera and, when the scene has an
-/// output camera, gathers the mask; `saved` receives the mask's path (or the
-/// output folder when there is no output camera).
+/// output camera, gathers the mask from the simulation in memory
+/// (wx_gather_simulation: the bytes a gather of those files writes); `saved`
+/// receives the mask's path (or the output folder when there is no output
+/// camera).
 wx_result vw_world_gather(vw_world *world, char saved[WX_PATH_MAX], wx_error *err);
 
 /// Layers of scene camera c's maps (1: not layered).
@@ -280,5 +287,15 @@ void vw_world_mask_colors(const vw_world *world, const uint32_t *picked, size_t 
 
 /// Frees everything; the struct is zeroed.
 void vw_world_free(vw_world *world);
+
+// Used by the world's files and by tests/test_viewer.c.
+
+/// The geometry with at most `max_samples` depth samples (VW_MAX_DEPTH_SAMPLES;
+/// tests take fewer to see a stride).
+wx_result vw_world_build_geometry_within(vw_world *world, int64_t max_samples, wx_error *err);
+
+/// The scale of a mask's ramp: 1, or for Curvature the 99th percentile of
+/// |value| over the samples (their largest when that is 0; 1 when all are flat).
+float vw_world_mask_scale(const vw_world *world, int m, const float *values);
 
 #endif

@@ -189,15 +189,15 @@ static wx_result write_one(const wx_scene *scene, const wx_run_def *opts, const 
     return r;
 }
 
-// Frame `frame` of the mask's image sequence from the simulation's state now:
-// the input maps' depth and normal borrowed, the dirt planes made for it.
-static wx_result write_frame(const wx_scene *scene, const wx_run_def *opts, const wx_sim *sim,
-                             const wx_maps *maps, const wx_maps *out_maps,
-                             const wx_textures *textures, wx_mask_context *masks, int frame,
-                             wx_error *err)
+// The input maps a gather reads from the simulation's state now, one per input
+// camera: `maps`' depth and normal borrowed, the dirt, initial and hits planes
+// made (gather_plane_blocks). free_simulation_views releases them.
+static wx_result simulation_views(const wx_scene *scene, const wx_run_def *opts, const wx_sim *sim,
+                                  const wx_maps *maps, wx_maps **out, wx_error *err)
 {
     int n = scene->input_count;
     wx_maps *view = calloc((size_t)n + 1, sizeof *view);
+    *out = view;
     if (view == NULL) {
         return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (frame)");
     }
@@ -212,15 +212,49 @@ static wx_result write_frame(const wx_scene *scene, const wx_run_def *opts, cons
         r = gather_plane_blocks(sim, &maps[c], c, opts->threads, &view[c].dirt,
                                 &view[c].initial_dirt, &view[c].hits, err);
     }
-    if (r == WX_OK) {
-        r = wx_gather_frame(scene, opts, view, out_maps, textures, masks, frame, NULL, err);
-    }
-    for (int c = 0; c < n; ++c) {
+    return r;
+}
+
+static void free_simulation_views(const wx_scene *scene, wx_maps *view)
+{
+    for (int c = 0; view != NULL && c < scene->input_count; ++c) {
         free(view[c].dirt);
         free(view[c].initial_dirt);
         free(view[c].hits);
     }
     free(view);
+}
+
+// Frame `frame` of the mask's image sequence from the simulation's state now:
+// the input maps' depth and normal borrowed, the dirt planes made for it.
+static wx_result write_frame(const wx_scene *scene, const wx_run_def *opts, const wx_sim *sim,
+                             const wx_maps *maps, const wx_maps *out_maps,
+                             const wx_textures *textures, wx_mask_context *masks, int frame,
+                             wx_error *err)
+{
+    wx_maps *view = NULL;
+    wx_result r = simulation_views(scene, opts, sim, maps, &view, err);
+    if (r == WX_OK) {
+        r = wx_gather_frame(scene, opts, view, out_maps, textures, masks, frame, NULL, err);
+    }
+    free_simulation_views(scene, view);
+    return r;
+}
+
+wx_result wx_gather_simulation(const wx_scene *scene, const wx_run_def *opts, const wx_sim *sim,
+                               const wx_maps *maps, wx_error *err)
+{
+    wx_maps *view = NULL;
+    wx_result r = simulation_views(scene, opts, sim, maps, &view, err);
+    // Layered cameras' normals point out of the solid, as the dirt maps'
+    // loader (wx_maps_load_layers) says of the maps it reads.
+    for (int c = 0; r == WX_OK && c < scene->input_count; ++c) {
+        view[c].outward = maps[c].outward;
+    }
+    if (r == WX_OK) {
+        r = wx_gather_maps(scene, opts, view, NULL, NULL, NULL, NULL, err);
+    }
+    free_simulation_views(scene, view);
     return r;
 }
 

@@ -22,6 +22,16 @@ struct wx_mask_context; // pipeline/masks_phase.h
 wx_result wx_write_dirt_maps(const wx_scene *scene, const wx_run_def *opts, const wx_sim *sim,
                              const wx_maps *maps, wx_error *err);
 
+/// The `gather` phase from the simulation's state now, without files in between:
+/// the mask (and its preview) that wx_gather_scene writes after
+/// wx_write_dirt_maps wrote this state, the same bytes. `maps` are the input
+/// cameras' maps the simulation runs on (one per input camera, scene order):
+/// their depth and normal are borrowed, the dirt planes made from `sim`; the
+/// output camera's maps are read. The mask only, as wx_gather_scene (the
+/// viewer's G).
+wx_result wx_gather_simulation(const wx_scene *scene, const wx_run_def *opts, const wx_sim *sim,
+                               const wx_maps *maps, wx_error *err);
+
 /// The `simulate` phase on maps already in memory (one per input camera, scene
 /// order, as wx_load_simulation_maps reads them): runs scene->steps steps per
 /// iteration and writes opts->out_dir/<camera>_dirt.exr for each input camera.
