@@ -209,7 +209,7 @@ sanitize: | deps
 # before ThreadSanitizer is set up. The bake is left out: its threads are Mesa's.
 TSAN_BUILD ?= $(BUILD)-tsan
 TSAN_CFLAGS := -O1 -g -fno-omit-frame-pointer -fsanitize=thread -DWX_NO_CLONES
-TSAN_TESTS := test_simulate test_gather
+TSAN_TESTS := test_simulate test_gather test_adaptive
 tsan: | deps
 	$(MAKE) --no-print-directory BUILD=$(TSAN_BUILD) CFLAGS="$(TSAN_CFLAGS)" \
 	    $(TSAN_BUILD)/weathering $(TSAN_TESTS:%=$(TSAN_BUILD)/tests/%)
