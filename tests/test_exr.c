@@ -1,4 +1,4 @@
-// test_exr_io.c: reading and writing float maps as OpenEXR files.
+// test_exr.c: reading and writing float maps as OpenEXR files.
 #include <dirent.h>
 #include <errno.h>
 #include <float.h>
