@@ -3,16 +3,18 @@
 # The last line is "N passed, M failed, K skipped" (a skip is a test that cannot
 # run here, as under a sanitizer; it does not fail the run); the exit status is
 # non-zero on failure. A program that crashes or prints no summary counts as
-# one failed test.
+# one failed test, and so does a folder with no test program in it.
 set -u
 dir=${1:-build/tests}
 total_pass=0
 total_fail=0
 total_skip=0
+programs=0
 export GALLIUM_DRIVER=llvmpipe
 for prog in "$dir"/test_*; do
     [ -x "$prog" ] || continue
     name=$(basename "$prog")
+    programs=$((programs + 1))
     echo "== $name"
     log=$(mktemp)
     t0=$SECONDS
@@ -39,5 +41,9 @@ for prog in "$dir"/test_*; do
         total_fail=$((total_fail + 1))
     fi
 done
+if [ "$programs" -eq 0 ]; then
+    echo "   no test program in $dir"
+    total_fail=$((total_fail + 1))
+fi
 echo "$total_pass passed, $total_fail failed, $total_skip skipped"
 [ "$total_fail" -eq 0 ]

@@ -1,7 +1,7 @@
 // test_run.c: the whole pipeline through the command line. `run` equals `bake`,
 // `simulate` and `gather` run one after the other; running a phase again into the
 // same folder gives the same bytes (a simulated dirt map keeps the dirt it started
-// from); every shipped scene validates.
+// from). The shipped scenes are run in test_shipped_scenes.c.
 #define _DEFAULT_SOURCE // wait4
 #include <dirent.h>
 #include <math.h>
@@ -288,35 +288,6 @@ TEST(default_scene_has_a_clean_band_and_streaks_below_the_sills)
     ENSURE(below > 5.0 * below0);
 }
 
-TEST(every_shipped_scene_validates)
-{
-    SLOW();
-    char dir[4200];
-    snprintf(dir, sizeof dir, "%s/../xml_scenes", ensure_tests_dir());
-    DIR *d = opendir(dir);
-    ENSURE(d != NULL);
-    int scenes = 0, failures = 0;
-    struct dirent *e;
-    while ((e = readdir(d)) != NULL) {
-        size_t n = strlen(e->d_name);
-        if (n < 5 || strcmp(e->d_name + n - 4, ".xml") != 0) {
-            continue;
-        }
-        char log[4096];
-        int status = ensure_shell(log, sizeof log, "'%s/weathering' info '%s/%s'",
-                                  ensure_build_dir(), dir, e->d_name);
-        if (status != 0) {
-            fprintf(stderr, "        %s: status %d\n%s\n", e->d_name, status, log);
-            failures++;
-        }
-        scenes++;
-    }
-    closedir(d);
-    ENSURE(failures == 0);
-    ENSURE(scenes >= 2);
-}
-
-
 // Runs `weathering run SCENE --out DIR -q` from the repository's root and
 // returns its peak resident memory in MiB (wait4's ru_maxrss), or -1.
 static double run_peak_mib(const char *scene, const char *dir)
@@ -350,39 +321,6 @@ static double estimate_mib(const char *scene)
     }
     const char *at = strstr(log, "memory: about ");
     return at != NULL ? atof(at + strlen("memory: about ")) : -1.0;
-}
-
-// The memory estimate is an upper bound of what a run really takes at its peak,
-// and not more than 3 times it (issue 13): every shipped scene, measured.
-TEST(memory_estimate_bounds_every_shipped_scene)
-{
-    SLOW();
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-    SKIP("sanitizers change the memory a run takes");
-#endif
-    char dir[4200];
-    snprintf(dir, sizeof dir, "%s/../xml_scenes", ensure_tests_dir());
-    DIR *d = opendir(dir);
-    ENSURE(d != NULL);
-    int scenes = 0, failures = 0;
-    struct dirent *e;
-    while ((e = readdir(d)) != NULL) {
-        size_t n = strlen(e->d_name);
-        if (n < 5 || strcmp(e->d_name + n - 4, ".xml") != 0) {
-            continue;
-        }
-        char scene[4500];
-        snprintf(scene, sizeof scene, "%s/%s", dir, e->d_name);
-        double estimate = estimate_mib(scene);
-        double peak = run_peak_mib(scene, out_dir(e->d_name));
-        fprintf(stderr, "        %-16s estimate %6.0f MiB, peak %6.0f MiB (%.2fx)\n", e->d_name,
-                estimate, peak, estimate / peak);
-        failures += !(peak > 0.0 && estimate >= peak && estimate <= 3.0 * peak);
-        scenes++;
-    }
-    closedir(d);
-    ENSURE(scenes >= 5);
-    ENSURE(failures == 0);
 }
 
 // A bumpy square of about `triangles` triangles (a grid of n x n quads, each
@@ -659,8 +597,6 @@ int main(void)
     RUN(simulating_again_starts_from_the_initial_dirt);
     RUN(simulated_dirt_map_holds_result_and_initial_dirt);
     RUN(default_scene_has_a_clean_band_and_streaks_below_the_sills);
-    RUN(every_shipped_scene_validates);
-    RUN(memory_estimate_bounds_every_shipped_scene);
     RUN(memory_estimate_bounds_meshes_and_particles_alive_at_once);
     RUN(a_run_without_a_single_hit_warns);
     RUN(inputs_are_read_once_per_run);
