@@ -95,9 +95,11 @@ static bool write_grid_mesh(const char *dir, const char *name, const char *forma
         return false;
     }
     if (ply) {
-        fprintf(f, "ply\nformat binary_little_endian 1.0\nelement vertex %d\nproperty float x\n"
-                   "property float y\nproperty float z\nelement face %d\n"
-                   "property list uchar int vertex_indices\nend_header\n", nv, nt);
+        fprintf(f,
+                "ply\nformat binary_little_endian 1.0\nelement vertex %d\nproperty float x\n"
+                "property float y\nproperty float z\nelement face %d\n"
+                "property list uchar int vertex_indices\nend_header\n",
+                nv, nt);
     }
     for (int pass = 0; pass < (gltf || ply ? 1 : 2); ++pass) {
         for (int j = 0; j <= n; ++j) {

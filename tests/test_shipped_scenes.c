@@ -30,8 +30,7 @@ static double run_peak_mib(const char *scene, const char *dir, const char *stats
         int null = open("/dev/null", O_WRONLY);
         dup2(null, STDOUT_FILENO);
         dup2(null, STDERR_FILENO);
-        execl(program, program, "run", scene, "--out", dir, "-q", "--stats", stats,
-              (char *)NULL);
+        execl(program, program, "run", scene, "--out", dir, "-q", "--stats", stats, (char *)NULL);
         _exit(98);
     }
     int status = 0;
