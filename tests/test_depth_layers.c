@@ -119,6 +119,7 @@ static void niche_scene(char *xml, size_t size, int layers)
 typedef struct tally {
     double hits;
     double area;
+    bool read; ///< every layer's maps were read (no hits counts only then)
 } tally;
 
 static bool read_camera(const char *path, wx_camera *cam)
@@ -145,7 +146,7 @@ static bool read_camera(const char *path, wx_camera *cam)
 static tally count_hits(const char *dir, const char *camera, int layers, const double lo[3],
                         const double hi[3])
 {
-    tally t = { 0.0, 0.0 };
+    tally t = { 0.0, 0.0, false };
     char depth_path[PATH_MAX], dirt_path[PATH_MAX];
     snprintf(depth_path, sizeof depth_path, "%s/%s_depth.exr", dir, camera);
     snprintf(dirt_path, sizeof dirt_path, "%s/%s_dirt.exr", dir, camera);
@@ -156,6 +157,7 @@ static tally count_hits(const char *dir, const char *camera, int layers, const d
     float fw, fh;
     wx_camera_frame_size(&cam, &fw, &fh);
     double texel_area = (double)fw / cam.width * (double)fh / cam.height;
+    t.read = true;
     for (int k = 0; k < layers; ++k) {
         char depth_name[32], hits_name[32];
         snprintf(depth_name, sizeof depth_name, k > 0 ? "layer%d.R" : "R", k);
@@ -163,6 +165,7 @@ static tally count_hits(const char *dir, const char *camera, int layers, const d
         int w = 0, h = 0, w2 = 0, h2 = 0;
         float *depth = ensure_read_channel(depth_path, depth_name, &w, &h);
         float *hits = ensure_read_channel(dirt_path, hits_name, &w2, &h2);
+        t.read = t.read && depth != NULL && hits != NULL && w == w2 && h == h2;
         if (depth != NULL && hits != NULL && w == w2 && h == h2) {
             for (int j = 0; j < h; ++j) {
                 for (int i = 0; i < w; ++i) {
@@ -225,6 +228,7 @@ TEST(rain_reaches_the_floor_of_a_niche_every_first_surface_hides)
            F, strip.hits / strip.area, strip.area, shadow.hits / fmax(shadow.area, 1e-9),
            wall.hits / fmax(wall.area, 1e-9), 0.5 * F, dry.hits / fmax(dry.area, 1e-9),
            dry.area);
+    ENSURE(strip.read && shadow.read && wall.read && dry.read);
     ENSURE(strip.area > 0.9 && wall.area > 0.9 && shadow.area > 0.9);
     ENSURE_NEAR(strip.hits / strip.area, F, 0.04 * F);
     ENSURE_NEAR(wall.hits / wall.area, 0.5 * F, 0.04 * 0.5 * F);

@@ -13,17 +13,21 @@
 #include "pipeline/outputs.h"
 #include "sim/simulate.h"
 
+// Number of entries of `dir` whose name starts with '.' (temporaries); -1 when
+// the folder cannot be read (never an empty folder's 0).
 static int count_hidden_files(const char *dir)
 {
     DIR *d = opendir(dir);
+    if (d == NULL) {
+        fprintf(stderr, "        %s: cannot be read\n", dir);
+        return -1;
+    }
     int n = 0;
     struct dirent *e;
-    while (d != NULL && (e = readdir(d)) != NULL) {
+    while ((e = readdir(d)) != NULL) {
         n += e->d_name[0] == '.' && strcmp(e->d_name, ".") != 0 && strcmp(e->d_name, "..") != 0;
     }
-    if (d != NULL) {
-        closedir(d);
-    }
+    closedir(d);
     return n;
 }
 

@@ -292,63 +292,6 @@ TEST(several_substances_give_the_same_bytes_for_any_thread_count)
     }
 }
 
-// Every substance's ledger of a --stats file balances (exact to rounding);
-// returns how many substances it checked, -1 when one does not balance.
-static int ledger_balances(const char *json)
-{
-    const char *at = strstr(json, "\"substances\": {");
-    if (at == NULL) {
-        return -1;
-    }
-    int checked = 0;
-    for (at = strstr(at + 15, "\": { \"initial_surface\""); at != NULL;
-         at = strstr(at + 1, "\": { \"initial_surface\"")) {
-        double in, out;
-        ledger_sides(at, &in, &out);
-        if (!(fabs(in - out) <= 1e-9 * (fabs(in) + 1.0))) {
-            fprintf(stderr, "        in %.17g, out %.17g\n", in, out);
-            return -1;
-        }
-        checked++;
-    }
-    return checked;
-}
-
-TEST(the_ledger_balances_on_every_shipped_scene)
-{
-    SLOW();
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-    SKIP("the shipped scenes take minutes under sanitizers");
-#endif
-    char dir[4200];
-    snprintf(dir, sizeof dir, "%s/../xml_scenes", ensure_tests_dir());
-    DIR *d = opendir(dir);
-    ENSURE(d != NULL);
-    int scenes = 0;
-    struct dirent *e;
-    while ((e = readdir(d)) != NULL) {
-        size_t n = strlen(e->d_name);
-        if (n < 5 || strcmp(e->d_name + n - 4, ".xml") != 0) {
-            continue;
-        }
-        char log[8192], stats[4400];
-        snprintf(stats, sizeof stats, "%s/ledger_%s.json", ensure_tmpdir(), e->d_name);
-        ENSURE(ensure_shell(log, sizeof log,
-                            "'%s/weathering' run '%s/%s' --out '%s/ledger_%s' -q --stats '%s'",
-                            ensure_build_dir(), dir, e->d_name, ensure_tmpdir(), e->d_name,
-                            stats) == 0);
-        char *json = ensure_read_file(stats);
-        ENSURE(json != NULL);
-        int checked = ledger_balances(json);
-        fprintf(stderr, "        %-16s %d substance(s) balance\n", e->d_name, checked);
-        ENSURE(checked >= 1);
-        free(json);
-        scenes++;
-    }
-    closedir(d);
-    ENSURE(scenes >= 6);
-}
-
 // A scene of over a thousand <Surface>s (a city's materials): the bake and the
 // ageing look each texel's surface up by its global index with no cap. The
 // plane's two materials are the last two of 1100 surfaces (the others match
@@ -537,7 +480,6 @@ int main(void)
     RUN(the_final_mask_is_the_last_frame_and_every_channel_has_a_preview);
     RUN(the_ledger_balances_for_every_substance);
     RUN(several_substances_give_the_same_bytes_for_any_thread_count);
-    RUN(the_ledger_balances_on_every_shipped_scene);
     RUN(surfaces_beyond_a_thousand_keep_their_rules);
     RUN(names_of_32_characters_run_to_the_end);
     return ensure_summary();
