@@ -38,6 +38,7 @@
 #include "io/exr.h"
 #include "core/input_file.h"
 #include "model/mesh.h"
+#include "model/naming.h"
 
 /// Limits that bound memory before anything else is checked.
 #define SCENE_MAX_BYTES (64L * 1024 * 1024)
@@ -68,10 +69,9 @@
 
 #define XSI_NAMESPACE "http://www.w3.org/2001/XMLSchema-instance"
 
-enum { MAP_DEPTH, MAP_NORMAL, MAP_IMPACT, MAP_DIRT, MAP_KINDS };
-static const char *const map_elements[MAP_KINDS] = { "DepthMap", "NormalMap", "ImpactMap",
-                                                     "DirtMap" };
-static const char *const map_kinds[MAP_KINDS] = { "depth", "normal", "impact", "dirt" };
+/// The elements of a camera's maps, in model/naming.h's order of the kinds.
+static const char *const map_elements[WX_MAP_KINDS] = { "DepthMap", "NormalMap", "ImpactMap",
+                                                        "DirtMap" };
 
 // ---------------------------------------------------------------------------
 // Parser state and errors
@@ -1699,8 +1699,8 @@ typedef struct ortho_def {
     wx_scene_camera *cam;
     const xmlNode *ctw_node, *wtc_node, *view_node, *output_node;
     float ctw[16], wtc[16];
-    const xmlNode *map_nodes[MAP_KINDS];
-    char *map_files[MAP_KINDS]; ///< as written in the scene (owned)
+    const xmlNode *map_nodes[WX_MAP_KINDS];
+    char *map_files[WX_MAP_KINDS]; ///< as written in the scene (owned)
     unsigned output_present;
 } ortho_def;
 
@@ -1722,7 +1722,7 @@ static wx_result parse_map(parser *p, const xmlNode *node, void *user)
 {
     ortho_def *o = user;
     int k = 0;
-    while (k < MAP_KINDS && strcmp(map_elements[k], name_of(node)) != 0) {
+    while (k < WX_MAP_KINDS && strcmp(map_elements[k], name_of(node)) != 0) {
         ++k;
     }
     map_def m = { NULL };
@@ -1859,8 +1859,8 @@ static wx_result camera_matrices(parser *p, const xmlNode *node, ortho_def *o)
 static wx_result camera_maps(parser *p, const xmlNode *node, ortho_def *o)
 {
     wx_scene_camera *cam = o->cam;
-    char **paths[MAP_KINDS] = { &cam->depth_path, &cam->normal_path, &cam->impact_path,
-                                &cam->dirt_path };
+    char **paths[WX_MAP_KINDS] = { &cam->depth_path, &cam->normal_path, &cam->impact_path,
+                                   &cam->dirt_path };
     int needed = cam->is_output ? 2 : 4; // depth, normal (+ impact, dirt for inputs)
     int named = 0;
     for (int k = 0; k < needed; ++k) {
@@ -1882,7 +1882,7 @@ static wx_result camera_maps(parser *p, const xmlNode *node, ortho_def *o)
                     cam->name, map_elements[k]);
     }
     const char *first_file = NULL;
-    for (int k = 0; k < MAP_KINDS; ++k) {
+    for (int k = 0; k < WX_MAP_KINDS; ++k) {
         const xmlNode *map = o->map_nodes[k];
         if (map == NULL) {
             continue;
@@ -1906,7 +1906,7 @@ static wx_result camera_maps(parser *p, const xmlNode *node, ortho_def *o)
         int w = header.width, h = header.height;
         wx_image_free(&header);
         if (r != WX_OK) {
-            return fail(p, map, exr_err.cause, "%s map of camera '%s': %s", map_kinds[k],
+            return fail(p, map, exr_err.cause, "%s map of camera '%s': %s", wx_map_kind_name(k),
                         cam->name, exr_err.message);
         }
         if (o->view_node != NULL) {
@@ -2001,7 +2001,7 @@ static wx_result camera_layers(parser *p, const xmlNode *node, ortho_def *o)
                     "mask shows the first surface the output camera sees); remove it",
                     cam->name, cam->layers);
     }
-    for (int k = 0; k < MAP_KINDS; ++k) {
+    for (int k = 0; k < WX_MAP_KINDS; ++k) {
         if (o->map_nodes[k] != NULL) {
             return fail(p, node, WX_CAUSE_BAD_SCENE,
                         "camera '%s' has layers=\"%d\" and names its map files: maps given as "
@@ -2066,7 +2066,7 @@ static wx_result parse_ortho(parser *p, const xmlNode *node, void *user)
         (r = camera_layers(p, node, &o)) == WX_OK) {
         r = camera_output(p, node, &o);
     }
-    for (int k = 0; k < MAP_KINDS; ++k) {
+    for (int k = 0; k < WX_MAP_KINDS; ++k) {
         free(o.map_files[k]);
     }
     return r;
@@ -2809,14 +2809,14 @@ static wx_result check_output_name(parser *p)
     }
     const wx_scene_camera *out = &s->cameras[s->output_index];
     for (int c = 0; c < s->camera_count; ++c) {
-        for (int k = 0; k < MAP_KINDS; ++k) {
+        for (int k = 0; k < WX_MAP_KINDS; ++k) {
             char name[128];
-            snprintf(name, sizeof name, "%s_%s.exr", s->cameras[c].name, map_kinds[k]);
+            wx_map_file_name(s->cameras[c].name, k, name, sizeof name);
             if (strcmp(name, out->output_file) == 0) {
                 return fail_line(p, out->line, WX_CAUSE_BAD_SCENE,
                                  "<OutputMap> file=\"%s\" is the name of camera '%s''s %s map in "
                                  "the output folder; choose another",
-                                 out->output_file, s->cameras[c].name, map_kinds[k]);
+                                 out->output_file, s->cameras[c].name, wx_map_kind_name(k));
             }
         }
     }
@@ -2832,19 +2832,11 @@ typedef struct output_entry {
     int line;
 } output_entry;
 
-/// The length of `file` without a final ".exr": the BASE of BASE.NNNN.exr and
-/// BASE_NAME.png (as the gather names them, pipeline/gather_phase.c).
-static size_t output_base_length(const char *file)
-{
-    size_t n = strlen(file);
-    return n >= 4 && strcmp(file + n - 4, ".exr") == 0 ? n - 4 : n;
-}
-
 /// The frame number N when `name` is BASE.NNNN.exr of `e`'s image sequence and
 /// the run writes that frame (N a multiple of every, at most the iterations); else 0.
 static int frame_of(const wx_scene *s, const char *name, const output_entry *e)
 {
-    size_t base = output_base_length(e->file);
+    size_t base = wx_output_base_length(e->file);
     size_t n = strlen(name);
     if (e->every <= 0 || n < base + 9 || strncmp(name, e->file, base) != 0 ||
         name[base] != '.' || strcmp(name + n - 4, ".exr") != 0) {
@@ -2879,18 +2871,17 @@ static int preview_names(const wx_scene *s, const char *file,
                          char names[SCENE_MAX_PREVIEWS][WX_OUTPUT_NAME_MAX])
 {
     if (!s->substances_declared && s->mask_count == 0) {
-        const char *dot = strrchr(file, '.');
-        int stem = dot != NULL && dot != file ? (int)(dot - file) : (int)strlen(file);
-        snprintf(names[0], WX_OUTPUT_NAME_MAX, "%.*s.png", stem, file);
+        // BASE.png: `file` ends in .exr (parse_output_map, parse_texture_map),
+        // so never BASE.preview.png here.
+        wx_preview_name(file, names[0], WX_OUTPUT_NAME_MAX);
         return 1;
     }
-    int base = (int)output_base_length(file);
     int n = 0;
     for (int k = 0; k < s->substance_count; ++k) {
-        snprintf(names[n++], WX_OUTPUT_NAME_MAX, "%.*s_%s.png", base, file, s->substances[k]);
+        wx_channel_preview_name(file, s->substances[k], names[n++], WX_OUTPUT_NAME_MAX);
     }
     for (int k = 0; k < s->mask_count; ++k) {
-        snprintf(names[n++], WX_OUTPUT_NAME_MAX, "%.*s_%s.png", base, file, s->masks[k].name);
+        wx_channel_preview_name(file, s->masks[k].name, names[n++], WX_OUTPUT_NAME_MAX);
     }
     return n;
 }
@@ -2963,14 +2954,14 @@ static wx_result check_texture_names(parser *p)
     for (int i = 0; i < s->texture_count; ++i) {
         const wx_texture_map *tex = &s->textures[i];
         for (int c = 0; c < s->camera_count; ++c) {
-            for (int k = 0; k < MAP_KINDS; ++k) {
+            for (int k = 0; k < WX_MAP_KINDS; ++k) {
                 char name[128];
-                snprintf(name, sizeof name, "%s_%s.exr", s->cameras[c].name, map_kinds[k]);
+                wx_map_file_name(s->cameras[c].name, k, name, sizeof name);
                 if (strcmp(name, tex->file) == 0) {
                     return fail_line(p, tex->line, WX_CAUSE_BAD_SCENE,
                                      "<TextureMap> file=\"%s\" is the name of camera '%s''s %s "
                                      "map in the output folder; choose another",
-                                     tex->file, s->cameras[c].name, map_kinds[k]);
+                                     tex->file, s->cameras[c].name, wx_map_kind_name(k));
                 }
             }
         }
@@ -3003,8 +2994,8 @@ static const attr_spec root_attrs[] = {
     { "name", T_NAME, offsetof(wx_scene, name), .size = sizeof(((wx_scene *)0)->name) },
 };
 
-/// The longest name among the files an output writes, as pipeline/gather_phase.c
-/// and texture_phase.c name them (docs/design.md sections 10 and 11): the file,
+/// The longest name among the files an output writes, as model/naming.c names
+/// them (docs/design.md sections 10 and 11): the file,
 /// its previews (BASE.png, or BASE.preview.png for a file ending in .png, when
 /// the scene has neither <Substances> nor <Masks>; else BASE_NAME.png per
 /// substance and per mask) and its last frame BASE.NNNN.exr.
@@ -3013,12 +3004,8 @@ static size_t longest_output_name(const wx_scene *s, const char *file, int every
 {
     char name[WX_OUTPUT_NAME_MAX];
     snprintf(longest, WX_OUTPUT_NAME_MAX, "%s", file);
-    int base = (int)output_base_length(file);
     if (!s->substances_declared && s->mask_count == 0) {
-        const char *dot = strrchr(file, '.');
-        int stem = dot != NULL && dot != file ? (int)(dot - file) : (int)strlen(file);
-        bool png = dot != NULL && dot != file && strcmp(dot, ".png") == 0;
-        snprintf(name, sizeof name, "%.*s%s", stem, file, png ? ".preview.png" : ".png");
+        wx_preview_name(file, name, sizeof name);
         if (strlen(name) > strlen(longest)) {
             memcpy(longest, name, sizeof name);
         }
@@ -3027,14 +3014,14 @@ static size_t longest_output_name(const wx_scene *s, const char *file, int every
                                                                    s->mask_count > 0; ++k) {
         const char *channel = k < s->substance_count ? s->substances[k]
                                                       : s->masks[k - s->substance_count].name;
-        snprintf(name, sizeof name, "%.*s_%s.png", base, file, channel);
+        wx_channel_preview_name(file, channel, name, sizeof name);
         if (strlen(name) > strlen(longest)) {
             memcpy(longest, name, sizeof name);
         }
     }
     int last = every > 0 ? s->iterations / every * every : 0;
     if (last > 0) {
-        snprintf(name, sizeof name, "%.*s.%04d.exr", base, file, last);
+        wx_frame_name(file, last, name, sizeof name);
         if (strlen(name) > strlen(longest)) {
             memcpy(longest, name, sizeof name);
         }
@@ -3064,8 +3051,7 @@ static wx_result check_output_name_lengths(parser *p)
         char own[WX_OUTPUT_NAME_MAX];
         snprintf(own, sizeof own, "%s", file);
         if (!mask && s->textures[k].tiles == WX_TILES_UDIM) {
-            snprintf(own, sizeof own, "%.*s.%04d.exr", (int)output_base_length(file), file,
-                     WX_UDIM_FIRST);
+            wx_tile_name(file, 0, own, sizeof own);
         }
         char longest[WX_OUTPUT_NAME_MAX];
         size_t len = longest_output_name(s, own, every, longest);

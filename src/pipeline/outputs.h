@@ -42,10 +42,6 @@ void wx_output_names_free(wx_output_names *names);
 /// True when `name` is one of the list's names (constant time).
 bool wx_output_names_has(const wx_output_names *names, const char *name);
 
-/// The preview's name for a mask's: its extension replaced by .png ("mask.exr"
-/// -> "mask.png"; "mask" -> "mask.png"; "mask.png" -> "mask.preview.png").
-void wx_preview_name(const char *mask_name, char *out, size_t cap);
-
 /// Checks made before any work or any folder: no file the phases will write
 /// is an input of the scene (the scene, a map or a mesh it names) or an
 /// existing non-regular file (a folder, a FIFO, a symbolic link), and the
