@@ -108,8 +108,7 @@ static int check_no_file_io(const char *path, const char *text)
 
 // Third-party headers that belong to a few files each: `owners` is a
 // space-separated list of them.
-static int check_library(const char *rel, const char *text, const char *header,
-                         const char *owners)
+static int check_library(const char *rel, const char *text, const char *header, const char *owners)
 {
     if (strstr(text, header) != NULL && !listed(owners, rel, strlen(rel))) {
         fprintf(stderr, "        %s includes %s, which only %s may\n", rel, header, owners);
@@ -122,6 +121,73 @@ static int check_library(const char *rel, const char *text, const char *header,
 // The scene reader's files (io/scene_xml*.c, issue 27): libxml2 only in the
 // one that reads the document and in the table engine's header.
 static const char *const libxml_owners = "io/scene_xml.c io/scene_xml_table.h";
+
+// The command line (cli/, issue 27) stands on the pipeline: it may include
+// core, model and pipeline headers, and of io only the scene loader and the
+// statistics writer; the maps, meshes and EXR files it reaches through the
+// pipeline, never sim, raster or gather.
+static const char *const cli_layers = "core model pipeline";
+static const char *const cli_io_headers = "io/scene_xml.h io/stats_json.h";
+
+// Every `#include "X/..."` of a cli file names a layer of cli_layers or a
+// header of cli_io_headers; returns the number of violations (printed).
+static int check_cli_includes(const char *path, const char *text)
+{
+    int bad = 0;
+    for (const char *p = text; (p = strstr(p, "#include \"")) != NULL; p += 10) {
+        const char *name = p + 10;
+        const char *slash = strchr(name, '/');
+        const char *quote = strchr(name, '"');
+        if (slash == NULL || quote == NULL || slash > quote) {
+            continue; // cli.h, by plain name
+        }
+        if (!listed(cli_layers, name, (size_t)(slash - name)) &&
+            !listed(cli_io_headers, name, (size_t)(quote - name))) {
+            fprintf(stderr, "        %s includes \"%.*s\": cli may include only %s and %s\n", path,
+                    (int)(quote - name), name, cli_layers, cli_io_headers);
+            bad++;
+        }
+    }
+    return bad;
+}
+
+TEST(the_command_line_stands_on_the_pipeline)
+{
+    char folder[4200];
+    snprintf(folder, sizeof folder, "%s/../cli", ensure_tests_dir());
+    DIR *dir = opendir(folder);
+    ENSURE(dir != NULL);
+    int files = 0, bad = 0;
+    struct dirent *e;
+    while ((e = readdir(dir)) != NULL) {
+        size_t n = strlen(e->d_name);
+        if (n < 3 || e->d_name[n - 2] != '.' ||
+            (e->d_name[n - 1] != 'c' && e->d_name[n - 1] != 'h')) {
+            continue;
+        }
+        char path[4500], rel[300];
+        snprintf(path, sizeof path, "%s/%s", folder, e->d_name);
+        snprintf(rel, sizeof rel, "cli/%s", e->d_name);
+        char *text = source_text(path);
+        if (text == NULL) {
+            bad++;
+            continue;
+        }
+        bad += check_cli_includes(rel, text);
+        bad += check_library(rel, text, "<libxml/", libxml_owners);
+        bad += check_library(rel, text, "<openexr.h>", "io/exr.c");
+        free(text);
+        files++;
+    }
+    closedir(dir);
+    fprintf(stderr, "        %d files in cli/\n", files);
+    ENSURE(files > 0);
+    ENSURE(bad == 0);
+    // The check finds what it is meant to find.
+    ENSURE(check_cli_includes("cli/x.c", "#include \"sim/emitter.h\"\n") == 1);
+    ENSURE(check_cli_includes("cli/x.c", "#include \"io/exr.h\"\n") == 1);
+    ENSURE(check_cli_includes("cli/x.c", "#include \"io/scene_xml.h\"\n#include \"cli.h\"\n") == 0);
+}
 // ---------------------------------------------------------------------------
 
 TEST(every_layer_includes_only_the_layers_below_it)
@@ -180,5 +246,6 @@ int main(void)
 {
     RUN(every_layer_includes_only_the_layers_below_it);
     RUN(a_wrong_include_is_caught);
+    RUN(the_command_line_stands_on_the_pipeline);
     return ensure_summary();
 }

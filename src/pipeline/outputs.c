@@ -16,6 +16,7 @@
 
 #include "core/array.h"
 #include "core/atomic_file.h"
+#include "io/exr.h"
 #include "model/naming.h"
 #include "pipeline/preset.h"
 
@@ -633,4 +634,26 @@ wx_result wx_use_baked_maps(wx_scene *scene, const wx_run_def *opts, wx_error *e
         }
     }
     return WX_OK;
+}
+
+void wx_output_describe(FILE *out, const wx_run_def *opts, const char *name)
+{
+    char path[WX_PATH_MAX + 512];
+    snprintf(path, sizeof path, "%s/%s", opts->out_dir, name);
+    struct stat st;
+    if (stat(path, &st) != 0) {
+        return;
+    }
+    wx_image *image = calloc(1, sizeof *image);
+    wx_error err;
+    fprintf(out, "  %-28s %8.1f MB", name, (double)st.st_size / 1e6);
+    if (image != NULL && wx_exr_read_header(path, image, &err) == WX_OK) {
+        fprintf(out, "  %d x %d, channels", image->width, image->height);
+        for (int c = 0; c < image->channel_count; ++c) {
+            fprintf(out, "%s %s", c > 0 ? "," : "", image->channel_names[c]);
+        }
+        wx_image_free(image);
+    }
+    free(image);
+    fprintf(out, "\n");
 }
