@@ -6,7 +6,8 @@
 // and the compute layers (raster, sim, gather) never open a file themselves:
 // they take and return memory, the pipeline reads and writes. Each third-party
 // library is included by the few files of one concept only: libxml2 by the scene
-// loader, Assimp by the mesh importer, OpenEXR by the EXR files of io/, OSMesa
+// loader (scene_xml.c and its table engine's header, which the element groups
+// include), Assimp by the mesh importer, OpenEXR by the EXR files of io/, OSMesa
 // and GL by the bake's GL side, libpng by io/png_preview.c. A folder's private
 // header (NAME_internal.h) is included by the files of that folder only.
 #include <dirent.h>
@@ -119,6 +120,79 @@ static int check_library(const char *rel, const char *text, const char *header, 
     return 0;
 }
 
+// ---------------------------------------------------------------------------
+// The scene reader's files (io/scene_xml*.c, issue 27): libxml2 only in the
+// one that reads the document and in the table engine's header.
+static const char *const libxml_owners = "io/scene_xml.c io/scene_xml_table.h";
+
+// The command line (cli/, issue 27) stands on the pipeline: it may include
+// core, model and pipeline headers, and of io only the scene loader and the
+// statistics writer; the maps, meshes and EXR files it reaches through the
+// pipeline, never sim, raster or gather.
+static const char *const cli_layers = "core model pipeline";
+static const char *const cli_io_headers = "io/scene_xml.h io/stats_json.h";
+
+// Every `#include "X/..."` of a cli file names a layer of cli_layers or a
+// header of cli_io_headers; returns the number of violations (printed).
+static int check_cli_includes(const char *path, const char *text)
+{
+    int bad = 0;
+    for (const char *p = text; (p = strstr(p, "#include \"")) != NULL; p += 10) {
+        const char *name = p + 10;
+        const char *slash = strchr(name, '/');
+        const char *quote = strchr(name, '"');
+        if (slash == NULL || quote == NULL || slash > quote) {
+            continue; // cli.h, by plain name
+        }
+        if (!listed(cli_layers, name, (size_t)(slash - name)) &&
+            !listed(cli_io_headers, name, (size_t)(quote - name))) {
+            fprintf(stderr, "        %s includes \"%.*s\": cli may include only %s and %s\n", path,
+                    (int)(quote - name), name, cli_layers, cli_io_headers);
+            bad++;
+        }
+    }
+    return bad;
+}
+
+TEST(the_command_line_stands_on_the_pipeline)
+{
+    char folder[4200];
+    snprintf(folder, sizeof folder, "%s/../cli", ensure_tests_dir());
+    DIR *dir = opendir(folder);
+    ENSURE(dir != NULL);
+    int files = 0, bad = 0;
+    struct dirent *e;
+    while ((e = readdir(dir)) != NULL) {
+        size_t n = strlen(e->d_name);
+        if (n < 3 || e->d_name[n - 2] != '.' ||
+            (e->d_name[n - 1] != 'c' && e->d_name[n - 1] != 'h')) {
+            continue;
+        }
+        char path[4500], rel[300];
+        snprintf(path, sizeof path, "%s/%s", folder, e->d_name);
+        snprintf(rel, sizeof rel, "cli/%s", e->d_name);
+        char *text = source_text(path);
+        if (text == NULL) {
+            bad++;
+            continue;
+        }
+        bad += check_cli_includes(rel, text);
+        bad += check_library(rel, text, "<libxml/", libxml_owners);
+        bad += check_library(rel, text, "<openexr.h>", "io/exr.c");
+        free(text);
+        files++;
+    }
+    closedir(dir);
+    fprintf(stderr, "        %d files in cli/\n", files);
+    ENSURE(files > 0);
+    ENSURE(bad == 0);
+    // The check finds what it is meant to find.
+    ENSURE(check_cli_includes("cli/x.c", "#include \"sim/emitter.h\"\n") == 1);
+    ENSURE(check_cli_includes("cli/x.c", "#include \"io/exr.h\"\n") == 1);
+    ENSURE(check_cli_includes("cli/x.c", "#include \"io/scene_xml.h\"\n#include \"cli.h\"\n") == 0);
+}
+// ---------------------------------------------------------------------------
+
 TEST(every_layer_includes_only_the_layers_below_it)
 {
     int files = 0, bad = 0;
@@ -146,7 +220,7 @@ TEST(every_layer_includes_only_the_layers_below_it)
             if (is_compute(&layers[l])) {
                 bad += check_no_file_io(rel, text);
             }
-            bad += check_library(rel, text, "<libxml/", "io/scene_xml.c");
+            bad += check_library(rel, text, "<libxml/", libxml_owners);
             bad += check_library(rel, text, "<assimp/", "io/mesh_import.c io/mesh_postprocess.c");
             bad += check_library(rel, text, "<openexr.h>",
                                  "io/exr.c io/exr_write.c io/exr_internal.h");
@@ -376,5 +450,6 @@ int main(void)
     RUN(private_headers_stay_in_their_folder);
     RUN(the_viewer_includes_only_the_library_and_its_world_no_gl);
     RUN(a_wrong_viewer_include_is_caught);
+    RUN(the_command_line_stands_on_the_pipeline);
     return ensure_summary();
 }

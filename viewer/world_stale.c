@@ -8,8 +8,7 @@
 #include <sys/stat.h>
 
 #include "core/limits.h"
-
-static const char *const MAP_KINDS[4] = { "depth", "normal", "impact", "dirt" };
+#include "model/naming.h"
 
 static bool file_mtime(const char *path, struct timespec *out)
 {
@@ -85,11 +84,11 @@ bool vw_world_needs_bake(const vw_world *world, const vw_world *running)
         if (!cam->has_view || wx_has_path(cam->depth_path)) {
             continue;
         }
-        int count = cam->is_output ? 2 : 4;
+        int count = cam->is_output ? WX_MAP_IMPACT : WX_MAP_KINDS;
         for (int k = 0; k < count; ++k) {
-            char path[WX_PATH_MAX + 128];
-            snprintf(path, sizeof path, "%s/%s_%s.exr", world->opts.out_dir, cam->name,
-                     MAP_KINDS[k]);
+            char name[WX_PATH_MAX], path[2 * WX_PATH_MAX + 2];
+            wx_map_file_name(cam->name, k, name, sizeof name);
+            snprintf(path, sizeof path, "%s/%s", world->opts.out_dir, name);
             struct timespec t;
             if (!file_mtime(path, &t)) {
                 return true;

@@ -3,7 +3,7 @@
 // matrices of 16 numbers that invert one another, unique camera names, map
 // files that exist and agree in size, no unknown elements or attributes), so
 // later phases can trust a wx_scene. Every error reads "scene.xml:LINE: what is
-// wrong". The only module that includes libxml2.
+// wrong". The only module that includes libxml2 (io/scene_xml*.c).
 #ifndef WX_SCENE_XML_H
 #define WX_SCENE_XML_H
 

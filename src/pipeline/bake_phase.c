@@ -14,6 +14,7 @@
 #include "core/progress.h"
 #include "io/maps_file.h"
 #include "io/mesh_import.h"
+#include "model/naming.h"
 #include "pipeline/load.h"
 #include "pipeline/outputs.h"
 
@@ -79,7 +80,6 @@ static wx_result keep_output_maps(const wx_image *depth, const wx_image *normal,
 // parallel, and points the camera at them.
 static wx_result write_maps(int camera, wx_image *maps, int count, void *user, wx_error *err)
 {
-    static const char *const kinds[4] = { "depth", "normal", "impact", "dirt" };
     bake_writer *w = user;
     wx_scene_camera *sc = &w->scene->cameras[camera];
     if (!w->prepared) {
@@ -92,7 +92,7 @@ static wx_result write_maps(int camera, wx_image *maps, int count, void *user, w
     for (int k = 0; k < count; ++k) {
         map_file *f = &w->files[k];
         char name[sizeof sc->name + 32];
-        snprintf(name, sizeof name, "%s_%s.exr", sc->name, kinds[k]);
+        wx_map_file_name(sc->name, k, name, sizeof name);
         wx_result r = wx_output_path(w->scene, w->opts, name, f->path, err);
         if (r != WX_OK) {
             wx_error_prefix(err, "bake camera '%s'", sc->name);

@@ -10,6 +10,7 @@
 #include "io/exr.h"
 #include "io/maps_file.h"
 #include "io/png_preview.h"
+#include "model/naming.h"
 #include "pipeline/load.h"
 #include "core/progress.h"
 #include "pipeline/masks_phase.h"
@@ -66,33 +67,6 @@ wx_result wx_gather_maps(const wx_scene *scene, const wx_run_def *opts, const wx
     return wx_gather_frame(scene, opts, in_maps, given_out, textures, masks, 0, detail, err);
 }
 
-void wx_gather_views_of_substance(wx_gather_view *views, const wx_maps *in_maps, int count,
-                                  int substance)
-{
-    for (int v = 0; v < count; ++v) {
-        size_t plane = (size_t)substance * (size_t)in_maps[v].width * (size_t)in_maps[v].height;
-        views[v].dirt = in_maps[v].dirt != NULL ? in_maps[v].dirt + plane : NULL;
-        views[v].initial = in_maps[v].initial_dirt != NULL ? in_maps[v].initial_dirt + plane
-                                                           : NULL;
-    }
-}
-
-bool wx_frame_wanted(const wx_scene *scene, int frame)
-{
-    if (scene->output_index >= 0 && scene->output_index < scene->camera_count) {
-        int every = scene->cameras[scene->output_index].every;
-        if (frame == 0 || (every > 0 && frame % every == 0)) {
-            return true;
-        }
-    }
-    for (int t = 0; t < scene->texture_count; ++t) {
-        if (wx_texture_writes_frame(&scene->textures[t], frame)) {
-            return true;
-        }
-    }
-    return false;
-}
-
 wx_result wx_gather_frame(const wx_scene *scene, const wx_run_def *opts, const wx_maps *in_maps,
                           const wx_maps *given_out, const wx_textures *textures,
                           wx_mask_context *given_masks, int frame, wx_phase_detail *detail,
@@ -140,40 +114,6 @@ wx_result wx_gather_frame(const wx_scene *scene, const wx_run_def *opts, const w
         wx_mask_context_free(&own);
     }
     return r;
-}
-
-int wx_mask_channels(const wx_scene *scene, char names[][WX_NAME_MAX])
-{
-    if (!scene->substances_declared && scene->mask_count == 0) {
-        snprintf(names[0], WX_NAME_MAX, "Y");
-        return 1;
-    }
-    int n = 0;
-    for (int s = 0; s < scene->substance_count; ++s) {
-        snprintf(names[n++], WX_NAME_MAX, "%s.Y", scene->substances[s]);
-    }
-    for (int m = 0; m < scene->mask_count; ++m) {
-        snprintf(names[n++], WX_NAME_MAX, "%s.Y", scene->masks[m].name);
-    }
-    return n;
-}
-
-void wx_frame_name(const char *mask_name, int frame, char *out, size_t cap)
-{
-    size_t n = strlen(mask_name);
-    size_t base = n >= 4 && strcmp(mask_name + n - 4, ".exr") == 0 ? n - 4 : n;
-    snprintf(out, cap, "%.*s.%04d.exr", (int)base, mask_name, frame);
-}
-
-void wx_channel_preview_name(const char *mask_name, const char *channel, char *out, size_t cap)
-{
-    size_t n = strlen(mask_name);
-    size_t base = n >= 4 && strcmp(mask_name + n - 4, ".exr") == 0 ? n - 4 : n;
-    size_t len = strlen(channel);
-    if (len >= 2 && strcmp(channel + len - 2, ".Y") == 0) {
-        len -= 2; // rust.Y -> BASE_rust.png
-    }
-    snprintf(out, cap, "%.*s_%.*s.png", (int)base, mask_name, (int)len, channel);
 }
 
 // The mask of frame `frame` (0: the final file and its previews).

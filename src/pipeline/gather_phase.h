@@ -52,23 +52,4 @@ wx_result wx_gather_frame(const wx_scene *scene, const wx_run_def *opts, const w
                           struct wx_mask_context *masks, int frame, wx_phase_detail *detail,
                           wx_error *err);
 
-/// Points views[0..count) (made by wx_gather_view_from_maps) at substance
-/// `substance`'s amount and baseline planes of in_maps (model/maps.h: S planes
-/// one after the other), for one gather of that substance.
-void wx_gather_views_of_substance(wx_gather_view *views, const wx_maps *in_maps, int count,
-                                  int substance);
-
-/// Whether frame `frame` writes anything: the mask's or some TextureMap's
-/// `every` divides it (frame 0: always).
-bool wx_frame_wanted(const wx_scene *scene, int frame);
-
-/// The mask's channels (docs/design.md section 10): "Y" for a scene without
-/// <Substances>, else NAME.Y per substance. Returns the count.
-int wx_mask_channels(const wx_scene *scene, char names[][WX_NAME_MAX]);
-
-/// BASE.NNNN.exr of mask file BASE.exr, and BASE_NAME.png, the preview of
-/// channel NAME.Y.
-void wx_frame_name(const char *mask_name, int frame, char *out, size_t cap);
-void wx_channel_preview_name(const char *mask_name, const char *channel, char *out, size_t cap);
-
 #endif

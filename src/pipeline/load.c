@@ -222,3 +222,13 @@ void wx_layer_scene_free(wx_layer_scene *layered)
     }
     memset(layered, 0, sizeof *layered);
 }
+
+void wx_gather_views_of_substance(wx_gather_view *views, const wx_maps *in_maps, int count,
+                                  int substance)
+{
+    for (int v = 0; v < count; ++v) {
+        size_t plane = (size_t)substance * (size_t)in_maps[v].width * (size_t)in_maps[v].height;
+        views[v].dirt = in_maps[v].dirt != NULL ? in_maps[v].dirt + plane : NULL;
+        views[v].initial = in_maps[v].initial_dirt != NULL ? in_maps[v].initial_dirt + plane : NULL;
+    }
+}

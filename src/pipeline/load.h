@@ -4,6 +4,7 @@
 #define WX_LOAD_H
 
 #include "core/error.h"
+#include "gather/gather.h"
 #include "model/maps.h"
 #include "model/scene.h"
 #include "pipeline/pipeline.h"
@@ -42,6 +43,12 @@ typedef struct wx_layer_scene {
     float *buried[WX_MAX_INPUT_CAMERAS];
     int buried_count;
 } wx_layer_scene;
+
+/// Points views[0..count) (made by wx_gather_view_from_maps) at substance
+/// `substance`'s amount and baseline planes of in_maps (model/maps.h: S planes
+/// one after the other), for one gather of that substance.
+void wx_gather_views_of_substance(wx_gather_view *views, const wx_maps *in_maps, int count,
+                                  int substance);
 
 wx_result wx_layer_scene_init(const wx_scene *scene, const wx_maps *maps, int threads,
                               wx_layer_scene *out, wx_error *err);

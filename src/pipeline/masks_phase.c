@@ -5,7 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "pipeline/gather_phase.h"
+#include "model/naming.h"
 
 bool wx_masks_worth_keeping(const wx_scene *scene)
 {

@@ -4,8 +4,6 @@
 #define _XOPEN_SOURCE 700 // realpath
 #include "pipeline/outputs.h"
 
-#include "pipeline/gather_phase.h"
-
 #include <errno.h>
 #include <limits.h>
 #include <stdarg.h>
@@ -18,16 +16,9 @@
 
 #include "core/array.h"
 #include "core/atomic_file.h"
+#include "io/exr.h"
+#include "model/naming.h"
 #include "pipeline/preset.h"
-#include "pipeline/texture_phase.h"
-
-void wx_preview_name(const char *mask_name, char *out, size_t cap)
-{
-    const char *dot = strrchr(mask_name, '.');
-    int stem = dot != NULL && dot != mask_name ? (int)(dot - mask_name) : (int)strlen(mask_name);
-    bool is_png = dot != NULL && dot != mask_name && strcmp(dot, ".png") == 0;
-    snprintf(out, cap, "%.*s%s", stem, mask_name, is_png ? ".preview.png" : ".png");
-}
 
 // A <View> camera whose maps `bake` writes into the output folder.
 static bool baked_camera(const wx_scene_camera *cam)
@@ -139,17 +130,19 @@ static wx_result add_sequence(const wx_scene *scene, const char *file, int every
 wx_result wx_output_names_list(const wx_scene *scene, unsigned phases, wx_output_names *out,
                                wx_error *err)
 {
-    static const char *const kinds[4] = { "depth", "normal", "impact", "dirt" };
     memset(out, 0, sizeof *out);
     wx_result r = WX_OK;
     for (int c = 0; c < scene->camera_count && r == WX_OK; ++c) {
         const wx_scene_camera *cam = &scene->cameras[c];
         int baked = (phases & WX_PHASE_BAKE) && baked_camera(cam) ? (cam->is_output ? 2 : 4) : 0;
+        char map[WX_OUTPUT_NAME_MAX];
         for (int k = 0; k < baked && r == WX_OK; ++k) {
-            r = add_name(out, NULL, "%s_%s.exr", cam->name, kinds[k]);
+            wx_map_file_name(cam->name, k, map, sizeof map);
+            r = add_name(out, NULL, "%s", map);
         }
         if (r == WX_OK && (phases & WX_PHASE_SIMULATE) && !cam->is_output) {
-            r = add_name(out, NULL, "%s_dirt.exr", cam->name);
+            wx_map_file_name(cam->name, WX_MAP_DIRT, map, sizeof map);
+            r = add_name(out, NULL, "%s", map);
         }
     }
     if (r == WX_OK && (phases & WX_PHASE_GATHER) && scene->output_index >= 0) {
@@ -611,7 +604,6 @@ bool wx_scene_needs_bake(const wx_scene *scene)
 
 wx_result wx_use_baked_maps(wx_scene *scene, const wx_run_def *opts, wx_error *err)
 {
-    static const char *const kinds[4] = { "depth", "normal", "impact", "dirt" };
     for (int c = 0; c < scene->camera_count; ++c) {
         wx_scene_camera *cam = &scene->cameras[c];
         if (!cam->has_view || wx_has_path(cam->depth_path)) {
@@ -622,9 +614,9 @@ wx_result wx_use_baked_maps(wx_scene *scene, const wx_run_def *opts, wx_error *e
                             &cam->dirt_path };
         int count = cam->is_output ? 2 : 4;
         for (int k = 0; k < count; ++k) {
-            char path[WX_PATH_MAX];
-            int n = snprintf(path, sizeof path, "%s/%s_%s.exr", opts->out_dir, cam->name,
-                             kinds[k]);
+            char path[WX_PATH_MAX], name[WX_OUTPUT_NAME_MAX];
+            wx_map_file_name(cam->name, k, name, sizeof name);
+            int n = snprintf(path, sizeof path, "%s/%s", opts->out_dir, name);
             if (n < 0 || n >= (int)sizeof path) {
                 return wx_fail(err, WX_CAUSE_PATH_TOO_LONG, "%s: output path too long",
                                opts->out_dir);
@@ -636,11 +628,32 @@ wx_result wx_use_baked_maps(wx_scene *scene, const wx_run_def *opts, wx_error *e
                 return wx_fail(err, WX_CAUSE_MISSING_PHASE,
                                "%s: camera '%s' has no baked %s map in %s; run `weathering "
                                "bake %s --out %s` first",
-                               scene->path, cam->name, kinds[k], opts->out_dir, scene->path,
-                               opts->out_dir);
+                               scene->path, cam->name, wx_map_kind_name(k), opts->out_dir,
+                               scene->path, opts->out_dir);
             }
         }
     }
     return WX_OK;
 }
 
+void wx_output_describe(FILE *out, const wx_run_def *opts, const char *name)
+{
+    char path[WX_PATH_MAX + 512];
+    snprintf(path, sizeof path, "%s/%s", opts->out_dir, name);
+    struct stat st;
+    if (stat(path, &st) != 0) {
+        return;
+    }
+    wx_image *image = calloc(1, sizeof *image);
+    wx_error err;
+    fprintf(out, "  %-28s %8.1f MB", name, (double)st.st_size / 1e6);
+    if (image != NULL && wx_exr_read_header(path, image, &err) == WX_OK) {
+        fprintf(out, "  %d x %d, channels", image->width, image->height);
+        for (int c = 0; c < image->channel_count; ++c) {
+            fprintf(out, "%s %s", c > 0 ? "," : "", image->channel_names[c]);
+        }
+        wx_image_free(image);
+    }
+    free(image);
+    fprintf(out, "\n");
+}

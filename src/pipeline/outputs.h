@@ -9,6 +9,7 @@
 #include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <stdio.h>
 
 #include "core/error.h"
 #include "core/limits.h"
@@ -41,10 +42,6 @@ void wx_output_names_free(wx_output_names *names);
 
 /// True when `name` is one of the list's names (constant time).
 bool wx_output_names_has(const wx_output_names *names, const char *name);
-
-/// The preview's name for a mask's: its extension replaced by .png ("mask.exr"
-/// -> "mask.png"; "mask" -> "mask.png"; "mask.png" -> "mask.preview.png").
-void wx_preview_name(const char *mask_name, char *out, size_t cap);
 
 /// Checks made before any work or any folder: no file the phases will write
 /// is an input of the scene (the scene, a map or a mesh it names) or an
@@ -88,6 +85,11 @@ void wx_output_remove_empty(const char *out_dir, const char *created);
 /// program baked into the output folder (maps_in_output) are not inputs.
 wx_result wx_output_path(const wx_scene *scene, const wx_run_def *opts, const char *name,
                          char path[WX_PATH_MAX], wx_error *err);
+
+/// One output's line in the summary of a run, on `out`: its name, its size in
+/// MB and, when it reads as an EXR, its size in texels and its channels.
+/// Nothing when opts->out_dir holds no file `name`.
+void wx_output_describe(FILE *out, const wx_run_def *opts, const char *name);
 
 /// True when some camera is given by <View> without map files in the scene:
 /// `bake` renders it from the geometry.

@@ -1,6 +1,6 @@
 // pipeline.h: what every phase of a run (bake, simulate, gather) shares: the
-// options of the command line (--out, --seed, --threads, -q, --stats) and the
-// phases themselves as bits.
+// options of the command line (--out, --seed, --threads, -q, --stats); the
+// phases themselves as bits are model/naming.h's.
 #ifndef WX_PIPELINE_H
 #define WX_PIPELINE_H
 
@@ -9,6 +9,7 @@
 #include <stdint.h>
 
 #include "core/error.h"
+#include "model/naming.h" // the phases as bits (WX_PHASE_*)
 #include "model/scene.h"
 
 /// Options shared by every phase (command line: --out, --seed, --threads, -q, --stats).
@@ -31,13 +32,5 @@ wx_run_def wx_default_run_def(const wx_scene *scene);
 /// character but letters, digits, '_', '-' and '.' replaced by '_', leading dots
 /// too, so that out/NAME always lies inside out/ ("..": "__"; "": "scene").
 void wx_default_out_name(const char *scene_name, char *out, size_t cap);
-
-/// The phases of a run, as bits.
-enum {
-    WX_PHASE_BAKE = 1 << 0,
-    WX_PHASE_SIMULATE = 1 << 1,
-    WX_PHASE_GATHER = 1 << 2,
-    WX_PHASE_ALL = 7,
-};
 
 #endif

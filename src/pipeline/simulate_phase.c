@@ -10,6 +10,7 @@
 #include "core/progress.h"
 #include "io/exr.h"
 #include "io/maps_file.h"
+#include "model/naming.h"
 #include "pipeline/gather_phase.h"
 #include "pipeline/load.h"
 #include "pipeline/masks_phase.h"

@@ -10,6 +10,7 @@
 #include "core/atomic_file.h"
 #include "io/exr.h"
 #include "model/image.h"
+#include "model/naming.h"
 #include "pipeline/outputs.h"
 #include "pipeline/pipeline.h"
 
@@ -17,9 +18,8 @@ void wx_split_file_name(const char *base, const char *channel, char out[WX_OUTPU
 {
     char name[WX_NAME_MAX];
     snprintf(name, sizeof name, "%s", channel);
-    size_t n = strlen(name);
-    if (n > 2 && strcmp(name + n - 2, ".Y") == 0) {
-        name[n - 2] = '\0';
+    if (strlen(name) > 2) { // a channel named ".Y" keeps its name
+        name[wx_channel_stem_length(name)] = '\0';
     }
     char joined[WX_OUTPUT_NAME_MAX];
     snprintf(joined, sizeof joined, "%s_%s", base, name);

@@ -12,20 +12,9 @@
 #include "io/exr.h"
 #include "io/png_preview.h"
 #include "model/image.h"
-#include "pipeline/gather_phase.h"
+#include "model/naming.h"
+#include "pipeline/load.h"
 #include "pipeline/outputs.h"
-
-int wx_texture_channels(const wx_scene *scene, char names[][WX_NAME_MAX])
-{
-    int n = wx_mask_channels(scene, names);
-    snprintf(names[n], WX_NAME_MAX, "seen");
-    return n + 1;
-}
-
-bool wx_texture_writes_frame(const wx_texture_map *t, int frame)
-{
-    return frame == 0 || (t->every > 0 && frame % t->every == 0);
-}
 
 // The arrays the sampling reads, copied: the bake releases the geometry's.
 static wx_result copy_mesh(const wx_mesh_data *from, int uv, wx_mesh_data *to, wx_error *err)
@@ -67,13 +56,6 @@ static double mesh_area(const wx_mesh_data *mesh)
         area += 0.5 * sqrt(x * x + y * y + z * z);
     }
     return area;
-}
-
-void wx_tile_name(const char *file, int udim, char *out, size_t cap)
-{
-    size_t n = strlen(file);
-    size_t base = n >= 4 && strcmp(file + n - 4, ".exr") == 0 ? n - 4 : n;
-    snprintf(out, cap, "%.*s.%04d.exr", (int)base, file, WX_UDIM_FIRST + udim);
 }
 
 void wx_textures_find_tiles(wx_scene *scene, const wx_geometry *geometry)

@@ -47,10 +47,6 @@ typedef struct wx_textures {
 /// and the memory estimate need before any work. The others are left alone.
 void wx_textures_find_tiles(wx_scene *scene, const wx_geometry *geometry);
 
-/// The name of tile `udim` of texture file `file`: BASE.(1001 + udim).exr,
-/// BASE the file without its ".exr" (as the frames' BASE.NNNN.exr).
-void wx_tile_name(const char *file, int udim, char *out, size_t cap);
-
 /// Rasterises every <TextureMap> from `geometry` (imported by
 /// wx_geometry_load with the UV channels they read, before the bake releases
 /// its arrays), and says for each what `info` says (coverage, overlaps,
@@ -60,9 +56,6 @@ wx_result wx_textures_prepare(const wx_scene *scene, const wx_geometry *geometry
 
 /// Frees everything; the struct is zeroed.
 void wx_textures_free(wx_textures *textures);
-
-/// Whether frame `frame` (0: the final files) writes texture `t`.
-bool wx_texture_writes_frame(const wx_texture_map *t, int frame);
 
 /// Writes the textures of frame `frame` from the input cameras' maps in memory
 /// (in_maps: one per input camera in scene order, depth, normal and the dirt
@@ -75,9 +68,6 @@ wx_result wx_textures_write(const wx_scene *scene, const wx_run_def *opts,
                             const wx_textures *textures, const wx_maps *in_maps,
                             wx_mask_context *masks, int frame, wx_phase_detail *detail,
                             wx_error *err);
-
-/// The texture's channels: the mask's (section 10) and `seen`. Returns the count.
-int wx_texture_channels(const wx_scene *scene, char names[][WX_NAME_MAX]);
 
 /// Bytes per texel of a UV raster while it is held (triangle and source).
 #define WX_TEXTURE_RASTER_BYTES_PER_TEXEL 8.0
