@@ -224,7 +224,7 @@ TEST(every_layer_includes_only_the_layers_below_it)
             bad += check_library(rel, text, "<assimp/", "io/mesh_import.c io/mesh_postprocess.c");
             bad += check_library(rel, text, "<openexr.h>",
                                  "io/exr.c io/exr_write.c io/exr_internal.h");
-            bad += check_library(rel, text, "<GL/", "raster/bake_internal.h");
+            bad += check_library(rel, text, "<GL/", "raster/baker_internal.h");
             bad += check_library(rel, text, "<png.h>", "io/png_preview.c");
             free(text);
             files++;
@@ -255,7 +255,7 @@ TEST(a_wrong_include_is_caught)
 
 // --- private headers ------------------------------------------------------------
 // A folder's NAME_internal.h is shared by the files of that folder only, and is
-// included by its folder-qualified name ("sim/simulate_internal.h"); the
+// included by its folder-qualified name ("sim/solver_internal.h"); the
 // programs' folders, cli/ and viewer/ (`folder` "cli" or "viewer"), name their
 // own by the bare name ("world_internal.h"). A file of another layer or folder,
 // or of tests/ (`folder` NULL), that includes one is a violation. Returns the
@@ -344,11 +344,11 @@ TEST(private_headers_stay_in_their_folder)
     ENSURE(files > 80);
     ENSURE(bad == 0);
     // The check finds what it is meant to find.
-    const char *text = "#include \"sim/simulate_internal.h\"\n";
+    const char *text = "#include \"sim/solver_internal.h\"\n";
     ENSURE(check_private_headers("sim/step.c", "sim", text) == 0);
     ENSURE(check_private_headers("gather/x.c", "gather", text) == 1);
     ENSURE(check_private_headers("cli/main.c", NULL, text) == 1);
-    ENSURE(check_private_headers("sim/x.c", "sim", "#include \"simulate_internal.h\"\n") == 1);
+    ENSURE(check_private_headers("sim/x.c", "sim", "#include \"solver_internal.h\"\n") == 1);
     ENSURE(check_private_headers("sim/x.c", "sim", "#include \"sim/simulate.h\"\n") == 0);
     const char *world = "#include \"world_internal.h\"\n";
     ENSURE(check_private_headers("viewer/world_load.c", "viewer", world) == 0);

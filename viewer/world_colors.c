@@ -84,36 +84,6 @@ double vw_world_deposit(const vw_world *world, int point)
     return map->texels[(size_t)sample->texel * (size_t)S + (size_t)s].dirt;
 }
 
-float vw_select_kth(float *a, size_t n, size_t k)
-{
-    ptrdiff_t lo = 0, hi = (ptrdiff_t)n - 1, want = (ptrdiff_t)k;
-    while (lo < hi) {
-        float pivot = a[lo + (hi - lo) / 2];
-        ptrdiff_t i = lo, j = hi;
-        while (i <= j) {
-            while (a[i] < pivot) {
-                i++;
-            }
-            while (a[j] > pivot) {
-                j--;
-            }
-            if (i <= j) {
-                float t = a[i];
-                a[i++] = a[j];
-                a[j--] = t;
-            }
-        }
-        if (want <= j) {
-            hi = j;
-        } else if (want >= i) {
-            lo = i;
-        } else {
-            break;
-        }
-    }
-    return a[want];
-}
-
 float vw_world_deposit_scale(const vw_world *world, const uint32_t *picked, size_t n,
                              float *scratch)
 {

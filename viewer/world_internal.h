@@ -14,7 +14,7 @@
 wx_result vw_world_build_geometry(vw_world *world, wx_error *err);
 
 /// The k-th smallest of a[0..n) (0-based, n > 0; a is reordered): Hoare's
-/// selection.
+/// selection (world_masks.c; the deposits' scale takes it too).
 float vw_select_kth(float *a, size_t n, size_t k);
 
 /// A colour of palette.h as floats, 0..1 per channel.

@@ -1,6 +1,7 @@
 // world_masks.c: a world's derived masks (world.h, docs/design.md section 12):
 // each mask computed once at the depth samples, on the grid of each layer's
-// sampled texels, and which mask is shown.
+// sampled texels, which mask is shown, and the quantiles both the masks' and
+// the deposits' colour scales take (vw_select_kth).
 #include "world_internal.h"
 
 #include <math.h>
@@ -156,6 +157,36 @@ static void masks_for_grid(const wx_scene *scene, int m, const mask_role role[],
             md->radius = 2.0f * (float)g->stride * g->texel;
         }
     }
+}
+
+float vw_select_kth(float *a, size_t n, size_t k)
+{
+    ptrdiff_t lo = 0, hi = (ptrdiff_t)n - 1, want = (ptrdiff_t)k;
+    while (lo < hi) {
+        float pivot = a[lo + (hi - lo) / 2];
+        ptrdiff_t i = lo, j = hi;
+        while (i <= j) {
+            while (a[i] < pivot) {
+                i++;
+            }
+            while (a[j] > pivot) {
+                j--;
+            }
+            if (i <= j) {
+                float t = a[i];
+                a[i++] = a[j];
+                a[j--] = t;
+            }
+        }
+        if (want <= j) {
+            hi = j;
+        } else if (want >= i) {
+            lo = i;
+        } else {
+            break;
+        }
+    }
+    return a[want];
 }
 
 float vw_world_mask_scale(const vw_world *world, int m, const float *values)

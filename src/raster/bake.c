@@ -21,7 +21,7 @@
 // every (camera, layer) is a view of the initial-dirt ownership.
 //
 // This file holds the bake's logic; bake_gl.c the GL side (context, shaders,
-// framebuffer, drawing, readback), through bake_internal.h.
+// framebuffer, drawing, readback), through baker_internal.h.
 #include "raster/bake.h"
 
 #include <math.h>
@@ -30,7 +30,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "raster/bake_internal.h"
+#include "raster/baker_internal.h"
 #include "model/maps.h"
 #include "model/scene.h"
 #include "model/geometry.h"

@@ -7,7 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "raster/bake_internal.h"
+#include "raster/baker_internal.h"
 #include "core/matrix.h"
 #include "shaders.h"
 

@@ -4,7 +4,7 @@
 #include <math.h>
 #include <stdlib.h>
 
-#include "sim/simulate_internal.h"
+#include "sim/solver_internal.h"
 
 // View c's ageing state: the baseline (amounts without the particles)
 // when the scene has rules, and the area Grow multiplies: the bake's record of

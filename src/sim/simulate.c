@@ -31,7 +31,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "sim/simulate_internal.h"
+#include "sim/solver_internal.h"
 
 enum {
     DEFAULT_HIT_CAPACITY = 4096,

@@ -4,7 +4,7 @@
 // the serial phase of simulate.c applies.
 #include <string.h>
 
-#include "sim/simulate_internal.h"
+#include "sim/solver_internal.h"
 #include "core/array.h"
 
 static const uint32_t lane_bit[WX_PARTICLE_BLOCK] = {

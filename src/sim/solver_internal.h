@@ -1,9 +1,9 @@
-// simulate_internal.h: what the files of the simulation (simulate.c: the
+// solver_internal.h: what the files of the simulation (simulate.c: the
 // orchestration, step.c: the step kernel, ageing.c: the ageing rules) share:
 // the solver's state and the records the threads hand to the serial phase.
 // Private to src/sim/.
-#ifndef WX_SIMULATE_INTERNAL_H
-#define WX_SIMULATE_INTERNAL_H
+#ifndef WX_SOLVER_INTERNAL_H
+#define WX_SOLVER_INTERNAL_H
 
 #include <stdatomic.h>
 #include <stdbool.h>

@@ -1,10 +1,10 @@
-// bake_internal.h: what the two files of the bake share: the baker's state
+// baker_internal.h: what the two files of the bake share: the baker's state
 // (its GL objects among it, hence the GL headers) and the GL side's functions
 // (bake_gl.c: the OSMesa context, the shaders, the framebuffer, the meshes on
 // the GPU, drawing and readback), which bake.c's logic calls. Private to
 // src/raster/.
-#ifndef WX_BAKE_INTERNAL_H
-#define WX_BAKE_INTERNAL_H
+#ifndef WX_BAKER_INTERNAL_H
+#define WX_BAKER_INTERNAL_H
 
 #define GL_GLEXT_PROTOTYPES 1
 #include <GL/osmesa.h>
