@@ -237,8 +237,69 @@ TEST(rain_reaches_the_floor_of_a_niche_every_first_surface_hides)
     ENSURE(dry.hits < 0.01 * F);
 }
 
+// Replaces the first `from` in `text` (a malloc'ed string) by `to`; false when
+// `from` is not there.
+static bool replace_once(char **text, const char *from, const char *to)
+{
+    char *at = strstr(*text, from);
+    if (at == NULL) {
+        return false;
+    }
+    size_t head = (size_t)(at - *text), from_len = strlen(from), to_len = strlen(to);
+    size_t tail = strlen(at + from_len);
+    char *joined = malloc(head + to_len + tail + 1);
+    if (joined == NULL) {
+        return false;
+    }
+    memcpy(joined, *text, head);
+    memcpy(joined + head, to, to_len);
+    memcpy(joined + head + to_len, at + from_len, tail + 1);
+    free(*text);
+    *text = joined;
+    return true;
+}
+
+// The mask's frames of a layered scene are gathered as the final mask is: the
+// last frame is its bytes. Spot's generated scene (4 layers per camera, front
+// and back cameras tied on every surface, so ownership needs the layers'
+// outward normals) over two iterations. The frames' views used to lose the
+// layers' `outward`, and the last frame differed from mask.exr.
+TEST(the_last_frame_of_a_layered_scene_is_the_final_mask)
+{
+    const char *dir = ensure_tmpdir();
+    char tests[PATH_MAX], args[PATH_MAX + 128];
+    ENSURE(realpath(ensure_tests_dir(), tests) != NULL);
+    snprintf(args, sizeof args,
+             "init '%s/../xml_scenes/meshes/spot.obj' -o frames.xml --resolution 128 --force",
+             tests);
+    ENSURE(weathering_in(dir, args, true) == 0);
+    char path[PATH_MAX];
+    snprintf(path, sizeof path, "%s/frames.xml", dir);
+    char *xml = ensure_read_file(path);
+    ENSURE(xml != NULL);
+    ENSURE(strstr(xml, "layers=\"4\"") != NULL);
+    ENSURE(replace_once(&xml, "seed=\"1\"/>", "seed=\"1\" iterations=\"2\"/>"));
+    ENSURE(replace_once(&xml, "<OutputMap file=\"mask.exr\"/>",
+                        "<OutputMap file=\"mask.exr\" every=\"1\"/>"));
+    const char *rate = strstr(xml, "rate=\"");
+    ENSURE(rate != NULL);
+    size_t len = strcspn(rate + 6, "\"");
+    ENSURE(len < 40);
+    char old_rate[64];
+    snprintf(old_rate, sizeof old_rate, "rate=\"%.*s\"", (int)len, rate + 6);
+    ENSURE(replace_once(&xml, old_rate, "rate=\"40000\""));
+    ensure_write_file(dir, "frames.xml", xml);
+    free(xml);
+    ENSURE(weathering_in(dir, "run frames.xml --out frames -q", true) == 0);
+    char log[4096];
+    ENSURE(ensure_shell(log, sizeof log, "cd '%s/frames' && cmp mask.exr mask.0002.exr", dir) == 0);
+    ENSURE(ensure_shell(log, sizeof log, "cd '%s/frames' && ! cmp -s mask.0001.exr mask.0002.exr",
+                        dir) == 0);
+}
+
 int main(void)
 {
     RUN(rain_reaches_the_floor_of_a_niche_every_first_surface_hides);
+    RUN(the_last_frame_of_a_layered_scene_is_the_final_mask);
     return ensure_summary();
 }

@@ -208,6 +208,10 @@ static wx_result simulation_views(const wx_scene *scene, const wx_run_def *opts,
         view[c].height = maps[c].height;
         view[c].substances = maps[c].substances;
         view[c].layers = maps[c].layers;
+        // Layered cameras' normals point out of the solid, as the dirt maps'
+        // loader (wx_maps_load_layers) says of the maps it reads: a frame's
+        // ownership and its masks' collider then are the final gather's.
+        view[c].outward = maps[c].outward;
         view[c].depth = maps[c].depth;
         view[c].normal = maps[c].normal;
         r = gather_plane_blocks(sim, &maps[c], c, opts->threads, &view[c].dirt,
@@ -247,11 +251,6 @@ wx_result wx_gather_simulation(const wx_scene *scene, const wx_run_def *opts, co
 {
     wx_maps *view = NULL;
     wx_result r = simulation_views(scene, opts, sim, maps, &view, err);
-    // Layered cameras' normals point out of the solid, as the dirt maps'
-    // loader (wx_maps_load_layers) says of the maps it reads.
-    for (int c = 0; r == WX_OK && c < scene->input_count; ++c) {
-        view[c].outward = maps[c].outward;
-    }
     if (r == WX_OK) {
         r = wx_gather_maps(scene, opts, view, NULL, NULL, NULL, NULL, err);
     }
