@@ -185,6 +185,79 @@ TEST(a_sequence_of_100000_frames_is_listed_at_once)
     ENSURE(seconds < 2.0); // about 0.03 s; 20 to 60 s when quadratic
 }
 
+// The run's list of outputs names exactly the previews the writers write
+// (wx_preview_names): BASE.png for a mask of one channel (no <Substances>, or
+// one declared substance, and no <Masks>), else BASE_NAME.png per channel, for
+// the mask and for each TextureMap alike. The list used to name BASE.png for
+// the mask always and no preview of a derived mask, so a stale temporary of
+// those was never cleaned and a folder at their names was not refused first.
+static bool lists(const wx_scene *scene, const char *const *yes, const char *const *no)
+{
+    wx_output_names names;
+    wx_error err;
+    if (wx_output_names_list(scene, WX_PHASE_ALL, &names, &err) != WX_OK) {
+        return false;
+    }
+    bool right = true;
+    for (int k = 0; yes[k] != NULL; ++k) {
+        if (!wx_output_names_has(&names, yes[k])) {
+            fprintf(stderr, "        %s is not listed\n", yes[k]);
+            right = false;
+        }
+    }
+    for (int k = 0; no[k] != NULL; ++k) {
+        if (wx_output_names_has(&names, no[k])) {
+            fprintf(stderr, "        %s is listed\n", no[k]);
+            right = false;
+        }
+    }
+    wx_output_names_free(&names);
+    return right;
+}
+
+TEST(the_output_list_names_the_previews_the_writers_write)
+{
+    wx_scene_camera cams[2] = {
+        { .name = "front", .has_view = true },
+        { .name = "out", .has_view = true, .is_output = true, .output_file = "mask.exr" }
+    };
+    wx_texture_map tex = { .file = "tex.exr" };
+    wx_scene scene = { .cameras = cams,
+                       .camera_count = 2,
+                       .output_index = 1,
+                       .textures = &tex,
+                       .texture_count = 1,
+                       .iterations = 1,
+                       .substance_count = 1,
+                       .substances = { "dirt" } };
+    // No <Substances>, no <Masks>: one channel Y.
+    ENSURE(lists(&scene, (const char *[]){ "mask.png", "tex.png", NULL },
+                 (const char *[]){ "mask_dirt.png", "tex_dirt.png", NULL }));
+    // One declared substance: still one channel, so BASE.png.
+    scene.substances_declared = true;
+    snprintf(scene.substances[0], sizeof scene.substances[0], "water");
+    ENSURE(lists(&scene, (const char *[]){ "mask.png", "tex.png", NULL },
+                 (const char *[]){ "mask_water.png", "tex_water.png", NULL }));
+    // <Masks> without <Substances>: the dirt's channel and the mask's.
+    scene.substances_declared = false;
+    snprintf(scene.substances[0], sizeof scene.substances[0], "dirt");
+    scene.mask_count = 1;
+    snprintf(scene.masks[0].name, sizeof scene.masks[0].name, "ao");
+    ENSURE(lists(
+        &scene,
+        (const char *[]){ "mask_dirt.png", "mask_ao.png", "tex_dirt.png", "tex_ao.png", NULL },
+        (const char *[]){ "mask.png", "tex.png", NULL }));
+    // Two substances and a mask.
+    scene.substances_declared = true;
+    scene.substance_count = 2;
+    snprintf(scene.substances[0], sizeof scene.substances[0], "water");
+    snprintf(scene.substances[1], sizeof scene.substances[1], "rust");
+    ENSURE(lists(&scene,
+                 (const char *[]){ "mask_water.png", "mask_rust.png", "mask_ao.png",
+                                   "tex_water.png", "tex_rust.png", "tex_ao.png", NULL },
+                 (const char *[]){ "mask.png", "tex.png", "mask_dirt.png", NULL }));
+}
+
 int main(void)
 {
     RUN(output_folder_is_created_with_parents);
@@ -193,5 +266,6 @@ int main(void)
     RUN(atomic_write_replaces_whole_and_leaves_no_temporary);
     RUN(stats_json_has_the_pinned_keys_and_values);
     RUN(a_sequence_of_100000_frames_is_listed_at_once);
+    RUN(the_output_list_names_the_previews_the_writers_write);
     return ensure_summary();
 }

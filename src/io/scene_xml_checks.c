@@ -107,32 +107,6 @@ static int frame_of(const wx_scene *s, const char *name, const output_entry *e)
     return (int)frame;
 }
 
-/// Most previews one output writes: one per substance and per derived mask.
-#define SCENE_MAX_PREVIEWS (WX_MAX_SUBSTANCES + WX_MAX_MASKS)
-
-/// The previews of `file` (docs/design.md section 10): BASE.png for the one
-/// channel Y of a scene with neither <Substances> nor <Masks>, else
-/// BASE_NAME.png per substance and per mask (a TextureMap's seen has none).
-/// Returns how many.
-static int preview_names(const wx_scene *s, const char *file,
-                         char names[SCENE_MAX_PREVIEWS][WX_OUTPUT_NAME_MAX])
-{
-    if (!s->substances_declared && s->mask_count == 0) {
-        // BASE.png: `file` ends in .exr (parse_output_map, parse_texture_map),
-        // so never BASE.preview.png here.
-        wx_preview_name(file, names[0], WX_OUTPUT_NAME_MAX);
-        return 1;
-    }
-    int n = 0;
-    for (int k = 0; k < s->substance_count; ++k) {
-        wx_channel_preview_name(file, s->substances[k], names[n++], WX_OUTPUT_NAME_MAX);
-    }
-    for (int k = 0; k < s->mask_count; ++k) {
-        wx_channel_preview_name(file, s->masks[k].name, names[n++], WX_OUTPUT_NAME_MAX);
-    }
-    return n;
-}
-
 /// "the <OutputMap> of output camera 'out' (line 12)" or "the <TextureMap> at line 30".
 static void describe_output(const output_entry *e, char *out, size_t cap)
 {
@@ -175,10 +149,10 @@ static wx_result check_texture_against(parser *p, const output_entry *t, const o
                          "file of %s; choose another",
                          t->file, t->every, frame, e->file, other);
     }
-    char mine[SCENE_MAX_PREVIEWS][WX_OUTPUT_NAME_MAX];
-    char theirs[SCENE_MAX_PREVIEWS][WX_OUTPUT_NAME_MAX];
-    int n_mine = preview_names(s, t->file, mine);
-    int n_theirs = preview_names(s, e->file, theirs);
+    char mine[WX_MAX_PREVIEWS][WX_OUTPUT_NAME_MAX];
+    char theirs[WX_MAX_PREVIEWS][WX_OUTPUT_NAME_MAX];
+    int n_mine = wx_preview_names(s, t->file, mine);
+    int n_theirs = wx_preview_names(s, e->file, theirs);
     for (int i = 0; i < n_mine; ++i) {
         for (int k = 0; k < n_theirs; ++k) {
             if (strcmp(mine[i], theirs[k]) == 0) {

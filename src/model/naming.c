@@ -82,6 +82,20 @@ int wx_texture_channels(const wx_scene *scene, char names[][WX_NAME_MAX])
     return n + 1;
 }
 
+int wx_preview_names(const wx_scene *scene, const char *file, char names[][WX_OUTPUT_NAME_MAX])
+{
+    char channels[WX_MAX_PREVIEWS][WX_NAME_MAX];
+    int n = wx_mask_channels(scene, channels);
+    if (n == 1) {
+        wx_preview_name(file, names[0], WX_OUTPUT_NAME_MAX);
+        return 1;
+    }
+    for (int c = 0; c < n; ++c) {
+        wx_channel_preview_name(file, channels[c], names[c], WX_OUTPUT_NAME_MAX);
+    }
+    return n;
+}
+
 bool wx_texture_writes_frame(const wx_texture_map *t, int frame)
 {
     return frame == 0 || (t->every > 0 && frame % t->every == 0);

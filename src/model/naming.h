@@ -64,6 +64,16 @@ int wx_mask_channels(const wx_scene *scene, char names[][WX_NAME_MAX]);
 /// The texture's channels: the mask's (section 10) and `seen`. Returns the count.
 int wx_texture_channels(const wx_scene *scene, char names[][WX_NAME_MAX]);
 
+/// The most previews one mask or texture file writes: one per channel.
+#define WX_MAX_PREVIEWS (WX_MAX_SUBSTANCES + WX_MAX_MASKS)
+
+/// The previews the final mask or TextureMap file `file` (BASE.exr) writes
+/// (docs/design.md section 10): BASE.png when the mask has one channel
+/// (wx_mask_channels), else BASE_NAME.png per channel NAME.Y. The one rule the
+/// writers, the scene's name checks and the run's list of outputs follow.
+/// Returns the count (at most WX_MAX_PREVIEWS).
+int wx_preview_names(const wx_scene *scene, const char *file, char names[][WX_OUTPUT_NAME_MAX]);
+
 /// Whether frame `frame` (0: the final files) writes texture `t`.
 bool wx_texture_writes_frame(const wx_texture_map *t, int frame);
 

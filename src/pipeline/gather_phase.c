@@ -129,15 +129,11 @@ static wx_result write_mask(const wx_scene *scene, const wx_run_def *opts, const
     for (int c = 0; c < channels; ++c) {
         channel_names[c] = names[c];
     }
-    char mask_path[WX_PATH_MAX], png_path[WX_PATH_MAX], png_name[WX_OUTPUT_NAME_MAX];
+    char mask_path[WX_PATH_MAX], png_path[WX_PATH_MAX];
     char frame_name[WX_OUTPUT_NAME_MAX];
     wx_frame_name(out->output_file, frame, frame_name, sizeof frame_name);
-    wx_preview_name(out->output_file, png_name, sizeof png_name);
-    wx_result result = wx_output_path(scene, opts, frame > 0 ? frame_name : out->output_file,
-                                      mask_path, err);
-    if (result == WX_OK) {
-        result = wx_output_path(scene, opts, png_name, png_path, err);
-    }
+    wx_result result =
+        wx_output_path(scene, opts, frame > 0 ? frame_name : out->output_file, mask_path, err);
     if (result != WX_OK) {
         return result;
     }
@@ -233,13 +229,11 @@ static wx_result write_mask(const wx_scene *scene, const wx_run_def *opts, const
     if (result == WX_OK) {
         result = wx_exr_write(mask_path, image, err);
     }
-    if (result == WX_OK && frame == 0 && channels == 1) {
-        result = wx_preview_write_png(png_path, image->channels[0], om->depth, om->width,
-                                      om->height, err);
-    }
-    for (int c = 0; c < channels && result == WX_OK && frame == 0 && channels > 1; ++c) {
-        wx_channel_preview_name(out->output_file, names[c], png_name, sizeof png_name);
-        result = wx_output_path(scene, opts, png_name, png_path, err);
+    // The final file's previews, one per channel (frames have none).
+    char previews[WX_MAX_PREVIEWS][WX_OUTPUT_NAME_MAX];
+    int preview_count = frame == 0 ? wx_preview_names(scene, out->output_file, previews) : 0;
+    for (int c = 0; c < preview_count && result == WX_OK; ++c) {
+        result = wx_output_path(scene, opts, previews[c], png_path, err);
         if (result == WX_OK) {
             result = wx_preview_write_png(png_path, image->channels[c], om->depth, om->width,
                                           om->height, err);

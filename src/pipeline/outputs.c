@@ -102,23 +102,18 @@ static wx_result add_name(wx_output_names *list, char *clash, const char *fmt, .
     return WX_OK;
 }
 
-// The previews of the channels of a file BASE.exr with <Substances> (BASE.png
-// without them is listed by the caller for the mask; a texture lists it here),
-// and its frames BASE.NNNN.exr for every k-th iteration.
+// The previews of a mask or texture file BASE.exr (wx_preview_names: BASE.png
+// for one channel, BASE_NAME.png per channel), and its frames BASE.NNNN.exr
+// for every k-th iteration.
 static wx_result add_sequence(const wx_scene *scene, const char *file, int every,
                               wx_output_names *out, char *clash)
 {
     char name[WX_OUTPUT_NAME_MAX];
+    char previews[WX_MAX_PREVIEWS][WX_OUTPUT_NAME_MAX];
+    int preview_count = wx_preview_names(scene, file, previews);
     wx_result r = WX_OK;
-    bool mask = scene->output_index >= 0 &&
-                strcmp(scene->cameras[scene->output_index].output_file, file) == 0;
-    if (!scene->substances_declared && !mask) {
-        wx_preview_name(file, name, sizeof name);
-        r = add_name(out, clash, "%s", name);
-    }
-    for (int s = 0; s < scene->substance_count && scene->substances_declared && r == WX_OK; ++s) {
-        wx_channel_preview_name(file, scene->substances[s], name, sizeof name);
-        r = add_name(out, clash, "%s", name);
+    for (int p = 0; p < preview_count && r == WX_OK; ++p) {
+        r = add_name(out, clash, "%s", previews[p]);
     }
     for (int k = every; every > 0 && k <= scene->iterations && r == WX_OK; k += every) {
         wx_frame_name(file, k, name, sizeof name);
@@ -147,12 +142,7 @@ wx_result wx_output_names_list(const wx_scene *scene, unsigned phases, wx_output
     }
     if (r == WX_OK && (phases & WX_PHASE_GATHER) && scene->output_index >= 0) {
         const wx_scene_camera *cam = &scene->cameras[scene->output_index];
-        char png[WX_OUTPUT_NAME_MAX];
-        wx_preview_name(cam->output_file, png, sizeof png);
         r = add_name(out, NULL, "%s", cam->output_file);
-        if (r == WX_OK) {
-            r = add_name(out, NULL, "%s", png);
-        }
         if (r == WX_OK) {
             r = add_sequence(scene, cam->output_file, cam->every, out, NULL);
         }

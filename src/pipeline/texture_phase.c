@@ -459,13 +459,11 @@ static wx_result write_texture(const wx_scene *scene, const wx_run_def *opts,
             alpha[i] = ras->source[i] >= 0 ? 1.0f : INFINITY;
         }
     }
-    for (int c = 0; c + 1 < channels && r == WX_OK && frame == 0; ++c) {
-        if (channels == 2) {
-            wx_preview_name(own, name, sizeof name);
-        } else {
-            wx_channel_preview_name(own, names[c], name, sizeof name);
-        }
-        r = wx_output_path(scene, opts, name, path, err);
+    // One preview per channel of the mask (`seen` has none).
+    char previews[WX_MAX_PREVIEWS][WX_OUTPUT_NAME_MAX];
+    int preview_count = r == WX_OK && frame == 0 ? wx_preview_names(scene, own, previews) : 0;
+    for (int c = 0; c < preview_count && r == WX_OK; ++c) {
+        r = wx_output_path(scene, opts, previews[c], path, err);
         if (r == WX_OK) {
             r = wx_preview_write_png(path, image->channels[c], alpha, def->width, def->height,
                                      err);
