@@ -49,6 +49,46 @@ static char *source_text(const char *path)
     return text;
 }
 
+// A check of one source file: `rel` its path as messages show it
+// ("sim/step.c", "cli/main.c"), `name` its file name, `ctx` the check's own
+// data. Returns the number of violations (printed).
+typedef int (*source_check)(const char *rel, const char *name, const char *text, const void *ctx);
+
+// Runs `check` on every .c and .h file directly in `dir`, shown as
+// `shown`/NAME, and counts them in *files. A folder or a file that cannot be
+// read is a violation. Returns the number of violations.
+static int check_folder(const char *dir, const char *shown, source_check check, const void *ctx,
+                        int *files)
+{
+    DIR *d = opendir(dir);
+    if (d == NULL) {
+        fprintf(stderr, "        cannot open %s\n", dir);
+        return 1;
+    }
+    int bad = 0;
+    struct dirent *e;
+    while ((e = readdir(d)) != NULL) {
+        size_t n = strlen(e->d_name);
+        if (n < 3 || e->d_name[n - 2] != '.' ||
+            (e->d_name[n - 1] != 'c' && e->d_name[n - 1] != 'h')) {
+            continue;
+        }
+        char path[4500], rel[300];
+        snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
+        snprintf(rel, sizeof rel, "%s/%s", shown, e->d_name);
+        char *text = source_text(path);
+        if (text == NULL) {
+            bad++;
+            continue;
+        }
+        bad += check(rel, e->d_name, text, ctx);
+        free(text);
+        ++*files;
+    }
+    closedir(d);
+    return bad;
+}
+
 // True when the first `len` characters of `name` are one of the words of `list`.
 static bool listed(const char *list, const char *name, size_t len)
 {
@@ -154,35 +194,20 @@ static int check_cli_includes(const char *path, const char *text)
     return bad;
 }
 
+static int check_cli_file(const char *rel, const char *name, const char *text, const void *ctx)
+{
+    (void)name;
+    (void)ctx;
+    return check_cli_includes(rel, text) + check_library(rel, text, "<libxml/", libxml_owners) +
+           check_library(rel, text, "<openexr.h>", "io/exr.c");
+}
+
 TEST(the_command_line_stands_on_the_pipeline)
 {
     char folder[4200];
     snprintf(folder, sizeof folder, "%s/../cli", ensure_tests_dir());
-    DIR *dir = opendir(folder);
-    ENSURE(dir != NULL);
-    int files = 0, bad = 0;
-    struct dirent *e;
-    while ((e = readdir(dir)) != NULL) {
-        size_t n = strlen(e->d_name);
-        if (n < 3 || e->d_name[n - 2] != '.' ||
-            (e->d_name[n - 1] != 'c' && e->d_name[n - 1] != 'h')) {
-            continue;
-        }
-        char path[4500], rel[300];
-        snprintf(path, sizeof path, "%s/%s", folder, e->d_name);
-        snprintf(rel, sizeof rel, "cli/%s", e->d_name);
-        char *text = source_text(path);
-        if (text == NULL) {
-            bad++;
-            continue;
-        }
-        bad += check_cli_includes(rel, text);
-        bad += check_library(rel, text, "<libxml/", libxml_owners);
-        bad += check_library(rel, text, "<openexr.h>", "io/exr.c");
-        free(text);
-        files++;
-    }
-    closedir(dir);
+    int files = 0;
+    int bad = check_folder(folder, "cli", check_cli_file, NULL, &files);
     fprintf(stderr, "        %d files in cli/\n", files);
     ENSURE(files > 0);
     ENSURE(bad == 0);
@@ -193,43 +218,30 @@ TEST(the_command_line_stands_on_the_pipeline)
 }
 // ---------------------------------------------------------------------------
 
+// The rules of one layer's file (`ctx` the layer).
+static int check_layer_file(const char *rel, const char *name, const char *text, const void *ctx)
+{
+    (void)name;
+    const layer *own = ctx;
+    int bad = check_includes(rel, text, own);
+    if (is_compute(own)) {
+        bad += check_no_file_io(rel, text);
+    }
+    bad += check_library(rel, text, "<libxml/", libxml_owners);
+    bad += check_library(rel, text, "<assimp/", "io/mesh_import.c io/mesh_postprocess.c");
+    bad += check_library(rel, text, "<openexr.h>", "io/exr.c io/exr_write.c io/exr_internal.h");
+    bad += check_library(rel, text, "<GL/", "raster/baker_internal.h");
+    bad += check_library(rel, text, "<png.h>", "io/png_preview.c");
+    return bad;
+}
+
 TEST(every_layer_includes_only_the_layers_below_it)
 {
     int files = 0, bad = 0;
     for (int l = 0; l < LAYER_COUNT; ++l) {
         char folder[4200];
         snprintf(folder, sizeof folder, "%s/../src/%s", ensure_tests_dir(), layers[l].name);
-        DIR *dir = opendir(folder);
-        ENSURE(dir != NULL);
-        struct dirent *e;
-        while ((e = readdir(dir)) != NULL) {
-            size_t n = strlen(e->d_name);
-            if (n < 3 || e->d_name[n - 2] != '.' ||
-                (e->d_name[n - 1] != 'c' && e->d_name[n - 1] != 'h')) {
-                continue;
-            }
-            char path[4500], rel[300];
-            snprintf(path, sizeof path, "%s/%s", folder, e->d_name);
-            snprintf(rel, sizeof rel, "%s/%s", layers[l].name, e->d_name);
-            char *text = source_text(path);
-            if (text == NULL) {
-                bad++;
-                continue;
-            }
-            bad += check_includes(rel, text, &layers[l]);
-            if (is_compute(&layers[l])) {
-                bad += check_no_file_io(rel, text);
-            }
-            bad += check_library(rel, text, "<libxml/", libxml_owners);
-            bad += check_library(rel, text, "<assimp/", "io/mesh_import.c io/mesh_postprocess.c");
-            bad += check_library(rel, text, "<openexr.h>",
-                                 "io/exr.c io/exr_write.c io/exr_internal.h");
-            bad += check_library(rel, text, "<GL/", "raster/baker_internal.h");
-            bad += check_library(rel, text, "<png.h>", "io/png_preview.c");
-            free(text);
-            files++;
-        }
-        closedir(dir);
+        bad += check_folder(folder, layers[l].name, check_layer_file, &layers[l], &files);
     }
     fprintf(stderr, "        %d files in %d layers\n", files, LAYER_COUNT);
     ENSURE(files > 40);
@@ -293,37 +305,12 @@ static int check_private_headers(const char *rel, const char *folder, const char
     return bad;
 }
 
-// Checks every .c and .h file directly in `dir` (shown as `shown`/NAME), whose
-// own folder is `folder` (NULL: outside src/); counts the files in *files.
-static int check_private_folder(const char *dir, const char *shown, const char *folder, int *files)
+// The private-header rule for a file whose own folder is `ctx` (a string; NULL:
+// outside src/, cli/ and viewer/).
+static int check_private_file(const char *rel, const char *name, const char *text, const void *ctx)
 {
-    DIR *d = opendir(dir);
-    if (d == NULL) {
-        fprintf(stderr, "        cannot open %s\n", dir);
-        return 1;
-    }
-    int bad = 0;
-    struct dirent *e;
-    while ((e = readdir(d)) != NULL) {
-        size_t n = strlen(e->d_name);
-        if (n < 3 || e->d_name[n - 2] != '.' ||
-            (e->d_name[n - 1] != 'c' && e->d_name[n - 1] != 'h')) {
-            continue;
-        }
-        char path[4500], rel[300];
-        snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
-        snprintf(rel, sizeof rel, "%s/%s", shown, e->d_name);
-        char *text = source_text(path);
-        if (text == NULL) {
-            bad++;
-            continue;
-        }
-        bad += check_private_headers(rel, folder, text);
-        free(text);
-        ++*files;
-    }
-    closedir(d);
-    return bad;
+    (void)name;
+    return check_private_headers(rel, ctx, text);
 }
 
 TEST(private_headers_stay_in_their_folder)
@@ -332,13 +319,13 @@ TEST(private_headers_stay_in_their_folder)
     char dir[4200];
     for (int l = 0; l < LAYER_COUNT; ++l) {
         snprintf(dir, sizeof dir, "%s/../src/%s", ensure_tests_dir(), layers[l].name);
-        bad += check_private_folder(dir, layers[l].name, layers[l].name, &files);
+        bad += check_folder(dir, layers[l].name, check_private_file, layers[l].name, &files);
     }
     static const char *const outside[] = { "../cli", "../viewer", ".", "bench", "tools" };
     static const char *const owner[] = { "cli", "viewer", NULL, NULL, NULL };
     for (size_t k = 0; k < sizeof outside / sizeof outside[0]; ++k) {
         snprintf(dir, sizeof dir, "%s/%s", ensure_tests_dir(), outside[k]);
-        bad += check_private_folder(dir, outside[k], owner[k], &files);
+        bad += check_folder(dir, outside[k], check_private_file, owner[k], &files);
     }
     fprintf(stderr, "        %d files checked for private headers\n", files);
     ENSURE(files > 80);
@@ -401,32 +388,19 @@ static int check_viewer_file(const char *name, const char *text)
     return bad;
 }
 
+static int check_viewer_entry(const char *rel, const char *name, const char *text, const void *ctx)
+{
+    (void)rel;
+    (void)ctx;
+    return check_viewer_file(name, text);
+}
+
 TEST(the_viewer_includes_only_the_library_and_its_world_no_gl)
 {
     char folder[4200];
     snprintf(folder, sizeof folder, "%s/../viewer", ensure_tests_dir());
-    DIR *dir = opendir(folder);
-    ENSURE(dir != NULL);
-    int files = 0, bad = 0;
-    struct dirent *e;
-    while ((e = readdir(dir)) != NULL) {
-        size_t n = strlen(e->d_name);
-        if (n < 3 || e->d_name[n - 2] != '.' ||
-            (e->d_name[n - 1] != 'c' && e->d_name[n - 1] != 'h')) {
-            continue;
-        }
-        char path[4500];
-        snprintf(path, sizeof path, "%s/%s", folder, e->d_name);
-        char *text = source_text(path);
-        if (text == NULL) {
-            bad++;
-            continue;
-        }
-        bad += check_viewer_file(e->d_name, text);
-        free(text);
-        files++;
-    }
-    closedir(dir);
+    int files = 0;
+    int bad = check_folder(folder, "viewer", check_viewer_entry, NULL, &files);
     fprintf(stderr, "        %d files in viewer/\n", files);
     ENSURE(files > 20);
     ENSURE(bad == 0);
