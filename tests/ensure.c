@@ -261,3 +261,17 @@ bool ensure_contains(const char *haystack, const char *needle)
 {
     return haystack != NULL && strstr(haystack, needle) != NULL;
 }
+
+void ensure_ledger_sides(const char *at, double *in, double *out)
+{
+    static const char *const ins[4] = { "initial_surface", "emitted", "grown", "transferred_in" };
+    static const char *const outs[5] = { "final_surface", "in_flight", "escaped", "decayed",
+                                         "transferred_out" };
+    *in = *out = 0.0;
+    for (int k = 0; k < 4; ++k) {
+        *in += ensure_json_number(at, NULL, ins[k]);
+    }
+    for (int k = 0; k < 5; ++k) {
+        *out += ensure_json_number(at, NULL, outs[k]);
+    }
+}

@@ -107,6 +107,12 @@ float *ensure_read_channel(const char *path, const char *name, int *width, int *
 /// either is absent.
 double ensure_json_number(const char *json, const char *after, const char *key);
 
+/// The two sides of a substance's ledger (docs/design.md section 9) in a
+/// --stats JSON, from its object's text at `at`: what came in (initial
+/// surface, emitted, grown, transferred in) and where it went (final surface,
+/// in flight, escaped, decayed, transferred out).
+void ensure_ledger_sides(const char *at, double *in, double *out);
+
 /// What a bad input of tests/bad/ must do, from its first line
 /// "<!-- expect: LINE: CAUSE: substring -->": fail for WX_CAUSE_<CAUSE> with a
 /// message that starts "path:LINE: " (LINE 0: names no XML line) and contains

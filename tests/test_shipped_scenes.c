@@ -57,22 +57,6 @@ static double estimate_mib(const char *scene)
     return at != NULL ? atof(at + strlen("memory: about ")) : -1.0;
 }
 
-// What came into a substance's ledger and what went out of it, from the text of
-// its JSON object at `at`.
-static void ledger_sides(const char *at, double *in, double *out)
-{
-    static const char *const ins[4] = { "initial_surface", "emitted", "grown", "transferred_in" };
-    static const char *const outs[5] = { "final_surface", "in_flight", "escaped", "decayed",
-                                         "transferred_out" };
-    *in = *out = 0.0;
-    for (int k = 0; k < 4; ++k) {
-        *in += ensure_json_number(at, NULL, ins[k]);
-    }
-    for (int k = 0; k < 5; ++k) {
-        *out += ensure_json_number(at, NULL, outs[k]);
-    }
-}
-
 // Every substance's ledger of a --stats file balances (exact to rounding);
 // returns how many substances it checked, -1 when one does not balance.
 static int ledger_balances(const char *json)
@@ -85,7 +69,7 @@ static int ledger_balances(const char *json)
     for (at = strstr(at + 15, "\": { \"initial_surface\""); at != NULL;
          at = strstr(at + 1, "\": { \"initial_surface\"")) {
         double in, out;
-        ledger_sides(at, &in, &out);
+        ensure_ledger_sides(at, &in, &out);
         if (!(fabs(in - out) <= 1e-9 * (fabs(in) + 1.0))) {
             fprintf(stderr, "        in %.17g, out %.17g\n", in, out);
             return -1;

@@ -232,22 +232,6 @@ TEST(the_final_mask_is_the_last_frame_and_every_channel_has_a_preview)
     ENSURE(stat(path, &st) != 0); // frames have none
 }
 
-// The two sides of a substance's ledger (docs/design.md section 9) from its
-// --stats entry at `at`: what came in and where it went.
-static void ledger_sides(const char *at, double *in, double *out)
-{
-    static const char *const ins[4] = { "initial_surface", "emitted", "grown", "transferred_in" };
-    static const char *const outs[5] = { "final_surface", "in_flight", "escaped", "decayed",
-                                         "transferred_out" };
-    *in = *out = 0.0;
-    for (int k = 0; k < 4; ++k) {
-        *in += ensure_json_number(at, NULL, ins[k]);
-    }
-    for (int k = 0; k < 5; ++k) {
-        *out += ensure_json_number(at, NULL, outs[k]);
-    }
-}
-
 TEST(the_ledger_balances_for_every_substance)
 {
     run_dir();
@@ -264,7 +248,7 @@ TEST(the_ledger_balances_for_every_substance)
         const char *at = strstr(json, key);
         ENSURE(at != NULL);
         double in, out;
-        ledger_sides(at, &in, &out);
+        ensure_ledger_sides(at, &in, &out);
         printf("        %s: in %.17g, out %.17g\n", names[s], in, out);
         ENSURE(fabs(in - out) <= 1e-9 * (fabs(in) + 1.0));
     }
