@@ -446,6 +446,183 @@ static wx_result fill_substances(const wx_scene *scene, const float *surface,
 }
 
 // ---------------------------------------------------------------------------
+// Depth peeling without contacts.
+
+// The planes of one peeling pass, as read back: d, the outward normal, and for
+// an input camera absorption, bounce, deposit, erosion, initial density and
+// <Surface> index + 1 (the three colour targets, shaders/bake_frag.glsl).
+enum {
+    PASS_D,
+    PASS_NX,
+    PASS_NY,
+    PASS_NZ,
+    PASS_ABSORPTION,
+    PASS_BOUNCE,
+    PASS_DEPOSIT,
+    PASS_EROSION,
+    PASS_DENSITY,
+    PASS_SURFACE,
+    PASS_PLANES,
+    PASS_DEPTH_PLANES = PASS_NZ + 1, // a camera baked for its depth alone
+};
+
+// At most this many peeling passes per layer: a texel needs one pass per
+// crossing it keeps and two per contact dropped before its last one.
+#define PEEL_PASSES_PER_LAYER 4
+
+// Per texel while a layered camera peels: the crossings kept (0 to layers),
+// and PEEL_DONE once nothing after them can change them.
+#define PEEL_DONE 0x80u
+
+static double dot3(const float a[3], const float b[3])
+{
+    return (double)a[0] * b[0] + (double)a[1] * b[1] + (double)a[2] * b[2];
+}
+
+// Whether a crossing with outward normal n leaves a solid (faces away from the camera).
+static bool leaving(const float n[3], const float view[3])
+{
+    return dot3(n, view) > 0.0;
+}
+
+// The plane value of texel t at o.
+static float *plane_at(const plane_out *o, size_t t)
+{
+    return o->plane + (o->stride > 0 ? o->stride : 1) * t;
+}
+
+// Whether crossing (d, n), the next one peeled at a texel, and (d0, n0), the
+// last one kept there, are a contact: a crossing leaving a solid and one
+// entering a solid at the same depth, within the peeling tie step of
+// bake_frag.glsl (4e-6 x (1 + |d|): 0.2 mm at d = 50), with no free space
+// between them. Two solids lying on each other (the slabs of a roof, a pane on
+// a wall) meet there; no particle reaches the faces, and both are dropped.
+static bool peel_contact(float d0, const float n0[3], float d, const float n[3], const float view[3])
+{
+    return leaving(n0, view) && dot3(n, view) < 0.0 &&
+           fabs((double)d - (double)d0) <= 4e-6 * (1.0 + fabs((double)d0));
+}
+
+// Merges one peeling pass (`pass`: `planes` planes of `texels`) into the kept
+// layers `dst` (layer l's plane p at dst[l][p]; a NULL plane is not wanted):
+// at each open texel the crossing cancels the last one kept when they are a
+// contact, else is kept while fewer than `layers` are. Returns the texels still
+// open (a texel closes when it has nothing behind, or a crossing after its
+// `layers` kept ones that is no contact).
+static size_t peel_merge(const float *pass, int planes, size_t texels, plane_out (*dst)[PASS_PLANES],
+                         int layers, unsigned char *kept, const float view[3])
+{
+    size_t open = 0;
+    for (size_t t = 0; t < texels; ++t) {
+        if (kept[t] & PEEL_DONE) {
+            continue;
+        }
+        float d = pass[PASS_D * texels + t];
+        if (!(d < INFINITY)) {
+            kept[t] |= PEEL_DONE;
+            continue;
+        }
+        int k = kept[t];
+        float n[3] = { pass[PASS_NX * texels + t], pass[PASS_NY * texels + t],
+                       pass[PASS_NZ * texels + t] };
+        if (k > 0) {
+            const plane_out *last = dst[k - 1];
+            float n0[3] = { *plane_at(&last[PASS_NX], t), *plane_at(&last[PASS_NY], t),
+                            *plane_at(&last[PASS_NZ], t) };
+            if (peel_contact(*plane_at(&last[PASS_D], t), n0, d, n, view)) {
+                kept[t] = (unsigned char)(k - 1);
+                ++open;
+                continue;
+            }
+        }
+        if (k == layers) {
+            kept[t] |= PEEL_DONE;
+            continue;
+        }
+        for (int p = 0; p < planes; ++p) {
+            if (dst[k][p].plane != NULL) {
+                *plane_at(&dst[k][p], t) = pass[(size_t)p * texels + t];
+            }
+        }
+        if (k + 1 == layers && !leaving(n, view)) {
+            // The last layer enters a solid: no contact can cancel it.
+            kept[t] = (unsigned char)(k + 1) | PEEL_DONE;
+            continue;
+        }
+        kept[t] = (unsigned char)(k + 1);
+        ++open;
+    }
+    return open;
+}
+
+// Draws layered camera c by depth peeling, into the kept layers `dst` (see
+// peel_merge): pass after pass, each keeping the crossings behind the one
+// before (bake_frag.glsl), until no texel is open or after
+// PEEL_PASSES_PER_LAYER x layers passes. Each texel's slots after its kept
+// crossings are the background (d +inf, the rest 0). *drawn: the most
+// crossings a texel kept (the layers after it hold none).
+static wx_result peel_camera(baker *b, int c, int layers, int planes, plane_out (*dst)[PASS_PLANES],
+                             int *drawn, wx_error *err)
+{
+    const wx_scene_camera *sc = &b->scene->cameras[c];
+    size_t texels = (size_t)sc->camera.width * (size_t)sc->camera.height;
+    float view[3];
+    wx_camera_view_dir(&sc->camera, view);
+    float *pass = malloc((size_t)planes * texels * sizeof *pass);
+    unsigned char *kept = calloc(texels, 1);
+    wx_result r = pass != NULL && kept != NULL
+                      ? WX_OK
+                      : wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "bake: out of memory (peeling)");
+    size_t open = texels;
+    int targets = planes > PASS_DEPTH_PLANES ? TARGET_COUNT : 1;
+    for (int p = 0; r == WX_OK && open > 0 && p < PEEL_PASSES_PER_LAYER * layers; ++p) {
+        r = bake_draw_camera(b, c, targets, p, err);
+        if (r == WX_OK) {
+            plane_out out[4];
+            for (int q = 0; q < 4; ++q) {
+                out[q] = (plane_out){ pass + (size_t)(PASS_D + q) * texels, 1 };
+            }
+            r = bake_read_target(b, TARGET_DEPTH_NORMAL, 4, out, err);
+        }
+        if (r == WX_OK && targets > 1) {
+            plane_out out[4];
+            for (int q = 0; q < 4; ++q) {
+                out[q] = (plane_out){ pass + (size_t)(PASS_ABSORPTION + q) * texels, 1 };
+            }
+            r = bake_read_target(b, TARGET_IMPACT_DIRT, 4, out, err);
+        }
+        if (r == WX_OK && targets > 1) {
+            plane_out out[2] = { { pass + (size_t)PASS_DENSITY * texels, 1 },
+                                 { pass + (size_t)PASS_SURFACE * texels, 1 } };
+            r = bake_read_target(b, TARGET_DENSITY, 2, out, err);
+        }
+        if (r == WX_OK) {
+            open = peel_merge(pass, planes, texels, dst, layers, kept, view);
+        }
+        if (r == WX_OK && open > 0) {
+            r = bake_keep_previous_layer(b, err);
+        }
+    }
+    int most = 0;
+    for (size_t t = 0; r == WX_OK && t < texels; ++t) {
+        int k = kept[t] & ~PEEL_DONE;
+        most = k > most ? k : most;
+        for (int l = k; l < layers; ++l) {
+            for (int q = 0; q < planes; ++q) {
+                const plane_out *o = &dst[l][q];
+                if (o->plane != NULL) {
+                    *plane_at(o, t) = q == PASS_D ? INFINITY : 0.0f;
+                }
+            }
+        }
+    }
+    *drawn = most;
+    free(kept);
+    free(pass);
+    return r;
+}
+
+// ---------------------------------------------------------------------------
 // One camera.
 
 // Whether a depth plane just read back holds some surface (a finite d): when
@@ -483,26 +660,23 @@ static wx_result render_depth_only(baker *b, int c, wx_error *err)
     cs->depth_height = sc->camera.height;
     double t0 = wx_now_s();
     wx_result r = WX_OK;
-    for (int l = 0; l < layers && r == WX_OK; ++l) {
-        float *depth = cs->depth + (size_t)l * n;
-        float *normal = layers > 1 ? cs->normal + 3 * (size_t)l * n : NULL;
-        if (l > 0 && !any_surface(depth - n, n)) {
-            for (size_t t = 0; t < n; ++t) {
-                depth[t] = INFINITY;
+    if (layers > 1) {
+        // Peeled as bake_camera peels it, contacts dropped (peel_camera).
+        plane_out dst[WX_MAX_LAYERS][PASS_PLANES];
+        for (int l = 0; l < layers; ++l) {
+            float *normal = cs->normal + 3 * (size_t)l * n;
+            dst[l][PASS_D] = (plane_out){ cs->depth + (size_t)l * n, 1 };
+            for (int q = 0; q < 3; ++q) {
+                dst[l][PASS_NX + q] = (plane_out){ normal + q, 3 };
             }
-            memset(normal, 0, 3 * n * sizeof *normal);
-            continue;
         }
-        r = bake_draw_camera(b, c, 1, l, err);
+        int drawn = 0;
+        r = peel_camera(b, c, layers, PASS_DEPTH_PLANES, dst, &drawn, err);
+    } else {
+        r = bake_draw_camera(b, c, 1, 0, err);
         if (r == WX_OK) {
-            plane_out out[4] = { { depth, 1 },
-                                 { normal, 3 },
-                                 { normal != NULL ? normal + 1 : NULL, 3 },
-                                 { normal != NULL ? normal + 2 : NULL, 3 } };
+            plane_out out[4] = { { cs->depth, 1 }, { NULL, 3 }, { NULL, 3 }, { NULL, 3 } };
             r = bake_read_target(b, TARGET_DEPTH_NORMAL, 4, out, err);
-        }
-        if (r == WX_OK && l + 1 < layers) {
-            r = bake_keep_previous_layer(b, err);
         }
     }
     b->stats->render_s += wx_now_s() - t0;
@@ -585,7 +759,37 @@ static wx_result bake_camera(baker *b, int c, wx_error *err)
     }
     double t0 = wx_now_s();
     int drawn = 0; // layers drawn; those after them hold no crossing
+    if (r == WX_OK && layers > 1) {
+        // Peeled, contacts dropped (peel_camera): each layer's planes.
+        plane_out dst[WX_MAX_LAYERS][PASS_PLANES];
+        for (int l = 0; l < layers; ++l) {
+            float *const *dirt = input ? &maps[3].channels[l * per] : NULL;
+            dst[l][PASS_D] = (plane_out){ maps[0].channels[l], 1 };
+            for (int q = 0; q < 3; ++q) {
+                dst[l][PASS_NX + q] = (plane_out){ maps[1].channels[3 * l + q], 1 };
+            }
+            if (input) {
+                dst[l][PASS_ABSORPTION] = (plane_out){ maps[2].channels[3 * l], 1 };
+                dst[l][PASS_BOUNCE] = (plane_out){ maps[2].channels[3 * l + 1], 1 };
+                dst[l][PASS_DEPOSIT] = (plane_out){ dirt[3 * g + 1], 1 };
+                dst[l][PASS_EROSION] = (plane_out){ dirt[3 * g + 2], 1 };
+                dst[l][PASS_DENSITY] = (plane_out){ dirt[3 * g], 1 };
+                dst[l][PASS_SURFACE] = (plane_out){ surface[l], 1 };
+            }
+        }
+        r = peel_camera(b, c, layers, input ? PASS_PLANES : PASS_DEPTH_PLANES, dst, &drawn, err);
+        wx_progress_update(&progress, 2 * layers);
+    }
     for (int l = 0; l < layers && r == WX_OK; ++l) {
+        if (layers > 1) {
+            if (l >= drawn) {
+                clear_layer(set, layers, l, texels);
+                if (scratch != NULL) {
+                    memset(surface[l], 0, texels * sizeof *surface[l]);
+                }
+            }
+            continue;
+        }
         if (l > 0 && !any_surface(maps[0].channels[l - 1], texels)) {
             clear_layer(set, layers, l, texels);
             if (scratch != NULL) {
