@@ -14,11 +14,15 @@
 // writes them, its files compressed in parallel) before the next camera renders,
 // so one set of images is alive. docs/cameras.md describes the choices.
 //
-// A layered input camera (docs/design.md section 14) is drawn once per layer,
-// depth peeling: after layer k is read back, attachment 0 is copied into the
+// A layered input camera (docs/design.md section 14) is drawn by depth
+// peeling: after each pass is read back, attachment 0 is copied into the
 // `previous` texture, and the next pass keeps only the crossings behind it
-// (bake_frag.glsl). Its normals are then the mesh's own, out of the solid, and
-// every (camera, layer) is a view of the initial-dirt ownership.
+// (bake_frag.glsl). The passes are merged into the camera's layers on the CPU
+// (peel_camera): where the crossings outnumber the layers, a contact (a solid
+// left and another entered at one depth: two solids lying on each other) gives
+// way to the crossings behind it, so the layers hold what a particle reaches.
+// Its normals are then the mesh's own, out of the solid, and every (camera,
+// layer) is a view of the initial-dirt ownership.
 //
 // This file holds the bake's logic; bake_gl.c the GL side (context, shaders,
 // framebuffer, drawing, readback), through baker_internal.h.
@@ -446,7 +450,7 @@ static wx_result fill_substances(const wx_scene *scene, const float *surface,
 }
 
 // ---------------------------------------------------------------------------
-// Depth peeling without contacts.
+// Depth peeling: contacts give way to what a particle reaches.
 
 // The planes of one peeling pass, as read back: d, the outward normal, and for
 // an input camera absorption, bounce, deposit, erosion, initial density and
@@ -467,7 +471,8 @@ enum {
 };
 
 // At most this many peeling passes per layer: a texel needs one pass per
-// crossing it keeps and two per contact dropped before its last one.
+// crossing it keeps and two per contact dropped before its last one (texels
+// still open after them keep what they hold).
 #define PEEL_PASSES_PER_LAYER 4
 
 // Per texel while a layered camera peels: the crossings kept (0 to layers),
@@ -496,21 +501,57 @@ static float *plane_at(const plane_out *o, size_t t)
 // entering a solid at the same depth, within the peeling tie step of
 // bake_frag.glsl (4e-6 x (1 + |d|): 0.2 mm at d = 50), with no free space
 // between them. Two solids lying on each other (the slabs of a roof, a pane on
-// a wall) meet there; no particle reaches the faces, and both are dropped.
+// a wall) meet there; no particle reaches either face (peel_merge).
 static bool peel_contact(float d0, const float n0[3], float d, const float n[3], const float view[3])
 {
     return leaving(n0, view) && dot3(n, view) < 0.0 &&
            fabs((double)d - (double)d0) <= 4e-6 * (1.0 + fabs((double)d0));
 }
 
+// The solids texel t's first k kept crossings leave open (entering and
+// leaving crossings paired as brackets; a leaving one with none open counts
+// for nothing). A contact counts only where this is 0 after its leaving
+// crossing: between two solids on the outside, where free space would be.
+// Inside another solid (the house's 1 mm pane lying on its core within a
+// facade box) the peel has merged coincident faces (the pane's back and the
+// box's: one depth, one crossing), the crossings no longer pair up, and
+// without the contact the core's face behind would be read as the pane's
+// (wx_maps_bury, the gather's nearer crossing): seen where nothing reaches.
+static int peel_inside(plane_out (*dst)[PASS_PLANES], size_t t, int k, const float view[3])
+{
+    int inside = 0;
+    for (int l = 0; l < k; ++l) {
+        float n[3] = { *plane_at(&dst[l][PASS_NX], t), *plane_at(&dst[l][PASS_NY], t),
+                       *plane_at(&dst[l][PASS_NZ], t) };
+        inside = leaving(n, view) ? (inside > 0 ? inside - 1 : 0) : inside + 1;
+    }
+    return inside;
+}
+
+// Copies crossing `from` of texel t's kept layers over crossing `to`.
+static void peel_move(plane_out (*dst)[PASS_PLANES], int planes, size_t t, int from, int to)
+{
+    for (int p = 0; p < planes; ++p) {
+        if (dst[to][p].plane != NULL) {
+            *plane_at(&dst[to][p], t) = *plane_at(&dst[from][p], t);
+        }
+    }
+}
+
 // Merges one peeling pass (`pass`: `planes` planes of `texels`) into the kept
-// layers `dst` (layer l's plane p at dst[l][p]; a NULL plane is not wanted):
-// at each open texel the crossing cancels the last one kept when they are a
-// contact, else is kept while fewer than `layers` are. Returns the texels still
-// open (a texel closes when it has nothing behind, or a crossing after its
-// `layers` kept ones that is no contact).
+// layers `dst` (layer l's plane p at dst[l][p]; a NULL plane is not wanted).
+// Contacts are kept while there is room, for they seal the faces on either
+// side (wx_maps_bury, and the gather's nearer crossing), and give way to the
+// crossings a particle can reach: at each open texel a crossing that closes a
+// contact with the last one kept is kept beside it (bit l of pairs[t]: layers
+// l and l + 1 are a contact), or, with no room left, drops it; any other
+// crossing is kept, in a full stack after the deepest contact kept is dropped
+// to make room, unless it leaves a solid none of the others left open (a
+// coincident face merged: peel_inside). Returns the texels still open: a texel closes when nothing is
+// behind, or when its stack is full of crossings no later one can displace.
 static size_t peel_merge(const float *pass, int planes, size_t texels, plane_out (*dst)[PASS_PLANES],
-                         int layers, unsigned char *kept, const float view[3])
+                         int layers, unsigned char *kept, unsigned char *pairs,
+                         const float view[3])
 {
     size_t open = 0;
     for (size_t t = 0; t < texels; ++t) {
@@ -525,31 +566,51 @@ static size_t peel_merge(const float *pass, int planes, size_t texels, plane_out
         int k = kept[t];
         float n[3] = { pass[PASS_NX * texels + t], pass[PASS_NY * texels + t],
                        pass[PASS_NZ * texels + t] };
-        if (k > 0) {
+        bool contact = false;
+        if (k > 0 && peel_inside(dst, t, k, view) == 0) {
             const plane_out *last = dst[k - 1];
             float n0[3] = { *plane_at(&last[PASS_NX], t), *plane_at(&last[PASS_NY], t),
                             *plane_at(&last[PASS_NZ], t) };
-            if (peel_contact(*plane_at(&last[PASS_D], t), n0, d, n, view)) {
-                kept[t] = (unsigned char)(k - 1);
-                ++open;
+            contact = peel_contact(*plane_at(&last[PASS_D], t), n0, d, n, view);
+        }
+        if (contact && k == layers) {
+            kept[t] = (unsigned char)(k - 1); // no room: the contact goes
+            ++open;
+            continue;
+        }
+        if (!contact && k == layers) {
+            if (pairs[t] == 0 || (leaving(n, view) && peel_inside(dst, t, k, view) == 0)) {
+                // Nothing to displace, or a crossing leaving no solid kept: a
+                // face merged with one it coincides with left the crossings
+                // unpaired, and the contact stays (as above).
+                kept[t] |= PEEL_DONE;
                 continue;
             }
-        }
-        if (k == layers) {
-            kept[t] |= PEEL_DONE;
-            continue;
+            int j = 7;
+            while (!(pairs[t] & (1u << j))) {
+                --j;
+            }
+            for (int l = j + 2; l < k; ++l) {
+                peel_move(dst, planes, t, l, l - 2);
+            }
+            pairs[t] = (unsigned char)(pairs[t] & ~(1u << j)); // the deepest: none after it
+            k -= 2;
         }
         for (int p = 0; p < planes; ++p) {
             if (dst[k][p].plane != NULL) {
                 *plane_at(&dst[k][p], t) = pass[(size_t)p * texels + t];
             }
         }
-        if (k + 1 == layers && !leaving(n, view)) {
-            // The last layer enters a solid: no contact can cancel it.
-            kept[t] = (unsigned char)(k + 1) | PEEL_DONE;
-            continue;
+        if (contact) {
+            pairs[t] = (unsigned char)(pairs[t] | (1u << (k - 1)));
         }
         kept[t] = (unsigned char)(k + 1);
+        if (k + 1 == layers && pairs[t] == 0 && !leaving(n, view)) {
+            // Full of reachable crossings, the last entering a solid: no later
+            // crossing makes a contact with it or displaces one.
+            kept[t] |= PEEL_DONE;
+            continue;
+        }
         ++open;
     }
     return open;
@@ -569,8 +630,8 @@ static wx_result peel_camera(baker *b, int c, int layers, int planes, plane_out 
     float view[3];
     wx_camera_view_dir(&sc->camera, view);
     float *pass = malloc((size_t)planes * texels * sizeof *pass);
-    unsigned char *kept = calloc(texels, 1);
-    wx_result r = pass != NULL && kept != NULL
+    unsigned char *kept = calloc(texels, 1), *pairs = calloc(texels, 1);
+    wx_result r = pass != NULL && kept != NULL && pairs != NULL
                       ? WX_OK
                       : wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "bake: out of memory (peeling)");
     size_t open = texels;
@@ -597,7 +658,7 @@ static wx_result peel_camera(baker *b, int c, int layers, int planes, plane_out 
             r = bake_read_target(b, TARGET_DENSITY, 2, out, err);
         }
         if (r == WX_OK) {
-            open = peel_merge(pass, planes, texels, dst, layers, kept, view);
+            open = peel_merge(pass, planes, texels, dst, layers, kept, pairs, view);
         }
         if (r == WX_OK && open > 0) {
             r = bake_keep_previous_layer(b, err);
@@ -617,6 +678,7 @@ static wx_result peel_camera(baker *b, int c, int layers, int planes, plane_out 
         }
     }
     *drawn = most;
+    free(pairs);
     free(kept);
     free(pass);
     return r;
