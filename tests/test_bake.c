@@ -1265,12 +1265,14 @@ TEST(layers_drop_the_contact_of_two_slabs_lying_on_each_other)
     // normal +y), layer 1 its underside (d 4, normal -y) and layer 2 the floor
     // (d 5, normal +y), which the contact's two crossings would hide. Beside
     // them a pair 1 cm apart (x in [1.25, 1.75]) keeps its gap: its upper
-    // slab's underside (d 3.79) and lower slab's top (d 3.8).
+    // slab's underside (d 3.79) and lower slab's top (d 3.8). A contact gives
+    // way only where the crossings outnumber the layers.
     const float density = 1.0f;
     wx_scene s;
     scene_begin(&s);
     const float eye[3] = { 0, 5, 0 }, up[3] = { 0, 0, -1 };
     add_camera(&s, "top", eye, ORIGIN, up, 4, 4, 64, 64, false)->layers = 3;
+    add_camera(&s, "top6", eye, ORIGIN, up, 4, 4, 64, 64, false)->layers = 6;
     add_surface(add_mesh(&s, write_box("floor.obj", -3, 3, -0.2f, 0, -3, 3), 30), "*", 0, 0,
                 density, 0, 0);
     add_surface(add_mesh(&s, write_box("lower.obj", -1, 1, 1, 1.2f, -1, 1), 31), "*", 0, 0,
@@ -1319,6 +1321,17 @@ TEST(layers_drop_the_contact_of_two_slabs_lying_on_each_other)
     ENSURE(layer_empty_at(&m[2], 8, 32));
     for (int l = 0; l < 3; ++l) {
         free_maps(&m[l]);
+    }
+    // With room for every crossing (6 layers) the contact stays, sealing the
+    // two faces: 3.6, 3.8 (leaving), 3.8 (entering), 4, 5, 5.2.
+    maps4 all[6];
+    const double depths[6] = { 3.6, 3.8, 3.8, 4.0, 5.0, 5.2 };
+    const float ys[6] = { 1, -1, 1, -1, 1, -1 };
+    for (int l = 0; l < 6; ++l) {
+        ENSURE(read_layer_maps(&s.cameras[1], l, &all[l]));
+        ENSURE_NEAR(at(&all[l].depth, 0, 32, 32), depths[l], 1e-4);
+        ensure_normal(&all[l], 32, 32, 0, ys[l], 0);
+        free_maps(&all[l]);
     }
     scene_end(&s);
 }
