@@ -1256,6 +1256,86 @@ TEST(layers_sill_underside_points_down)
     scene_end(&s);
 }
 
+TEST(layers_drop_the_contact_of_two_slabs_lying_on_each_other)
+{
+    // Two slabs x, z in [-1, 1] lying on each other (y 1..1.2 and 1.2..1.4)
+    // over a floor (y -0.2..0), seen from above with 3 layers: the upper
+    // slab's underside and the lower one's top meet at y 1.2 with no free
+    // space between (a contact: dropped), so layer 0 is the pair's top (d 3.6,
+    // normal +y), layer 1 its underside (d 4, normal -y) and layer 2 the floor
+    // (d 5, normal +y), which the contact's two crossings would hide. Beside
+    // them a pair 1 cm apart (x in [1.25, 1.75]) keeps its gap: its upper
+    // slab's underside (d 3.79) and lower slab's top (d 3.8). A contact gives
+    // way only where the crossings outnumber the layers.
+    const float density = 1.0f;
+    wx_scene s;
+    scene_begin(&s);
+    const float eye[3] = { 0, 5, 0 }, up[3] = { 0, 0, -1 };
+    add_camera(&s, "top", eye, ORIGIN, up, 4, 4, 64, 64, false)->layers = 3;
+    add_camera(&s, "top6", eye, ORIGIN, up, 4, 4, 64, 64, false)->layers = 6;
+    add_surface(add_mesh(&s, write_box("floor.obj", -3, 3, -0.2f, 0, -3, 3), 30), "*", 0, 0,
+                density, 0, 0);
+    add_surface(add_mesh(&s, write_box("lower.obj", -1, 1, 1, 1.2f, -1, 1), 31), "*", 0, 0,
+                density, 0, 0);
+    add_surface(add_mesh(&s, write_box("upper.obj", -1, 1, 1.2f, 1.4f, -1, 1), 32), "*", 0, 0,
+                density, 0, 0);
+    add_surface(add_mesh(&s, write_box("gap_lower.obj", 1.25f, 1.75f, 1, 1.2f, -1, 1), 33), "*",
+                0, 0, density, 0, 0);
+    add_surface(add_mesh(&s, write_box("gap_upper.obj", 1.25f, 1.75f, 1.21f, 1.4f, -1, 1), 34),
+                "*", 0, 0, density, 0, 0);
+    wx_run_def o;
+    options_for(&o, "layers_contact");
+    wx_error err = { 0 };
+    ENSURE(wx_bake_scene(&s, &o, &err) == WX_OK);
+    maps4 m[3];
+    for (int l = 0; l < 3; ++l) {
+        ENSURE(read_layer_maps(&s.cameras[0], l, &m[l]));
+    }
+    const double texel_area = (4.0 / 64) * (4.0 / 64);
+    // Texels 16..47 lie over the touching pair, 52..59 over the pair with a gap.
+    const int over_pair[][2] = { { 32, 32 }, { 16, 16 }, { 47, 47 }, { 20, 40 } };
+    for (size_t k = 0; k < sizeof over_pair / sizeof over_pair[0]; ++k) {
+        int i = over_pair[k][0], j = over_pair[k][1];
+        ENSURE_NEAR(at(&m[0].depth, 0, i, j), 3.6, 1e-4);
+        ensure_normal(&m[0], i, j, 0, 1, 0);
+        ENSURE_NEAR(at(&m[1].depth, 0, i, j), 4.0, 1e-4);
+        ensure_normal(&m[1], i, j, 0, -1, 0);
+        ENSURE_NEAR(at(&m[1].dirt, 0, i, j), density * texel_area, 1e-7);
+        ENSURE_NEAR(at(&m[2].depth, 0, i, j), 5.0, 1e-4);
+        ensure_normal(&m[2], i, j, 0, 1, 0);
+        ENSURE_NEAR(at(&m[2].dirt, 0, i, j), density * texel_area, 1e-7);
+    }
+    const int over_gap[][2] = { { 56, 32 }, { 52, 16 }, { 59, 47 } };
+    for (size_t k = 0; k < sizeof over_gap / sizeof over_gap[0]; ++k) {
+        int i = over_gap[k][0], j = over_gap[k][1];
+        ENSURE_NEAR(at(&m[0].depth, 0, i, j), 3.6, 1e-4);
+        ENSURE_NEAR(at(&m[1].depth, 0, i, j), 3.79, 1e-4);
+        ensure_normal(&m[1], i, j, 0, -1, 0);
+        ENSURE_NEAR(at(&m[2].depth, 0, i, j), 3.8, 1e-4);
+        ensure_normal(&m[2], i, j, 0, 1, 0);
+    }
+    // Beside both: the floor's top and underside, nothing after them.
+    ENSURE_NEAR(at(&m[0].depth, 0, 8, 32), 5.0, 1e-4);
+    ENSURE_NEAR(at(&m[1].depth, 0, 8, 32), 5.2, 1e-4);
+    ensure_normal(&m[1], 8, 32, 0, -1, 0);
+    ENSURE(layer_empty_at(&m[2], 8, 32));
+    for (int l = 0; l < 3; ++l) {
+        free_maps(&m[l]);
+    }
+    // With room for every crossing (6 layers) the contact stays, sealing the
+    // two faces: 3.6, 3.8 (leaving), 3.8 (entering), 4, 5, 5.2.
+    maps4 all[6];
+    const double depths[6] = { 3.6, 3.8, 3.8, 4.0, 5.0, 5.2 };
+    const float ys[6] = { 1, -1, 1, -1, 1, -1 };
+    for (int l = 0; l < 6; ++l) {
+        ENSURE(read_layer_maps(&s.cameras[1], l, &all[l]));
+        ENSURE_NEAR(at(&all[l].depth, 0, 32, 32), depths[l], 1e-4);
+        ensure_normal(&all[l], 32, 32, 0, ys[l], 0);
+        free_maps(&all[l]);
+    }
+    scene_end(&s);
+}
+
 // Whether two files hold the same bytes.
 static bool same_file(const char *a, const char *b)
 {
@@ -1496,6 +1576,7 @@ int main(void)
     RUN(layers_box_wound_inwards_points_out);
     RUN(layers_pane_one_millimetre_before_a_wall);
     RUN(layers_sill_underside_points_down);
+    RUN(layers_drop_the_contact_of_two_slabs_lying_on_each_other);
     RUN(layers_one_is_today_and_layer_zero_of_four_matches_it);
     RUN(layers_share_initial_dirt_with_other_cameras);
     RUN(layers_hold_every_substance_the_surface_and_the_area);

@@ -183,9 +183,11 @@ void wx_memory_estimate_geometry(const wx_scene *scene, unsigned phases,
             need->camera_line = sc->line;
         }
         if (bake && sc->has_view && !wx_has_path(sc->depth_path)) {
-            // Peeling reads the previous layer's depth from a texture.
+            // Peeling reads the previous layer's depth from a texture, and
+            // each pass is read back whole (10 floats a texel, 2 bytes of
+            // state) before it is merged into the layers (raster/bake.c).
             framebuffer = fmax(framebuffer, (WX_BAKE_FRAMEBUFFER_BYTES_PER_TEXEL +
-                                             (layers > 1.0 ? 8.0 : 0.0)) * texels);
+                                             (layers > 1.0 ? 8.0 + 42.0 : 0.0)) * texels);
             images = fmax(images, layers * texels *
                                       (sc->is_output ? WX_BAKE_OUTPUT_IMAGE_BYTES_PER_TEXEL
                                                      : input_image));
