@@ -99,6 +99,31 @@ static inline int bake_cam_layers(const wx_scene_camera *sc)
     return sc->layers < WX_MAX_LAYERS ? sc->layers : WX_MAX_LAYERS;
 }
 
+// The planes of one peeling pass, as read back: d, the outward normal, and for
+// an input camera absorption, bounce, deposit, erosion, initial density and
+// <Surface> index + 1 (the three colour targets, shaders/bake_frag.glsl).
+enum {
+    PASS_D,
+    PASS_NX,
+    PASS_NY,
+    PASS_NZ,
+    PASS_ABSORPTION,
+    PASS_BOUNCE,
+    PASS_DEPOSIT,
+    PASS_EROSION,
+    PASS_DENSITY,
+    PASS_SURFACE,
+    PASS_PLANES,
+    PASS_DEPTH_PLANES = PASS_NZ + 1, // a camera baked for its depth alone
+};
+
+// bake_peel.c: draws layered camera c by depth peeling into the kept layers
+// `dst` (`planes` of PASS_*: PASS_PLANES for an input camera,
+// PASS_DEPTH_PLANES for its depth alone), contacts giving way where the
+// crossings outnumber the layers; *drawn: the most crossings a texel kept.
+wx_result bake_peel_camera(baker *b, int c, int layers, int planes, plane_out (*dst)[PASS_PLANES],
+                           int *drawn, wx_error *err);
+
 // bake_gl.c: the GL 4.5 core context, its program and the framebuffer's
 // limits (b->max_side).
 wx_result bake_create_context(baker *b, wx_error *err);
