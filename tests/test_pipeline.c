@@ -247,6 +247,16 @@ TEST(the_output_list_names_the_previews_the_writers_write)
         &scene,
         (const char *[]){ "mask_dirt.png", "mask_ao.png", "tex_dirt.png", "tex_ao.png", NULL },
         (const char *[]){ "mask.png", "tex.png", NULL }));
+    // An upper-case extension (the scene reader accepts .EXR): the same BASE
+    // for the frames and every preview.
+    snprintf(cams[1].output_file, sizeof cams[1].output_file, "shot.EXR");
+    cams[1].every = 1;
+    ENSURE(
+        lists(&scene,
+              (const char *[]){ "shot.EXR", "shot_dirt.png", "shot_ao.png", "shot.0001.exr", NULL },
+              (const char *[]){ "shot.EXR_dirt.png", "shot.EXR.0001.exr", NULL }));
+    snprintf(cams[1].output_file, sizeof cams[1].output_file, "mask.exr");
+    cams[1].every = 0;
     // Two substances and a mask.
     scene.substances_declared = true;
     scene.substance_count = 2;

@@ -4,6 +4,7 @@
 
 #include <stdio.h>
 #include <string.h>
+#include <strings.h>
 
 static const char *const map_kinds[WX_MAP_KINDS] = { "depth", "normal", "impact", "dirt" };
 
@@ -20,7 +21,9 @@ void wx_map_file_name(const char *camera, int kind, char *out, size_t cap)
 size_t wx_output_base_length(const char *file)
 {
     size_t n = strlen(file);
-    return n >= 4 && strcmp(file + n - 4, ".exr") == 0 ? n - 4 : n;
+    // In any case, as the scene reader accepts it: mask.EXR's frames are
+    // mask.0001.exr and its previews mask.png and mask_rust.png alike.
+    return n >= 4 && strcasecmp(file + n - 4, ".exr") == 0 ? n - 4 : n;
 }
 
 void wx_preview_name(const char *mask_name, char *out, size_t cap)

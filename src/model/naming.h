@@ -36,8 +36,8 @@ const char *wx_map_kind_name(int kind);
 /// camera's map in the output folder.
 void wx_map_file_name(const char *camera, int kind, char *out, size_t cap);
 
-/// The length of `file` without a final ".exr": the BASE of BASE.NNNN.exr,
-/// BASE.TTTT.exr and BASE_NAME.png.
+/// The length of `file` without a final ".exr" (in any case: ".EXR" too): the
+/// BASE of BASE.NNNN.exr, BASE.TTTT.exr and BASE_NAME.png.
 size_t wx_output_base_length(const char *file);
 
 /// The preview's name for a mask's: its extension replaced by .png ("mask.exr"
