@@ -57,8 +57,9 @@ void wx_tile_name(const char *file, int udim, char *out, size_t cap);
 /// ".Y" -> ""); the whole length when it has none.
 size_t wx_channel_stem_length(const char *channel);
 
-/// The mask's channels (docs/design.md section 10): "Y" for a scene without
-/// <Substances>, else NAME.Y per substance. Returns the count.
+/// The mask's channels (docs/design.md sections 10 and 12): "Y" for a scene
+/// with neither <Substances> nor <Masks>, else NAME.Y per substance ("dirt"
+/// without <Substances>), then NAME.Y per derived mask. Returns the count.
 int wx_mask_channels(const wx_scene *scene, char names[][WX_NAME_MAX]);
 
 /// The texture's channels: the mask's (section 10) and `seen`. Returns the count.
