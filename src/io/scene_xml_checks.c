@@ -47,6 +47,24 @@ static wx_result check_surface_rules(parser *p)
     return WX_OK;
 }
 
+/// Whether `file` is the name of a map bake or simulate writes
+/// (<camera>_<kind>.exr); then *camera and *kind say whose.
+static bool map_named(const wx_scene *s, const char *file, int *camera, int *kind)
+{
+    for (int c = 0; c < s->camera_count; ++c) {
+        for (int k = 0; k < WX_MAP_KINDS; ++k) {
+            char name[128];
+            wx_map_file_name(s->cameras[c].name, k, name, sizeof name);
+            if (strcmp(name, file) == 0) {
+                *camera = c;
+                *kind = k;
+                return true;
+            }
+        }
+    }
+    return false;
+}
+
 /// The mask must not take the name of a map that bake or simulate writes.
 static wx_result check_output_name(parser *p)
 {
@@ -55,17 +73,12 @@ static wx_result check_output_name(parser *p)
         return WX_OK;
     }
     const wx_scene_camera *out = &s->cameras[s->output_index];
-    for (int c = 0; c < s->camera_count; ++c) {
-        for (int k = 0; k < WX_MAP_KINDS; ++k) {
-            char name[128];
-            wx_map_file_name(s->cameras[c].name, k, name, sizeof name);
-            if (strcmp(name, out->output_file) == 0) {
-                return fail_line(p, out->line, WX_CAUSE_BAD_SCENE,
-                                 "<OutputMap> file=\"%s\" is the name of camera '%s''s %s map in "
-                                 "the output folder; choose another",
-                                 out->output_file, s->cameras[c].name, wx_map_kind_name(k));
-            }
-        }
+    int c, k;
+    if (map_named(s, out->output_file, &c, &k)) {
+        return fail_line(p, out->line, WX_CAUSE_BAD_SCENE,
+                         "<OutputMap> file=\"%s\" is the name of camera '%s''s %s map in "
+                         "the output folder; choose another",
+                         out->output_file, s->cameras[c].name, wx_map_kind_name(k));
     }
     return WX_OK;
 }
@@ -174,17 +187,12 @@ static wx_result check_texture_names(parser *p)
     const wx_scene *s = p->scene;
     for (int i = 0; i < s->texture_count; ++i) {
         const wx_texture_map *tex = &s->textures[i];
-        for (int c = 0; c < s->camera_count; ++c) {
-            for (int k = 0; k < WX_MAP_KINDS; ++k) {
-                char name[128];
-                wx_map_file_name(s->cameras[c].name, k, name, sizeof name);
-                if (strcmp(name, tex->file) == 0) {
-                    return fail_line(p, tex->line, WX_CAUSE_BAD_SCENE,
-                                     "<TextureMap> file=\"%s\" is the name of camera '%s''s %s "
-                                     "map in the output folder; choose another",
-                                     tex->file, s->cameras[c].name, wx_map_kind_name(k));
-                }
-            }
+        int c, k;
+        if (map_named(s, tex->file, &c, &k)) {
+            return fail_line(p, tex->line, WX_CAUSE_BAD_SCENE,
+                             "<TextureMap> file=\"%s\" is the name of camera '%s''s %s "
+                             "map in the output folder; choose another",
+                             tex->file, s->cameras[c].name, wx_map_kind_name(k));
         }
         output_entry t = { .file = tex->file, .every = tex->every, .line = tex->line };
         if (s->output_index >= 0) {
