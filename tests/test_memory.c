@@ -16,6 +16,7 @@
 #include <unistd.h>
 
 #include "ensure.h"
+#include "memory_fixture.h"
 
 // A folder of this test's scenes with the unit box of tests/data (box.obj).
 static const char *scene_dir(void)
@@ -40,41 +41,6 @@ static const char *out_dir(const char *name)
     char *dir = dirs[next++ % 4];
     snprintf(dir, sizeof dirs[0], "%s/%s", ensure_tmpdir(), name);
     return dir;
-}
-
-// Runs `weathering run SCENE --out DIR -q` from the repository's root and
-// returns its peak resident memory in MiB (wait4's ru_maxrss), or -1.
-static double run_peak_mib(const char *scene, const char *dir)
-{
-    char program[4200];
-    snprintf(program, sizeof program, "%s/weathering", ensure_build_dir());
-    pid_t pid = fork();
-    if (pid == 0) {
-        int null = open("/dev/null", O_WRONLY);
-        dup2(null, STDOUT_FILENO);
-        dup2(null, STDERR_FILENO);
-        execl(program, program, "run", scene, "--out", dir, "-q", (char *)NULL);
-        _exit(98);
-    }
-    int status = 0;
-    struct rusage usage;
-    if (pid < 0 || wait4(pid, &status, 0, &usage) != pid || !WIFEXITED(status) ||
-        WEXITSTATUS(status) != 0) {
-        return -1.0;
-    }
-    return (double)usage.ru_maxrss / 1024.0;
-}
-
-// info's "memory: about N MiB at the peak" of a scene, or -1.
-static double estimate_mib(const char *scene)
-{
-    static char log[16384];
-    if (ensure_shell(log, sizeof log, "'%s/weathering' info '%s'", ensure_build_dir(), scene) !=
-        0) {
-        return -1.0;
-    }
-    const char *at = strstr(log, "memory: about ");
-    return at != NULL ? atof(at + strlen("memory: about ")) : -1.0;
 }
 
 // A bumpy square of about `triangles` triangles (a grid of n x n quads, each
@@ -204,7 +170,7 @@ TEST(memory_estimate_bounds_meshes_and_particles_alive_at_once)
             ensure_write_file(dir, name, text);
             snprintf(path, sizeof path, "%s/%s", dir, name);
             double estimate = estimate_mib(path);
-            double peak = run_peak_mib(path, out_dir(name));
+            double peak = run_peak_mib(path, out_dir(name), NULL);
             fprintf(stderr, "        %-22s estimate %6.0f MiB, peak %6.0f MiB (%.2fx)\n", name,
                     estimate, peak, estimate / peak);
             failures += !(peak > 0.0 && estimate >= peak && estimate <= 3.0 * peak);
@@ -217,7 +183,7 @@ TEST(memory_estimate_bounds_meshes_and_particles_alive_at_once)
     ensure_write_file(dir, "rain_20s.xml", text);
     snprintf(path, sizeof path, "%s/rain_20s.xml", dir);
     double estimate = estimate_mib(path);
-    double peak = run_peak_mib(path, out_dir("rain_20s"));
+    double peak = run_peak_mib(path, out_dir("rain_20s"), NULL);
     fprintf(stderr, "        %-22s estimate %6.0f MiB, peak %6.0f MiB (%.2fx)\n", "rain_20s.xml",
             estimate, peak, estimate / peak);
     failures += !(peak > 0.0 && estimate >= peak && estimate <= 3.0 * peak);

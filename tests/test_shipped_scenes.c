@@ -17,45 +17,7 @@
 #include <unistd.h>
 
 #include "ensure.h"
-
-// Runs `weathering run SCENE --out DIR -q --stats STATS` from the repository's
-// root and returns its peak resident memory in MiB (wait4's ru_maxrss), or -1
-// when it did not exit with status 0.
-static double run_peak_mib(const char *scene, const char *dir, const char *stats)
-{
-    char program[4200];
-    snprintf(program, sizeof program, "%s/weathering", ensure_build_dir());
-    pid_t pid = fork();
-    if (pid == 0) {
-        int null = open("/dev/null", O_WRONLY);
-        dup2(null, STDOUT_FILENO);
-        dup2(null, STDERR_FILENO);
-        execl(program, program, "run", scene, "--out", dir, "-q", "--stats", stats, (char *)NULL);
-        _exit(98);
-    }
-    int status = 0;
-    struct rusage usage;
-    if (pid < 0 || wait4(pid, &status, 0, &usage) != pid || !WIFEXITED(status) ||
-        WEXITSTATUS(status) != 0) {
-        return -1.0;
-    }
-    return (double)usage.ru_maxrss / 1024.0;
-}
-
-// info's "memory: about N MiB at the peak" of a scene; -1 when info fails (the
-// scene does not validate) or does not say it.
-static double estimate_mib(const char *scene)
-{
-    static char log[16384];
-    int status =
-        ensure_shell(log, sizeof log, "'%s/weathering' info '%s'", ensure_build_dir(), scene);
-    if (status != 0) {
-        fprintf(stderr, "        info %s: status %d\n%s\n", scene, status, log);
-        return -1.0;
-    }
-    const char *at = strstr(log, "memory: about ");
-    return at != NULL ? atof(at + strlen("memory: about ")) : -1.0;
-}
+#include "memory_fixture.h"
 
 // Every substance's ledger of a --stats file balances (exact to rounding);
 // returns how many substances it checked, -1 when one does not balance.
