@@ -30,6 +30,11 @@ typedef struct cli_args {
     // run MESH: the scene generated in memory, loaded as scene_path's file
     // and written there once the run's checks pass.
     const char *scene_text;
+    // tiles (docs/tiles.md): --tiles NX NZ (0: not given), --halo M, --slurm.
+    int tiles_x, tiles_z;
+    double halo;
+    bool halo_set;
+    bool slurm;
 } cli_args;
 
 /// The commands (main.c's table): each returns the exit status.
@@ -40,6 +45,8 @@ int command_gather(const cli_args *args);
 int command_init(const cli_args *args); // mesh.c
 int command_run(const cli_args *args);
 int command_split(const cli_args *args); // split.c
+int command_tiles(const cli_args *args); // tiles.c
+int command_merge(const cli_args *args);
 
 /// A usage error: the message and the hint to --help on stderr; returns 2.
 static inline int usage_error(const char *fmt, const char *detail)

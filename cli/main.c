@@ -4,16 +4,19 @@
 //   weathering init MESH [--preset P] [-o SCENE.xml] [--resolution PX] [--units U] [--force]
 //   weathering run MESH --preset P [options]      (docs/presets.md)
 //   weathering split FILE.exr [--out DIR]
+//   weathering tiles SCENE.xml --tiles NX NZ [--halo M] [--out DIR] [--slurm]
+//   weathering merge DIR [--out DIR2]
 //
 // Exit status: 0 success, 2 bad usage or bad input (one message naming the file,
 // and the line for XML), 1 any other failure.
 //
 // This file reads the arguments, dispatches to the commands (info.c,
-// phases.c, mesh.c, split.c) and catches the interrupts.
+// phases.c, mesh.c, split.c, tiles.c) and catches the interrupts.
 #include "cli.h"
 
 #include <signal.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
@@ -40,6 +43,8 @@ static const command commands[] = {
     { "info", command_info, "validate a scene and print what it holds" },
     { "init", command_init, "write a commented scene for a mesh from a preset (MESH, not SCENE)" },
     { "split", command_split, "write each channel of an EXR as a file of its own (FILE.exr)" },
+    { "tiles", command_tiles, "cut a scene into tile scenes, a job each (--tiles NX NZ)" },
+    { "merge", command_merge, "join the tiles' masks and TextureMaps (DIR, not SCENE)" },
 };
 enum { COMMAND_COUNT = sizeof commands / sizeof commands[0] };
 
@@ -50,6 +55,8 @@ static void print_usage(FILE *out)
             "       weathering init MESH [--preset P] [-o SCENE.xml] [--resolution PX] [--units U] [--force]\n"
             "       weathering run MESH --preset P [options]\n"
             "       weathering split FILE.exr [--out DIR]\n"
+            "       weathering tiles SCENE.xml --tiles NX NZ [--halo M] [--out DIR] [--slurm]\n"
+            "       weathering merge DIR [--out DIR2]\n"
             "\n"
             "Particle-driven weathering masks: dirt-carrying particles collide against\n"
             "depth maps of a model and leave a dirt mask for compositing.\n"
@@ -71,6 +78,9 @@ static void print_usage(FILE *out)
             "  --resolution PX    init, run MESH: texels across the largest frame (1024)\n"
             "  --units U          init, run MESH: the mesh's unit: m (default), cm, mm, in, ft\n"
             "  --force            init: replace an existing scene file\n"
+            "  --tiles NX NZ      tiles: tiles along x and z (1 to 1000 each)\n"
+            "  --halo M           tiles: world units around a tile that shelter it (0)\n"
+            "  --slurm            tiles: also write a Slurm job array and its merge job\n"
             "  -h, --help         this help\n"
             "  --version          print the version\n"
             "\n"
@@ -173,6 +183,30 @@ static int parse_args(int argc, char **argv, cli_args *args)
             }
         } else if (strcmp(arg, "--force") == 0) {
             args->force = true;
+        } else if (strcmp(arg, "--tiles") == 0) {
+            uint64_t nx = 0, nz = 0;
+            if (i + 2 >= argc) {
+                return usage_error("%s needs two whole numbers: NX NZ", "--tiles");
+            }
+            if (!wx_parse_whole(argv[i + 1], 1, 1000, &nx) ||
+                !wx_parse_whole(argv[i + 2], 1, 1000, &nz)) {
+                return usage_error("--tiles takes two whole numbers from 1 to 1000, not '%s'",
+                                   argv[i + 1]);
+            }
+            args->tiles_x = (int)nx;
+            args->tiles_z = (int)nz;
+            i += 2;
+        } else if (is_option(arg, "--halo")) {
+            const char *v = option_value(argc, argv, &i, "--halo", &missing);
+            char *end = NULL;
+            double h = missing ? 0.0 : strtod(v, &end);
+            if (!missing && (end == v || *end != '\0' || !(h >= 0.0) || !(h < 1e30))) {
+                return usage_error("--halo takes a distance of 0 or more, not '%s'", v);
+            }
+            args->halo = h;
+            args->halo_set = true;
+        } else if (strcmp(arg, "--slurm") == 0) {
+            args->slurm = true;
         } else if (arg[0] == '-' && arg[1] != '\0') {
             return usage_error("unknown option '%s'", arg);
         } else if (args->command == NULL) {
@@ -240,6 +274,7 @@ int main(int argc, char **argv)
             if (args.scene_path == NULL) {
                 return usage_error(strcmp(args.command, "init") == 0    ? "%s needs a mesh file"
                                    : strcmp(args.command, "split") == 0 ? "%s needs an EXR file"
+                                   : strcmp(args.command, "merge") == 0 ? "%s needs a folder"
                                                                         : "%s needs a scene file",
                                    args.command);
             }
@@ -250,6 +285,11 @@ int main(int argc, char **argv)
             if (mesh_options && !takes_them) {
                 return usage_error("--preset, -o, --resolution, --units and --force are for "
                                    "`init MESH` and `run MESH` (%s was given a scene)",
+                                   args.command);
+            }
+            bool tile_options = args.tiles_x > 0 || args.halo_set || args.slurm;
+            if (tile_options && strcmp(args.command, "tiles") != 0) {
+                return usage_error("--tiles, --halo and --slurm are for `tiles` (not %s)",
                                    args.command);
             }
             return commands[i].run(&args);

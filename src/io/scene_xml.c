@@ -23,6 +23,7 @@
 
 #include <errno.h>
 #include <locale.h>
+#include <math.h>
 #include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -179,7 +180,7 @@ static wx_result parse_document(const char *path, const char *text, size_t size,
     return WX_OK;
 }
 
-static wx_result read_document(const char *path, xmlDocPtr *out, wx_error *err)
+wx_result xml_read_document(const char *path, xmlDocPtr *out, wx_error *err)
 {
     *out = NULL;
     char *text;
@@ -193,6 +194,45 @@ static wx_result read_document(const char *path, xmlDocPtr *out, wx_error *err)
 }
 
 // ---------------------------------------------------------------------------
+// <Tile> (docs/tiles.md): the region of a larger scene this scene is a tile of
+
+typedef struct tile_attrs {
+    double min_x, max_x, min_z, max_z, halo;
+} tile_attrs;
+
+static const attr_spec tile_specs[] = {
+    { "minX", T_DOUBLE, offsetof(tile_attrs, min_x), .range = R_FINITE },
+    { "maxX", T_DOUBLE, offsetof(tile_attrs, max_x), .range = R_FINITE },
+    { "minZ", T_DOUBLE, offsetof(tile_attrs, min_z), .range = R_FINITE },
+    { "maxZ", T_DOUBLE, offsetof(tile_attrs, max_z), .range = R_FINITE },
+    { "halo", T_DOUBLE, offsetof(tile_attrs, halo), .range = R_NONNEG },
+};
+
+static wx_result parse_tile(parser *p, const xmlNode *node, void *user)
+{
+    (void)user;
+    tile_attrs a = { 0 };
+    unsigned given = 0;
+    wx_result r = LEAF(tile_specs, &a, &given);
+    if (r != WX_OK) {
+        return r;
+    }
+    wx_tile_def *t = &p->scene->tile;
+    t->present = true;
+    t->min[0] = (given & 1u) ? a.min_x : -INFINITY;
+    t->max[0] = (given & 2u) ? a.max_x : INFINITY;
+    t->min[1] = (given & 4u) ? a.min_z : -INFINITY;
+    t->max[1] = (given & 8u) ? a.max_z : INFINITY;
+    t->halo = a.halo;
+    t->line = line_of(node);
+    if (!(t->min[0] < t->max[0]) || !(t->min[1] < t->max[1])) {
+        return fail(p, node, WX_CAUSE_BAD_VALUE,
+                    "<Tile>: the region is empty (minX must be below maxX, minZ below maxZ)");
+    }
+    return WX_OK;
+}
+
+// ---------------------------------------------------------------------------
 // <Weathering>
 
 static const child_spec root_children[] = {
@@ -200,6 +240,7 @@ static const child_spec root_children[] = {
     { "Emitters", xml_parse_emitters, false },     { "Collider", xml_parse_collider, false },
     { "Geometry", xml_parse_geometry, false },     { "Substances", xml_skip_substances, false },
     { "Ageing", xml_parse_ageing, false },         { "Masks", xml_parse_masks, false },
+    { "Tile", parse_tile, false },
 };
 
 /// The first <Substances> child of the root, read before the rest (a second
@@ -296,7 +337,7 @@ static wx_result scene_load(const char *path, const char *text, size_t size, wx_
     xmlDocPtr doc = NULL;
     if (r == WX_OK) {
         r = text != NULL ? parse_document(path, text, size, &doc, err)
-                         : read_document(path, &doc, err);
+                         : xml_read_document(path, &doc, err);
     }
     if (r == WX_OK) {
         // Numbers are read with '.' as the decimal point whatever the locale.

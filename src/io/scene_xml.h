@@ -20,4 +20,22 @@ wx_result wx_scene_load(const char *path, wx_scene *out, wx_error *err);
 wx_result wx_scene_load_text(const char *path, const char *text, size_t size, wx_scene *out,
                              wx_error *err);
 
+/// One tile's changes to a scene file (docs/tiles.md): its name, its <Tile>,
+/// the new <View> of each input camera (by name; a camera not listed is left
+/// out of the tile), and the folder the tile scene is written to, so that
+/// relative paths of meshes and maps are rewritten to stay valid from there.
+typedef struct wx_tile_scene_edit {
+    const char *name;       ///< the tile scene's `name`
+    wx_tile_def tile;       ///< written as <Tile>
+    const char *to_dir;     ///< absolute folder the tile scene goes to
+    int view_count;
+    const char *const *view_names;
+    const wx_view *views;
+} wx_tile_scene_edit;
+
+/// The text of the tile scene that `edit` makes of the scene file `path`
+/// (everything else as the file has it, comments included). *text is malloc'd.
+wx_result wx_scene_tile_text(const char *path, const wx_tile_scene_edit *edit, char **text,
+                             size_t *size, wx_error *err);
+
 #endif

@@ -29,6 +29,10 @@
 /// <Accessibility rays>: rays per surface point (docs/design.md section 12).
 #define SCENE_MAX_RAYS 4096
 
+/// Reads and parses a scene file safely (no network, no entities): the
+/// document, or an error naming the file and line.
+wx_result xml_read_document(const char *path, xmlDocPtr *out, wx_error *err);
+
 /// CTWMatrix must be the inverse of WTCMatrix to this relative tolerance
 /// (wx_camera_inverse_error): matrices printed with 4-6 digits pass.
 #define SCENE_INVERSE_TOLERANCE 1e-3f

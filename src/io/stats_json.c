@@ -37,11 +37,17 @@ wx_result wx_write_stats(const char *path, const wx_sim_stats *stats, const wx_p
         }
         used += (size_t)m;
     }
+    char tile[64] = "";
+    if (stats->tiled) {
+        snprintf(tile, sizeof tile, "  \"tile_particles\": %lld,\n",
+                 (long long)stats->tile_particles);
+    }
     char json[16384];
     int n = snprintf(
         json, sizeof json,
         "{\n"
         "  \"particles_emitted\": %lld,\n"
+        "%s"
         "  \"particle_steps\": %lld,\n"
         "  \"collisions\": %lld,\n"
         "  \"absorbed\": %lld,\n"
@@ -66,7 +72,7 @@ wx_result wx_write_stats(const char *path, const wx_sim_stats *stats, const wx_p
         "  \"threads\": %d,\n"
         "  \"seed\": %llu\n"
         "}\n",
-        (long long)stats->particles_emitted, (long long)stats->particle_steps,
+        (long long)stats->particles_emitted, tile, (long long)stats->particle_steps,
         (long long)stats->collisions, (long long)stats->absorbed, (long long)stats->settled,
         (long long)stats->escaped, (long long)stats->escaped_without_hit,
         (long long)stats->alive, (long long)stats->alive_without_hit, dirt,

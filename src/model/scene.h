@@ -272,6 +272,34 @@ typedef struct wx_mask_def {
     int line;
 } wx_mask_def;
 
+/// <Tile>: the scene is one tile of a larger scene, as `weathering tiles`
+/// writes it (docs/tiles.md). Its outputs hold only the surface points whose
+/// x and z lie in [min, max) (an absent bound: unbounded), and its emitters fly
+/// only the particles that start within `halo` world units of that region
+/// (the others are drawn, so every particle keeps its index and random stream,
+/// and dropped).
+typedef struct wx_tile_def {
+    bool present;
+    double min[2]; ///< x, z; -INFINITY when not given
+    double max[2]; ///< x, z; +INFINITY when not given
+    double halo;   ///< >= 0, default 0
+    int line;
+} wx_tile_def;
+
+/// Whether the tile owns the surface point at world x, z (always without a tile).
+static inline bool wx_tile_owns(const wx_tile_def *t, double x, double z)
+{
+    return !t->present || (x >= t->min[0] && x < t->max[0] && z >= t->min[1] && z < t->max[1]);
+}
+
+/// Whether a particle starting at world x, z flies in the tile's run: within
+/// `halo` of the tile (always without a tile).
+static inline bool wx_tile_keeps(const wx_tile_def *t, double x, double z)
+{
+    return !t->present || (x >= t->min[0] - t->halo && x < t->max[0] + t->halo &&
+                           z >= t->min[1] - t->halo && z < t->max[1] + t->halo);
+}
+
 typedef struct wx_mesh {
     char *path; ///< resolved against the scene's folder (owned)
     wx_surface *surfaces;
@@ -326,6 +354,8 @@ typedef struct wx_scene {
     int iterations;          ///< >= 1, default 1
     wx_rule *rules;          ///< global ageing rules (<Ageing>), document order (owned)
     int rule_count;
+    /// <Tile>: present when the scene is one tile of a larger one.
+    wx_tile_def tile;
 } wx_scene;
 
 /// True when a path is given (not NULL, not empty).

@@ -4,6 +4,7 @@
 #ifndef WX_STATS_H
 #define WX_STATS_H
 
+#include <stdbool.h>
 #include <stdint.h>
 
 #include "core/limits.h"
@@ -26,6 +27,11 @@ typedef struct wx_substance_ledger {
 /// Counters of a simulation (the pinned keys of --stats).
 typedef struct wx_sim_stats {
     int64_t particles_emitted;
+    /// A tile's run (<Tile>, docs/tiles.md): of the particles emitted, those that
+    /// start in the tile itself (not in its halo), so that the tiles' counts add
+    /// up to the whole scene's particles_emitted; `tiled` says whether to report it.
+    bool tiled;
+    int64_t tile_particles;
     int64_t particle_steps;
     int64_t collisions;
     int64_t absorbed;

@@ -15,6 +15,7 @@
 #include "core/progress.h"
 #include "pipeline/masks_phase.h"
 #include "pipeline/outputs.h"
+#include "pipeline/tiles.h"
 #include "pipeline/texture_phase.h"
 
 static wx_result write_mask(const wx_scene *scene, const wx_run_def *opts, const wx_maps *in_maps,
@@ -211,6 +212,10 @@ static wx_result write_mask(const wx_scene *scene, const wx_run_def *opts, const
         result = wx_masks_at_camera(scene, opts, masks, WX_MASK_SLOT_OUTPUT, &out->camera, om,
                                     (const float *const *)image->channels,
                                     image->channels + substances, err);
+    }
+    // A tile's run writes only the points its <Tile> owns (docs/tiles.md).
+    if (result == WX_OK) {
+        wx_tile_restrict_camera(scene, &out->camera, om->depth, image);
     }
     double t2 = wx_now_s();
     detail->compute = t2 - t1;

@@ -15,6 +15,7 @@
 #include "model/naming.h"
 #include "pipeline/load.h"
 #include "pipeline/outputs.h"
+#include "pipeline/tiles.h"
 
 // The arrays the sampling reads, copied: the bake releases the geometry's.
 static wx_result copy_mesh(const wx_mesh_data *from, int uv, wx_mesh_data *to, wx_error *err)
@@ -387,7 +388,7 @@ static wx_result write_texture(const wx_scene *scene, const wx_run_def *opts,
     double *position = NULL;
     float *normal = NULL;
     const bool enclosing = masks != NULL && masks->ready;
-    if (r == WX_OK && (scene->mask_count > 0 || enclosing)) {
+    if (r == WX_OK && (scene->mask_count > 0 || enclosing || scene->tile.present)) {
         position = calloc(3 * texels, sizeof *position);
         normal = calloc(3 * texels, sizeof *normal);
         if (position == NULL || normal == NULL) {
@@ -419,6 +420,10 @@ static wx_result write_texture(const wx_scene *scene, const wx_run_def *opts,
                 image->channels[c][i] = 0.0f;
             }
         }
+    }
+    // A tile's run writes only the points its <Tile> owns (docs/tiles.md).
+    if (r == WX_OK) {
+        wx_tile_restrict_points(scene, position, image->channels[channels - 1], image);
     }
     // The derived masks at the texels whose point is seen, then the padding of
     // every channel.

@@ -263,6 +263,7 @@ static int64_t emitted_after(const wx_sim *sim, const wx_emitter *em, int64_t st
 
 static wx_result emit(wx_sim *sim, int64_t step, wx_error *err)
 {
+    const wx_tile_def *tile = &sim->scene->tile;
     for (int e = 0; e < sim->emitter_count; ++e) {
         const wx_emitter *em = &sim->emitters[e];
         int64_t target = emitted_after(sim, em, step);
@@ -274,10 +275,17 @@ static wx_result emit(wx_sim *sim, int64_t step, wx_error *err)
             return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (%lld particles)",
                                 (long long)(sim->particles.count + count));
         }
+        int64_t pushed = 0;
         for (int64_t k = 0; k < count; ++k) {
             uint64_t id = wx_particle_id((uint32_t)e, (uint64_t)(sim->emitted[e] + k));
             float pos[3], vel[3];
             wx_emitter_sample(em, sim->seed, id, pos, vel);
+            // A tile flies only the particles that start within its halo; the
+            // others are drawn all the same, so every particle keeps its index
+            // (and random stream) of the whole scene (docs/tiles.md).
+            if (!wx_tile_keeps(tile, pos[0], pos[2])) {
+                continue;
+            }
             double load[WX_MAX_SUBSTANCES];
             for (int s = 0; s < sim->substances; ++s) {
                 load[s] = em->load[s];
@@ -285,15 +293,19 @@ static wx_result emit(wx_sim *sim, int64_t step, wx_error *err)
             if (wx_particles_push(&sim->particles, pos, vel, em->mass, load, id,
                                   max_collisions_of(em->max_collisions)) < 0) {
                 sim->emitted[e] += k;
-                sim->stats.particles_emitted += k;
+                sim->stats.particles_emitted += pushed;
                 return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (particle masses)");
+            }
+            pushed++;
+            if (tile->present && wx_tile_owns(tile, pos[0], pos[2])) {
+                sim->stats.tile_particles++;
             }
             for (int s = 0; s < sim->substances; ++s) {
                 sim->stats.substance[s].emitted += em->load[s];
             }
         }
         sim->emitted[e] = target;
-        sim->stats.particles_emitted += count;
+        sim->stats.particles_emitted += pushed;
     }
     return WX_OK;
 }
@@ -379,6 +391,7 @@ wx_result wx_sim_create(const wx_scene *scene, const wx_sim_def *config, wx_sim 
     sim->substances = scene->substance_count > 1 ? scene->substance_count : 1;
     sim->particles.substances = sim->substances;
     sim->stats.substance_count = sim->substances;
+    sim->stats.tiled = scene->tile.present;
     sim->thread_count = config->threads > 0 ? config->threads : wx_cpu_count();
     sim->hit_capacity = config->hit_capacity > 0 ? config->hit_capacity : DEFAULT_HIT_CAPACITY;
     int64_t chunk = config->chunk_particles > 0 ? config->chunk_particles : DEFAULT_CHUNK;
