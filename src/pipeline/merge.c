@@ -212,7 +212,8 @@ static wx_result write_previews(const wx_scene *scene, const char *out_dir, cons
 
 // The transparent texels of a merged preview: for the mask, the background of
 // the output camera's depth map (every tile bakes the whole output camera);
-// for a texture, the texels no tile wrote (covered texels none sees included).
+// for a texture, the texels no tile wrote: neither seen nor holding a value
+// (covered texels no camera sees included, which a run's preview shows black).
 static float *preview_surface(const wx_scene *scene, const tile_ref *first, bool mask,
                               const wx_image *image, int threads)
 {
@@ -245,9 +246,15 @@ static float *preview_surface(const wx_scene *scene, const tile_ref *first, bool
         wx_maps_free(&maps);
         return surface;
     }
+    const float *seen = NULL;
+    for (int c = 0; c < image->channel_count; ++c) {
+        if (strcmp(image->channel_names[c], "seen") == 0) {
+            seen = image->channels[c];
+        }
+    }
     float *surface = malloc(n * sizeof *surface);
     for (size_t i = 0; surface != NULL && i < n; ++i) {
-        bool any = false;
+        bool any = seen != NULL && seen[i] > 0.0f;
         for (int c = 0; c < image->channel_count && !any; ++c) {
             any = image->channels[c][i] != 0.0f;
         }
