@@ -395,6 +395,13 @@ int command_info(const cli_args *args)
                scene.steps * iterations, wx_scene_duration(&scene) * iterations);
     }
     printf("; seed %" PRIu64 "\n", opts.seed);
+    // A tile of a larger scene (docs/tiles.md).
+    if (scene.tile.present) {
+        const wx_tile_def *t = &scene.tile;
+        printf("tile: x in [%g, %g), z in [%g, %g), halo %g: the outputs hold only its points, "
+               "the particles that start within the halo fly\n",
+               t->min[0], t->max[0], t->min[1], t->max[1], t->halo);
+    }
     // Substances (docs/design.md section 9): without <Substances> the one "dirt".
     printf("substances (%d):", scene.substance_count);
     for (int k = 0; k < scene.substance_count; ++k) {
