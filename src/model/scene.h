@@ -222,14 +222,14 @@ typedef enum wx_mask_kind {
     WX_MASK_CURVATURE,     ///< mean curvature, 1/world unit (convex > 0)
     WX_MASK_HEIGHT,        ///< clamp((y - min) / (max - min), 0, 1)
     WX_MASK_COMBINE,       ///< clamp(scale * sum of terms, 0, 1)
-    WX_MASK_NOISE,         ///< fractal Perlin noise of the world position, uniform on [0, 1] by area
+    WX_MASK_NOISE,         ///< fractal Perlin noise of the world position, uniform by area
 } wx_mask_kind;
 
 typedef enum wx_term_kind {
     WX_TERM_MASK,      ///< a derived mask defined before the Combine
     WX_TERM_SUBSTANCE, ///< a substance, per square metre
     WX_TERM_CONSTANT,
-    WX_TERM_AGE,       ///< constant * i / iterations in the frame after iteration i (1: final)
+    WX_TERM_AGE,       ///< constant * i / iterations in the frame after iteration i
 } wx_term_kind;
 
 /// One <Term> of a <Combine>: weight * S(x), S Riihiaho's sigmoid
