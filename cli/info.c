@@ -204,8 +204,8 @@ static void print_frames(const wx_scene *scene, const wx_mesh_data *mesh)
 // at the rate bench_masks measures (about 1.3 million rays a second a thread).
 static void print_masks(const wx_scene *scene, int threads)
 {
-    static const char *const kinds[] = { "accessibility", "exposure", "curvature", "height",
-                                         "combine", "noise" };
+    static const char *const kinds[] = { "accessibility", "exposure", "curvature",
+                                         "height",        "combine",  "noise" };
     if (scene->mask_count == 0) {
         return;
     }

@@ -93,7 +93,8 @@ TEST(noise_is_deterministic_per_seed)
     for (int k = 0; k < 3000; ++k) {
         points[k] = uniform(&s);
     }
-    double *t1 = malloc(WX_NOISE_TABLE_SIZE * sizeof *t1), *t2 = malloc(WX_NOISE_TABLE_SIZE * sizeof *t2);
+    double *t1 = malloc(WX_NOISE_TABLE_SIZE * sizeof *t1),
+           *t2 = malloc(WX_NOISE_TABLE_SIZE * sizeof *t2);
     wx_error err;
     ENSURE(t1 != NULL && t2 != NULL);
     ENSURE(wx_noise_table_build(&m, points, NULL, 1000, t1, &err) == WX_OK);
@@ -155,7 +156,8 @@ TEST(threshold_leaves_its_area_on_a_sphere)
     ENSURE(n == WX_NOISE_SAMPLE_POINTS);
     for (int a = 0; a < A; ++a) {
         for (int b = 0; b < B; ++b) {
-            double y = -1.0 + 2.0 * (a + 0.5) / A, r = sqrt(1.0 - y * y), ph = 2 * PI * (b + 0.5) / B;
+            double y = -1.0 + 2.0 * (a + 0.5) / A, r = sqrt(1.0 - y * y),
+                   ph = 2 * PI * (b + 0.5) / B;
             double *p = &grid[3 * ((size_t)a * B + b)];
             p[0] = r * cos(ph);
             p[1] = y;
@@ -225,8 +227,8 @@ TEST(threshold_leaves_its_area_on_the_house)
             for (int i = 0; i < k && count < want + 100000; ++i) {
                 double r1 = sqrt(uniform(&s)), r2 = uniform(&s);
                 for (int a = 0; a < 3; ++a) {
-                    points[3 * count + a] = (1 - r1) * v[0][a] + r1 * (1 - r2) * v[1][a] +
-                                            r1 * r2 * v[2][a];
+                    points[3 * count + a] =
+                        (1 - r1) * v[0][a] + r1 * (1 - r2) * v[1][a] + r1 * r2 * v[2][a];
                 }
                 count++;
             }
@@ -440,21 +442,22 @@ TEST(same_world_point_same_value_from_two_cameras)
     const double shift = 8 * 2.0 / 64;
     for (int c = 0; c < 2; ++c) {
         char text[4096], name[32], args[96];
-        snprintf(text, sizeof text,
-                 "<Weathering>\n"
-                 "  <Solver><BoundingBox size=\"12\"/><Simulation timeStep=\"0.01\" "
-                 "steps=\"1\"/></Solver>\n"
-                 "  <Collider><ProjectedMaps>\n"
-                 "    <Ortho cameraName=\"top\"><View eye=\"0 5 0\" target=\"0 0 0\" up=\"0 0 "
-                 "-1\" width=\"6\" height=\"6\" resolution=\"256\"/></Ortho>\n"
-                 "    <Ortho cameraName=\"shot\" out=\"true\"><View eye=\"%g %g 0\" target=\"%g 0 "
-                 "0\" up=\"0 0 -1\" width=\"2\" height=\"2\" resolution=\"64\"/>"
-                 "<OutputMap file=\"mask.exr\"/></Ortho>\n"
-                 "  </ProjectedMaps></Collider>\n"
-                 "  <Geometry><Mesh file=\"floor.obj\"><Surface material=\"*\"/></Mesh></Geometry>\n"
-                 "  <Masks><Noise name=\"grain\" frequency=\"3\"/></Masks>\n"
-                 "</Weathering>\n",
-                 c * shift, 4.0 + c, c * shift);
+        snprintf(
+            text, sizeof text,
+            "<Weathering>\n"
+            "  <Solver><BoundingBox size=\"12\"/><Simulation timeStep=\"0.01\" "
+            "steps=\"1\"/></Solver>\n"
+            "  <Collider><ProjectedMaps>\n"
+            "    <Ortho cameraName=\"top\"><View eye=\"0 5 0\" target=\"0 0 0\" up=\"0 0 "
+            "-1\" width=\"6\" height=\"6\" resolution=\"256\"/></Ortho>\n"
+            "    <Ortho cameraName=\"shot\" out=\"true\"><View eye=\"%g %g 0\" target=\"%g 0 "
+            "0\" up=\"0 0 -1\" width=\"2\" height=\"2\" resolution=\"64\"/>"
+            "<OutputMap file=\"mask.exr\"/></Ortho>\n"
+            "  </ProjectedMaps></Collider>\n"
+            "  <Geometry><Mesh file=\"floor.obj\"><Surface material=\"*\"/></Mesh></Geometry>\n"
+            "  <Masks><Noise name=\"grain\" frequency=\"3\"/></Masks>\n"
+            "</Weathering>\n",
+            c * shift, 4.0 + c, c * shift);
         snprintf(name, sizeof name, "cam%d.xml", c);
         ensure_write_file(dir, name, text);
         snprintf(args, sizeof args, "run %s --out cam%d -q", name, c);

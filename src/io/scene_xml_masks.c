@@ -302,8 +302,8 @@ static wx_result parse_mask(parser *p, const xmlNode *node, wx_mask_kind kind)
         r = LEAF(noise_attrs, m, NULL);
         if (r == WX_OK && m->frequency > WX_NOISE_MAX_FREQUENCY) {
             r = fail(p, node, WX_CAUSE_BAD_VALUE,
-                     "<Noise> frequency=\"%g\" is above %g per world unit",
-                     (double)m->frequency, WX_NOISE_MAX_FREQUENCY);
+                     "<Noise> frequency=\"%g\" is above %g per world unit", (double)m->frequency,
+                     WX_NOISE_MAX_FREQUENCY);
         }
         break;
     }

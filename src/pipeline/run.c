@@ -97,8 +97,8 @@ wx_result wx_run_phases(wx_scene *scene, const wx_run_def *opts, unsigned phases
     for (int m = 0; m < scene->mask_count; ++m) {
         noise_needed |= scene->masks[m].kind == WX_MASK_NOISE;
     }
-    noise_needed = noise_needed && scene->mesh_count > 0 &&
-                   (phases & (WX_PHASE_SIMULATE | WX_PHASE_GATHER));
+    noise_needed =
+        noise_needed && scene->mesh_count > 0 && (phases & (WX_PHASE_SIMULATE | WX_PHASE_GATHER));
     if (r == WX_OK && (bake || textures_needed || bounds_needed || noise_needed)) {
         r = wx_geometry_load(scene, opts->quiet, &geometry, err);
     }

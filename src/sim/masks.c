@@ -390,8 +390,7 @@ static float combine(const job *jb, const wx_mask_def *m, size_t t)
 // without one, the raw value mapped from [-1, 1] to [0, 1].
 static float noise_value(const job *jb, const wx_mask_def *m, const double p[3])
 {
-    const double *table =
-        jb->def->noise_tables != NULL ? jb->def->noise_tables[jb->mask] : NULL;
+    const double *table = jb->def->noise_tables != NULL ? jb->def->noise_tables[jb->mask] : NULL;
     double raw = wx_noise_raw(m, p);
     return table != NULL ? wx_noise_remap(table, raw)
                          : (float)fmin(1.0, fmax(0.0, 0.5 * raw + 0.5));

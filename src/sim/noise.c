@@ -15,8 +15,8 @@ static uint64_t mix(uint64_t x)
 
 // Perlin's 12 gradients: the edges' midpoints of a cube.
 static const signed char gradients[12][3] = {
-    { 1, 1, 0 }, { -1, 1, 0 }, { 1, -1, 0 }, { -1, -1, 0 }, { 1, 0, 1 }, { -1, 0, 1 },
-    { 1, 0, -1 }, { -1, 0, -1 }, { 0, 1, 1 }, { 0, -1, 1 }, { 0, 1, -1 }, { 0, -1, -1 },
+    { 1, 1, 0 },  { -1, 1, 0 },  { 1, -1, 0 }, { -1, -1, 0 }, { 1, 0, 1 },  { -1, 0, 1 },
+    { 1, 0, -1 }, { -1, 0, -1 }, { 0, 1, 1 },  { 0, -1, 1 },  { 0, 1, -1 }, { 0, -1, -1 },
 };
 
 static double fade(double t)
@@ -55,7 +55,8 @@ static double perlin(const double q[3], uint64_t key)
     for (int a = 0; a < 2; ++a) {
         for (int b = 0; b < 2; ++b) {
             for (int e = 0; e < 2; ++e) {
-                c[a][b][e] = corner(key, i[0] + a, i[1] + b, i[2] + e, d[0] - a, d[1] - b, d[2] - e);
+                c[a][b][e] =
+                    corner(key, i[0] + a, i[1] + b, i[2] + e, d[0] - a, d[1] - b, d[2] - e);
             }
         }
     }
