@@ -483,6 +483,77 @@ TEST(same_world_point_same_value_from_two_cameras)
     free(b);
 }
 
+// A scene of pre-rendered maps only (no <Geometry>: the maps of a run of the
+// floor above) builds its remap from the input camera's texels: over the
+// output camera's pixels, which see the floor as the input camera does, a
+// threshold t leaves 1 - t within 1%, and the values are those of the run with
+// the mesh within 0.02 (two samples of the same surface).
+TEST(pre_rendered_maps_remap_by_their_texels)
+{
+    SLOW();
+    const char *dir = ensure_tmpdir();
+    ensure_write_file(dir, "floor.obj",
+                      "v -3 0 -3\nv 3 0 -3\nv 3 0 3\nv -3 0 3\nf 1 3 2\nf 1 4 3\n");
+    static const char *const view =
+        "<View eye=\"0 5 0\" target=\"0 0 0\" up=\"0 0 -1\" width=\"6\" height=\"6\" "
+        "resolution=\"%d\"/>";
+    char top[256], shot[256], text[8192];
+    snprintf(top, sizeof top, view, 256);
+    snprintf(shot, sizeof shot, view, 128);
+    snprintf(text, sizeof text,
+             "<Weathering>\n"
+             "  <Solver><BoundingBox size=\"12\"/><Simulation timeStep=\"0.01\" "
+             "steps=\"1\"/></Solver>\n"
+             "  <Collider><ProjectedMaps>\n"
+             "    <Ortho cameraName=\"top\">%s</Ortho>\n"
+             "    <Ortho cameraName=\"shot\" out=\"true\">%s<OutputMap file=\"mask.exr\"/></Ortho>\n"
+             "  </ProjectedMaps></Collider>\n"
+             "  <Geometry><Mesh file=\"floor.obj\"><Surface material=\"*\"/></Mesh></Geometry>\n"
+             "  <Masks><Noise name=\"grain\" frequency=\"1.5\"/></Masks>\n"
+             "</Weathering>\n",
+             top, shot);
+    ensure_write_file(dir, "mesh.xml", text);
+    ENSURE(weathering_in(dir, "run mesh.xml --out m -q", true) == 0);
+    snprintf(text, sizeof text,
+             "<Weathering>\n"
+             "  <Solver><BoundingBox size=\"12\"/><Simulation timeStep=\"0.01\" "
+             "steps=\"1\"/></Solver>\n"
+             "  <Collider><ProjectedMaps>\n"
+             "    <Ortho cameraName=\"top\">%s<DepthMap file=\"m/top_depth.exr\"/>"
+             "<NormalMap file=\"m/top_normal.exr\"/><ImpactMap file=\"m/top_impact.exr\"/>"
+             "<DirtMap file=\"m/top_dirt.exr\"/></Ortho>\n"
+             "    <Ortho cameraName=\"shot\" out=\"true\">%s<DepthMap file=\"m/shot_depth.exr\"/>"
+             "<NormalMap file=\"m/shot_normal.exr\"/><OutputMap file=\"mask.exr\"/></Ortho>\n"
+             "  </ProjectedMaps></Collider>\n"
+             "  <Masks><Noise name=\"grain\" frequency=\"1.5\"/></Masks>\n"
+             "</Weathering>\n",
+             top, shot);
+    ensure_write_file(dir, "maps.xml", text);
+    ENSURE(weathering_in(dir, "run maps.xml --out p -q", true) == 0);
+    int w, h;
+    float *a = channel(dir, "m", "mask.exr", "grain.Y", &w, &h);
+    float *b = channel(dir, "p", "mask.exr", "grain.Y", &w, &h);
+    ENSURE(a != NULL && b != NULL);
+    static const double thresholds[3] = { 0.25, 0.5, 0.75 };
+    double above[3] = { 0, 0, 0 }, worst = 0.0;
+    size_t n = (size_t)w * h;
+    for (size_t t = 0; t < n; ++t) {
+        worst = fmax(worst, fabs(a[t] - b[t]));
+        for (int k = 0; k < 3; ++k) {
+            above[k] += b[t] > thresholds[k];
+        }
+    }
+    printf("        maps only: above 0.25, 0.5, 0.75: %.4f %.4f %.4f of the pixels; within %.3f "
+           "of the mesh's remap\n",
+           above[0] / n, above[1] / n, above[2] / n, worst);
+    for (int k = 0; k < 3; ++k) {
+        ENSURE_NEAR(above[k] / n, 1.0 - thresholds[k], 0.01);
+    }
+    ENSURE(worst <= 0.02);
+    free(a);
+    free(b);
+}
+
 int main(void)
 {
     RUN(noise_is_deterministic_per_seed);
@@ -491,5 +562,6 @@ int main(void)
     RUN(texture_uniform_seamless_and_the_same_for_any_thread_count);
     RUN(term_age_advances_with_the_frames);
     RUN(same_world_point_same_value_from_two_cameras);
+    RUN(pre_rendered_maps_remap_by_their_texels);
     return ensure_summary();
 }
