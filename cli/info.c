@@ -204,8 +204,8 @@ static void print_frames(const wx_scene *scene, const wx_mesh_data *mesh)
 // at the rate bench_masks measures (about 1.3 million rays a second a thread).
 static void print_masks(const wx_scene *scene, int threads)
 {
-    static const char *const kinds[] = { "accessibility", "exposure", "curvature", "height",
-                                         "combine" };
+    static const char *const kinds[] = { "accessibility", "exposure", "curvature",
+                                         "height",        "combine",  "noise" };
     if (scene->mask_count == 0) {
         return;
     }
@@ -241,6 +241,11 @@ static void print_masks(const wx_scene *scene, int threads)
                 printf(", y over the geometry's bounds%s", md->has_min || md->has_max ? " (one end given)" : "");
             }
             break;
+        case WX_MASK_NOISE:
+            printf(", frequency %g, %d octaves, gain %g, seed %llu, uniform over the area",
+                   (double)md->frequency, md->octaves, (double)md->gain,
+                   (unsigned long long)md->noise_seed);
+            break;
         case WX_MASK_COMBINE:
             printf(", scale %g:", (double)md->scale);
             for (int k = 0; k < md->term_count; ++k) {
@@ -248,6 +253,8 @@ static void print_masks(const wx_scene *scene, int threads)
                 printf(" %s%g x S(", k > 0 ? "+ " : "", (double)t->weight);
                 if (t->kind == WX_TERM_CONSTANT) {
                     printf("%g", (double)t->constant);
+                } else if (t->kind == WX_TERM_AGE) {
+                    printf("%g x age", (double)t->constant);
                 } else {
                     printf("%s", t->kind == WX_TERM_MASK ? scene->masks[t->index].name
                                                           : scene->substances[t->index]);

@@ -40,6 +40,8 @@ const char *vw_world_mask_kind_name(const vw_world *world, int m)
     case WX_MASK_CURVATURE: return "curvature";
     case WX_MASK_HEIGHT: return "height";
     case WX_MASK_COMBINE: return "combine";
+    case WX_MASK_NOISE:
+        return "noise";
     }
     return "mask";
 }

@@ -1,6 +1,6 @@
 // scene_xml_masks.c: <Masks> (docs/design.md section 12): the derived masks
-// (Accessibility, Exposure, Curvature, Height) and their combinations, in
-// document order.
+// (Accessibility, Exposure, Curvature, Height, Noise) and their
+// combinations, in document order.
 #include "io/scene_xml_internal.h"
 
 #include <stddef.h>
@@ -42,6 +42,14 @@ static const attr_spec height_attrs[] = {
     [HT_NAME] = MASK_NAME,
     [HT_MIN] = { "min", T_FLOAT, offsetof(wx_mask_def, min), .range = R_FINITE },
     [HT_MAX] = { "max", T_FLOAT, offsetof(wx_mask_def, max), .range = R_FINITE },
+};
+
+static const attr_spec noise_attrs[] = {
+    MASK_NAME,
+    { "frequency", T_FLOAT, offsetof(wx_mask_def, frequency), .range = R_POSITIVE },
+    { "octaves", T_INT, offsetof(wx_mask_def, octaves), .lo = 1, .hi = WX_NOISE_MAX_OCTAVES },
+    { "gain", T_FLOAT, offsetof(wx_mask_def, gain), .range = R_UNIT },
+    { "seed", T_UINT64, offsetof(wx_mask_def, noise_seed), .range = R_FINITE },
 };
 
 static const attr_spec combine_attrs[] = {
@@ -104,11 +112,11 @@ typedef struct combine_state {
 
 typedef struct term_def {
     char mask[SCENE_REF_MAX], substance[SCENE_REF_MAX];
-    float constant, weight, offset, steepness;
+    float constant, weight, offset, steepness, age;
 } term_def;
 
 // Bits of `present`.
-enum { TM_MASK, TM_SUBSTANCE, TM_CONSTANT, TM_WEIGHT, TM_OFFSET, TM_STEEPNESS };
+enum { TM_MASK, TM_SUBSTANCE, TM_CONSTANT, TM_WEIGHT, TM_OFFSET, TM_STEEPNESS, TM_AGE };
 
 static const attr_spec term_attrs[] = {
     [TM_MASK] = { "mask", T_TEXT, offsetof(term_def, mask), .size = SCENE_REF_MAX },
@@ -118,6 +126,7 @@ static const attr_spec term_attrs[] = {
     [TM_WEIGHT] = { "weight", T_FLOAT, offsetof(term_def, weight), .range = R_FINITE },
     [TM_OFFSET] = { "offset", T_FLOAT, offsetof(term_def, offset), .range = R_FINITE },
     [TM_STEEPNESS] = { "steepness", T_FLOAT, offsetof(term_def, steepness), .range = R_NONNEG },
+    [TM_AGE] = { "age", T_FLOAT, offsetof(term_def, age), .range = R_FINITE },
 };
 
 /// The line of the element called `name` at or after `from` among its
@@ -193,16 +202,16 @@ static wx_result parse_term(parser *p, const xmlNode *node, void *user)
     if (r != WX_OK) {
         return r;
     }
-    static const int sources[] = { TM_MASK, TM_SUBSTANCE, TM_CONSTANT };
+    static const int sources[] = { TM_MASK, TM_SUBSTANCE, TM_CONSTANT, TM_AGE };
     int first = -1;
-    for (int i = 0; i < 3; ++i) {
+    for (int i = 0; i < 4; ++i) {
         if (!(given & (1u << sources[i]))) {
             continue;
         }
         if (first >= 0) {
             return fail(p, node, WX_CAUSE_BAD_SCENE,
-                        "<Term> gives both %s and %s: a term has one source (mask, substance or "
-                        "constant)",
+                        "<Term> gives both %s and %s: a term has one source (mask, substance, "
+                        "constant or age)",
                         term_attrs[first].name, term_attrs[sources[i]].name);
         }
         first = sources[i];
@@ -227,9 +236,13 @@ static wx_result parse_term(parser *p, const xmlNode *node, void *user)
         t.kind = WX_TERM_CONSTANT;
         t.constant = d.constant;
         break;
+    case TM_AGE:
+        t.kind = WX_TERM_AGE; // age="w": w * i / iterations in frame i
+        t.constant = d.age;
+        break;
     default:
         return fail(p, node, WX_CAUSE_MISSING,
-                    "<Term> needs one of mask, substance or constant");
+                    "<Term> needs one of mask, substance, constant or age");
     }
     if (r != WX_OK) {
         return r;
@@ -281,6 +294,18 @@ static wx_result parse_mask(parser *p, const xmlNode *node, wx_mask_kind kind)
         m->scale = 1.0f;
         r = ATTRS(combine_attrs, m, NULL);
         break;
+    case WX_MASK_NOISE:
+        m->frequency = 1.0f;
+        m->octaves = 4;
+        m->gain = 0.5f;
+        m->noise_seed = 1;
+        r = LEAF(noise_attrs, m, NULL);
+        if (r == WX_OK && m->frequency > WX_NOISE_MAX_FREQUENCY) {
+            r = fail(p, node, WX_CAUSE_BAD_VALUE,
+                     "<Noise> frequency=\"%g\" is above %g per world unit", (double)m->frequency,
+                     WX_NOISE_MAX_FREQUENCY);
+        }
+        break;
     }
     if (r != WX_OK || (r = check_mask_name(p, node, m->name)) != WX_OK) {
         return r;
@@ -331,6 +356,12 @@ static wx_result parse_height(parser *p, const xmlNode *node, void *user)
     return parse_mask(p, node, WX_MASK_HEIGHT);
 }
 
+static wx_result parse_noise(parser *p, const xmlNode *node, void *user)
+{
+    (void)user;
+    return parse_mask(p, node, WX_MASK_NOISE);
+}
+
 static wx_result parse_combine(parser *p, const xmlNode *node, void *user)
 {
     (void)user;
@@ -343,6 +374,7 @@ static const child_spec masks_children[] = {
     { "Curvature", parse_curvature, true },
     { "Height", parse_height, true },
     { "Combine", parse_combine, true },
+    { "Noise", parse_noise, true },
 };
 
 /// <Masks>: after <Substances> (read first), since names are shared and terms

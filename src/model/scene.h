@@ -222,12 +222,14 @@ typedef enum wx_mask_kind {
     WX_MASK_CURVATURE,     ///< mean curvature, 1/world unit (convex > 0)
     WX_MASK_HEIGHT,        ///< clamp((y - min) / (max - min), 0, 1)
     WX_MASK_COMBINE,       ///< clamp(scale * sum of terms, 0, 1)
+    WX_MASK_NOISE,         ///< fractal Perlin noise of the world position, uniform by area
 } wx_mask_kind;
 
 typedef enum wx_term_kind {
     WX_TERM_MASK,      ///< a derived mask defined before the Combine
     WX_TERM_SUBSTANCE, ///< a substance, per square metre
     WX_TERM_CONSTANT,
+    WX_TERM_AGE,       ///< constant * i / iterations in the frame after iteration i
 } wx_term_kind;
 
 /// One <Term> of a <Combine>: weight * S(x), S Riihiaho's sigmoid
@@ -235,7 +237,7 @@ typedef enum wx_term_kind {
 typedef struct wx_term {
     wx_term_kind kind;
     int index;       ///< MASK: index into wx_scene.masks (< the Combine's); SUBSTANCE: substance
-    float constant;  ///< CONSTANT: the value x
+    float constant;  ///< CONSTANT: the value x; AGE: w of age="w"
     float weight;    ///< default 1
     float offset;    ///< o, default 0
     float steepness; ///< s >= 0, default 0 (S(x) = x)
@@ -247,6 +249,10 @@ typedef struct wx_term {
 /// Most derived masks a scene takes (with the substances, at most
 /// WX_IMAGE_MAX_CHANNELS - 1 channels in all: `seen` needs one).
 #define WX_MAX_MASKS 24
+
+/// Most octaves a <Noise> takes, and its highest frequency per world unit.
+#define WX_NOISE_MAX_OCTAVES 16
+#define WX_NOISE_MAX_FREQUENCY 1.0e6
 
 /// One derived mask of <Masks> (docs/design.md section 12).
 typedef struct wx_mask_def {
@@ -269,6 +275,13 @@ typedef struct wx_mask_def {
     float scale; ///< default 1
     wx_term terms[WX_MAX_TERMS];
     int term_count;
+    /// Noise (docs/design.md section 15): frequency per world unit (> 0,
+    /// default 1), octaves (1..16, default 4), gain (each octave's amplitude
+    /// over the one before, [0, 1], default 0.5), its own seed (default 1).
+    float frequency;
+    int octaves;
+    float gain;
+    uint64_t noise_seed;
     int line;
 } wx_mask_def;
 
@@ -344,6 +357,12 @@ typedef struct wx_scene {
     /// default range); has_bounds false until then.
     double bounds_min[3], bounds_max[3];
     bool has_bounds;
+    /// An area-weighted sample of the meshes' surfaces once imported (3
+    /// doubles a point, world; wx_noise_sample_meshes): what a Noise mask's
+    /// remap is built from. NULL without meshes or until a run fills it (the
+    /// input cameras' texels are used then); the run owns it.
+    const double *surface_sample;
+    int64_t surface_sample_count;
 
     /// Substances (docs/design.md section 9): without <Substances> the one
     /// substance "dirt" (substances_declared false).

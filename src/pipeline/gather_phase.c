@@ -92,6 +92,7 @@ wx_result wx_gather_frame(const wx_scene *scene, const wx_run_def *opts, const w
         masks = &own;
         r = wx_mask_context_init(scene, in_maps, false, &own, err);
     }
+    masks->frame = frame; // what <Term age> reads
     // Every layer of a camera is gathered as an input camera of its own; the
     // derived masks' collider above reads the layers together.
     wx_layer_scene layered;

@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "model/naming.h"
+#include "sim/noise.h"
 
 bool wx_masks_worth_keeping(const wx_scene *scene)
 {
@@ -27,6 +28,106 @@ int wx_mask_slot_texture(const wx_scene *scene, int t, int f)
         slot += wx_texture_file_count(&scene->textures[k]);
     }
     return slot + f;
+}
+
+// Without the meshes' sample: the input cameras' surface texels (every layer),
+// each weighted by the area of surface it records (its footprint over the
+// cosine between its normal and the camera's axis, the cosine kept above 0.05
+// where the surface is seen edge-on), at most WX_NOISE_SAMPLE_POINTS of them
+// at an even stride. A surface that several cameras record counts once per
+// camera: the remap is then uniform over the recorded area, not the true one.
+static wx_result sample_maps(const wx_scene *scene, const wx_maps *in_maps, double **points,
+                             double **weights, size_t *count, wx_error *err)
+{
+    size_t all = 0;
+    for (int k = 0; k < scene->input_count; ++k) {
+        all += (size_t)in_maps[k].width * (size_t)in_maps[k].height *
+               (size_t)wx_maps_layers(&in_maps[k]);
+    }
+    size_t stride = all / WX_NOISE_SAMPLE_POINTS + 1, cap = all / stride + 1;
+    *points = malloc(3 * cap * sizeof **points);
+    *weights = malloc(cap * sizeof **weights);
+    *count = 0;
+    if (*points == NULL || *weights == NULL) {
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "masks: out of memory (noise sample)");
+    }
+    size_t index = 0;
+    int k = 0;
+    for (int c = 0; c < scene->camera_count; ++c) {
+        if (scene->cameras[c].is_output) {
+            continue;
+        }
+        const wx_camera *cam = &scene->cameras[c].camera;
+        const wx_maps *m = &in_maps[k++];
+        const size_t texels = (size_t)m->width * (size_t)m->height;
+        float frame_w, frame_h, a[3], b[3];
+        wx_camera_frame_size(cam, &frame_w, &frame_h);
+        const double footprint = (double)frame_w / m->width * (double)frame_h / m->height;
+        wx_camera_map_to_world(cam, (const float[3]){ 0.5f, 0.5f, 0.0f }, a);
+        wx_camera_map_to_world(cam, (const float[3]){ 0.5f, 0.5f, 1.0f }, b);
+        double axis[3] = { b[0] - a[0], b[1] - a[1], b[2] - a[2] };
+        double length = sqrt(axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]);
+        for (int l = 0; l < wx_maps_layers(m); ++l) {
+            for (size_t t = 0; t < texels; ++t, ++index) {
+                size_t at = (size_t)l * texels + t;
+                const float *n = &m->normal[3 * at];
+                float d = m->depth[at];
+                if (index % stride != 0 || wx_depth_is_empty(d) ||
+                    (n[0] == 0.0f && n[1] == 0.0f && n[2] == 0.0f) || *count >= cap) {
+                    continue;
+                }
+                float uvd[3] = { 0.0f, 0.0f, d }, p[3];
+                wx_map_texel_center(m->width, m->height, (int)(t % (size_t)m->width),
+                                    (int)(t / (size_t)m->width), &uvd[0], &uvd[1]);
+                wx_camera_map_to_world(cam, uvd, p);
+                double cosine =
+                    length > 0.0 ? fabs(n[0] * axis[0] + n[1] * axis[1] + n[2] * axis[2]) / length
+                                 : 1.0;
+                for (int x = 0; x < 3; ++x) {
+                    (*points)[3 * *count + x] = p[x];
+                }
+                (*weights)[*count] = footprint / fmax(cosine, 0.05);
+                (*count)++;
+            }
+        }
+    }
+    return WX_OK;
+}
+
+// The remap table of every Noise mask of the scene (wx_mask_context's
+// noise_tables): from the meshes' sample when the run made one, else from the
+// input cameras' texels.
+static wx_result noise_tables_init(const wx_scene *scene, const wx_maps *in_maps,
+                                   wx_mask_context *ctx, wx_error *err)
+{
+    bool any = false;
+    for (int m = 0; m < scene->mask_count; ++m) {
+        any = any || scene->masks[m].kind == WX_MASK_NOISE;
+    }
+    if (!any) {
+        return WX_OK;
+    }
+    double *own_points = NULL, *weights = NULL;
+    const double *points = scene->surface_sample;
+    size_t count = (size_t)scene->surface_sample_count;
+    wx_result r = WX_OK;
+    if (points == NULL || count == 0) {
+        r = sample_maps(scene, in_maps, &own_points, &weights, &count, err);
+        points = own_points;
+    }
+    for (int m = 0; r == WX_OK && m < scene->mask_count; ++m) {
+        if (scene->masks[m].kind != WX_MASK_NOISE) {
+            continue;
+        }
+        ctx->noise_tables[m] = malloc(WX_NOISE_TABLE_SIZE * sizeof *ctx->noise_tables[m]);
+        r = ctx->noise_tables[m] == NULL
+                ? wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "masks: out of memory (noise table)")
+                : wx_noise_table_build(&scene->masks[m], points, weights, count,
+                                       ctx->noise_tables[m], err);
+    }
+    free(own_points);
+    free(weights);
+    return r;
 }
 
 wx_result wx_mask_context_init(const wx_scene *scene, const wx_maps *in_maps, bool keep,
@@ -96,6 +197,9 @@ wx_result wx_mask_context_init(const wx_scene *scene, const wx_maps *in_maps, bo
     if (r == WX_OK) {
         r = wx_collider_init(&ctx->collider, cams, maps, n, false, err);
     }
+    if (r == WX_OK) {
+        r = noise_tables_init(scene, in_maps, ctx, err);
+    }
     free(cams);
     free(maps);
     if (r != WX_OK) {
@@ -118,6 +222,9 @@ void wx_mask_context_free(wx_mask_context *ctx)
         free(ctx->known[k]);
     }
     free(ctx->known);
+    for (int m = 0; m < WX_MAX_MASKS; ++m) {
+        free(ctx->noise_tables[m]);
+    }
     memset(ctx, 0, sizeof *ctx);
 }
 
@@ -134,6 +241,10 @@ wx_result wx_masks_at_points(const wx_scene *scene, const wx_run_def *opts, wx_m
                          .height_min = ctx->height_min,
                          .height_max = ctx->height_max,
                          .known = (const float *const *)known,
+                         .noise_tables = (const double *const *)ctx->noise_tables,
+                         .age = ctx->frame > 0 && scene->iterations > 0
+                                    ? (double)ctx->frame / (double)scene->iterations
+                                    : 1.0,
                          .seed = opts->seed,
                          .threads = opts->threads,
                          .quiet = opts->quiet };

@@ -28,6 +28,13 @@ typedef struct wx_mask_context {
     /// (WX_MASK_SLOT_OUTPUT, wx_mask_slot_texture) once computed, else NULL.
     float **known;
     int slots, mask_count;
+    /// Per mask, for each Noise mask: its remap table (sim/noise.h), built
+    /// once from the scene's surface sample (scene->surface_sample) or, without
+    /// one, from the input cameras' surface texels weighted by their area.
+    double *noise_tables[WX_MAX_MASKS];
+    /// The frame being gathered: i after iteration i, 0 for the final mask
+    /// (what <Term age> reads: i / iterations, 1 for the final mask).
+    int frame;
 } wx_mask_context;
 
 /// The targets a context keeps masks for: the output camera, then each file of

@@ -17,6 +17,7 @@
 #include "pipeline/outputs.h"
 #include "pipeline/texture_phase.h"
 #include "sim/emitter.h"
+#include "sim/noise.h"
 
 // ---------------------------------------------------------------------------
 // Particles alive at once (docs/reliability.md, "Particles alive at once")
@@ -232,10 +233,20 @@ void wx_memory_estimate_geometry(const wx_scene *scene, unsigned phases,
     // With layers a TextureMap's gather builds that collider too (the faces it
     // encloses are not seen: wx_masks_unsee_enclosed).
     bool textures = scene->texture_count > 0 && (phases & (WX_PHASE_SIMULATE | WX_PHASE_GATHER));
-    const double collider =
+    double collider =
         scene->mask_count > 0 || (textures && wx_scene_has_layers(scene))
             ? WX_MASK_COLLIDER_BYTES_PER_TEXEL * input_texels + 8.0 * largest_input
             : 0.0;
+    // A Noise mask's remap (sim/noise.h): the area sample kept over the run
+    // (3 doubles a point, and a weight without meshes), the sorted values
+    // while a table is built, and a table per Noise.
+    for (int m = 0, first = 1; m < scene->mask_count; ++m) {
+        if (scene->masks[m].kind == WX_MASK_NOISE) {
+            collider += first * (32.0 + 16.0) * WX_NOISE_SAMPLE_POINTS +
+                        8.0 * WX_NOISE_TABLE_SIZE;
+            first = 0;
+        }
+    }
     bool texture_frames = false;
     for (int t = 0; textures && t < scene->texture_count; ++t) {
         const wx_texture_map *tm = &scene->textures[t];

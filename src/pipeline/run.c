@@ -17,6 +17,7 @@
 #include "pipeline/outputs.h"
 #include "pipeline/simulate_phase.h"
 #include "pipeline/texture_phase.h"
+#include "sim/noise.h"
 
 // Marks the maps of the cameras bake renders as the output folder's own (bake
 // is about to write them there); true when there is any.
@@ -39,6 +40,27 @@ static void free_maps(wx_maps *maps, int count)
         }
         free(maps);
     }
+}
+
+// The meshes' area-weighted sample a Noise mask's remap is built from, lent
+// to the scene (scene->surface_sample) for the run.
+static wx_result sample_surfaces(wx_scene *scene, const wx_geometry *geometry, double **out,
+                                 wx_error *err)
+{
+    const wx_mesh_data **meshes = calloc((size_t)geometry->count + 1, sizeof *meshes);
+    *out = malloc(3 * (size_t)WX_NOISE_SAMPLE_POINTS * sizeof **out);
+    if (meshes == NULL || *out == NULL) {
+        free(meshes);
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (noise sample)");
+    }
+    for (int m = 0; m < geometry->count; ++m) {
+        meshes[m] = &geometry->meshes[m].data;
+    }
+    size_t n = wx_noise_sample_meshes(meshes, geometry->count, WX_NOISE_SAMPLE_POINTS, *out);
+    free(meshes);
+    scene->surface_sample = n > 0 ? *out : NULL;
+    scene->surface_sample_count = (int64_t)n;
+    return WX_OK;
 }
 
 wx_result wx_run_phases(wx_scene *scene, const wx_run_def *opts, unsigned phases,
@@ -69,8 +91,20 @@ wx_result wx_run_phases(wx_scene *scene, const wx_run_def *opts, unsigned phases
         bounds_needed |= md->kind == WX_MASK_HEIGHT && !(md->has_min && md->has_max);
     }
     bounds_needed = bounds_needed && scene->mesh_count > 0 && (phases & WX_PHASE_GATHER);
-    if (r == WX_OK && (bake || textures_needed || bounds_needed)) {
+    // A Noise mask's remap is built from the meshes' surfaces when the scene
+    // has meshes (docs/masks.md): whatever phases run, the same table.
+    bool noise_needed = false;
+    for (int m = 0; m < scene->mask_count; ++m) {
+        noise_needed |= scene->masks[m].kind == WX_MASK_NOISE;
+    }
+    noise_needed =
+        noise_needed && scene->mesh_count > 0 && (phases & (WX_PHASE_SIMULATE | WX_PHASE_GATHER));
+    if (r == WX_OK && (bake || textures_needed || bounds_needed || noise_needed)) {
         r = wx_geometry_load(scene, opts->quiet, &geometry, err);
+    }
+    double *surface_sample = NULL;
+    if (r == WX_OK && noise_needed) {
+        r = sample_surfaces(scene, &geometry, &surface_sample, err);
     }
     // The UDIM tiles the UVs cover name the files a tiles="udim" texture
     // writes: the output checks and the memory estimate below need them.
@@ -195,6 +229,9 @@ wx_result wx_run_phases(wx_scene *scene, const wx_run_def *opts, unsigned phases
         report->times.gather = wx_now_s() - t0;
     }
     wx_mask_context_free(&masks); // before the maps it borrows
+    scene->surface_sample = NULL;
+    scene->surface_sample_count = 0;
+    free(surface_sample);
     free_maps(maps, scene->input_count);
     wx_maps_free(&output_maps);
     wx_textures_free(&textures);

@@ -7,6 +7,7 @@
 
 #include "core/parallel.h"
 #include "core/progress.h"
+#include "sim/noise.h"
 
 #define PI 3.14159265358979323846
 
@@ -377,11 +378,22 @@ static float combine(const job *jb, const wx_mask_def *m, size_t t)
     for (int k = 0; k < m->term_count; ++k) {
         const wx_term *term = &m->terms[k];
         double x = term->kind == WX_TERM_CONSTANT ? term->constant
+                   : term->kind == WX_TERM_AGE    ? term->constant * jb->def->age
                    : term->kind == WX_TERM_MASK   ? jb->out[term->index][t]
                                                   : jb->def->substances[term->index][t];
         sum += term->weight * wx_sigmoid(x, term->offset, term->steepness);
     }
     return (float)fmin(1.0, fmax(0.0, m->scale * sum));
+}
+
+// Noise's value at p: its raw value through the scene's remap table, or,
+// without one, the raw value mapped from [-1, 1] to [0, 1].
+static float noise_value(const job *jb, const wx_mask_def *m, const double p[3])
+{
+    const double *table = jb->def->noise_tables != NULL ? jb->def->noise_tables[jb->mask] : NULL;
+    double raw = wx_noise_raw(m, p);
+    return table != NULL ? wx_noise_remap(table, raw)
+                         : (float)fmin(1.0, fmax(0.0, 0.5 * raw + 0.5));
 }
 
 static void mask_rows(int64_t begin, int64_t end, int worker, void *context)
@@ -416,6 +428,9 @@ static void mask_rows(int64_t begin, int64_t end, int worker, void *context)
                 break;
             case WX_MASK_COMBINE:
                 out[t] = combine(jb, m, t);
+                break;
+            case WX_MASK_NOISE:
+                out[t] = noise_value(jb, m, p);
                 break;
             }
         }
@@ -483,7 +498,7 @@ bool wx_mask_is_geometric(const wx_scene *scene, int m)
     }
     for (int k = 0; k < md->term_count; ++k) {
         const wx_term *term = &md->terms[k];
-        if (term->kind == WX_TERM_SUBSTANCE ||
+        if (term->kind == WX_TERM_SUBSTANCE || term->kind == WX_TERM_AGE ||
             (term->kind == WX_TERM_MASK && !wx_mask_is_geometric(scene, term->index))) {
             return false;
         }

@@ -49,6 +49,13 @@ typedef struct wx_masks_def {
     /// wx_mask_is_geometric says depends on the geometry alone); they are
     /// copied instead of computed.
     const float *const *known;
+    /// Per mask, for each Noise mask: its remap table (WX_NOISE_TABLE_SIZE
+    /// quantiles, sim/noise.h), the same for every target; NULL entries (or
+    /// NULL): the identity of [-1, 1].
+    const double *const *noise_tables;
+    /// What a Combine's <Term age="w"> reads, times w: i / iterations for the
+    /// frame written after iteration i, 1 for the final mask.
+    double age;
     uint64_t seed;
     int threads;
     bool quiet; ///< no progress bar
@@ -60,7 +67,8 @@ wx_result wx_masks_compute(const wx_masks_def *def, float *const *out, wx_error 
 
 /// Whether mask m depends on the geometry alone (every kind but a Combine; a
 /// Combine when none of its terms, through the masks it names, reads a
-/// substance): its values at a set of points are the same in every frame.
+/// substance or the age): its values at a set of points are the same in every
+/// frame.
 bool wx_mask_is_geometric(const wx_scene *scene, int m);
 
 /// Clears seen[t] (width*height of `points`, 1 where a layer of some camera
