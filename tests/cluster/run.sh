@@ -52,10 +52,14 @@ mkdir -p "$tmp/run" "$tmp/munge" "$tmp/state" "$tmp/spool" "$tmp/log"
 chmod 700 "$tmp/munge"
 pids=()
 jobs_submitted=""
+# Each daemon's log file, or what it printed when it could not open one.
 show_logs() {
-    for f in "$tmp"/log/*; do
+    local d f
+    for d in munged slurmctld slurmd; do
+        f=$tmp/log/$d.log
+        [ -s "$f" ] || f=$tmp/log/$d.out
         [ -s "$f" ] || continue
-        echo "---- $f (last 40 lines)"
+        echo "---- $f (last 40 lines; all in $out/daemon-logs/)"
         tail -n 40 "$f"
     done
 }
@@ -169,13 +173,15 @@ ended=$(scontrol -o show job "$tiles_job" | grep -c 'JobState=COMPLETED .*ExitCo
 if [ "$ended" -eq 4 ]; then
     ok "the 4 tasks of the job array completed with exit status 0"
 else
-    scontrol -o show job "$tiles_job" | grep -o 'JobId=[^ ]* .*JobState=[^ ]*\|ExitCode=[^ ]*'
+    scontrol -o show job "$tiles_job" | grep -o 'ArrayTaskId=[^ ]*\|JobState=[^ ]*\|ExitCode=[^ ]*' |
+        paste -d ' ' - - - || true
     bad "$ended of the 4 tasks of the job array completed with exit status 0"
 fi
 if scontrol -o show job "$merge_job" | grep -q 'JobState=COMPLETED .*ExitCode=0:0'; then
     ok "the merge job completed with exit status 0"
 else
-    scontrol -o show job "$merge_job" | grep -o 'JobState=[^ ]*\|Reason=[^ ]*\|ExitCode=[^ ]*'
+    scontrol -o show job "$merge_job" | grep -o 'JobState=[^ ]*\|Reason=[^ ]*\|ExitCode=[^ ]*' |
+        paste -d ' ' - - - || true
     bad "the merge job did not complete"
 fi
 for log in "$out"/tiles/logs/*.log; do
@@ -205,12 +211,13 @@ fi
 
 # No particle counted twice or lost: the tiles' tile_particles add up to the
 # whole run's particles_emitted (rate 40000 x 1 s).
-stat_value() { sed -n "s/^ *\"$2\": *\([0-9]*\),*$/\1/p" "$1" | head -n 1; }
+# "KEY": N of a --stats file; nothing when the file or the key is missing.
+stat_value() { { sed -n "s/^ *\"$2\": *\([0-9]*\),*$/\1/p" "$1" 2>/dev/null || true; } | head -n 1; }
 sum=0
 for ix in 0 1; do
     for iz in 0 1; do
         n=$(stat_value "$out/tiles/tile_${ix}_${iz}.json" tile_particles)
-        echo "     tile_${ix}_${iz}: ${n:-none} particles"
+        echo "     tile_${ix}_${iz}: ${n:-no tile_particles in its stats file} particles"
         sum=$((sum + ${n:-0}))
     done
 done
