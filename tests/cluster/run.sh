@@ -51,7 +51,7 @@ chmod 755 "$tmp"
 mkdir -p "$tmp/run" "$tmp/munge" "$tmp/state" "$tmp/spool" "$tmp/log"
 chmod 700 "$tmp/munge"
 pids=()
-jobs_submitted=""
+jobs_submitted=()
 # Each daemon's log file, or what it printed when it could not open one.
 show_logs() {
     local d f
@@ -66,8 +66,16 @@ show_logs() {
 stop() {
     local status=$?
     set +e
-    if [ -n "$jobs_submitted" ]; then
-        scancel $jobs_submitted 2>/dev/null
+    # Jobs still queued or running are cancelled, and given 20 s to end while
+    # slurmd is there to stop their steps.
+    if [ ${#jobs_submitted[@]} -gt 0 ]; then
+        local ids
+        ids=$(IFS=,; echo "${jobs_submitted[*]}")
+        scancel "${jobs_submitted[@]}" 2>/dev/null
+        for _ in $(seq 40); do
+            [ -n "$(squeue -h -j "$ids" -t PD,CF,R,CG,S -o %i 2>/dev/null)" ] || break
+            sleep 0.5
+        done
     fi
     # Last started, first stopped: slurmd, slurmctld, munged.
     for ((i = ${#pids[@]} - 1; i >= 0; i--)); do
@@ -80,6 +88,21 @@ stop() {
         done
         kill -KILL "$pid" 2>/dev/null
         wait "$pid" 2>/dev/null
+    done
+    # A job step whose slurmd went first waits for it for ever, ignoring
+    # SIGTERM: ours are the slurmstepd processes with a file open in $tmp.
+    local p fd
+    for p in /proc/[0-9]*; do
+        [ "$(cat "$p/comm" 2>/dev/null)" = slurmstepd ] || continue
+        for fd in "$p"/fd/*; do
+            case $(readlink "$fd" 2>/dev/null) in
+            "$tmp"/*)
+                echo "stopping a job step left behind: pid ${p#/proc/}"
+                kill -KILL "${p#/proc/}" 2>/dev/null
+                break
+                ;;
+            esac
+        done
     done
     mkdir -p "$out"
     rm -rf "$out/daemon-logs"
@@ -147,14 +170,17 @@ cp tests/cluster/street.xml tests/cluster/street.obj "$out/"
     die "weathering tiles street.xml --tiles 2 2 --halo 4 --out tiles --slurm"
 (cd "$out" && "$weathering" run street.xml --out whole --stats whole.json -q) ||
     die "weathering run street.xml --out whole --stats whole.json"
-ok "weathering tiles wrote $(ls "$out"/tiles/tile_*.xml | wc -l) tile scenes and the Slurm scripts"
+scenes=("$out"/tiles/tile_*.xml)
+ok "weathering tiles wrote ${#scenes[@]} tile scenes and the Slurm scripts"
 
 submitted=$("$out/tiles/submit.sh") || die "tiles/submit.sh: sbatch refused the jobs"
 echo "$submitted"
 tiles_job=$(echo "$submitted" | sed -n 's/^tiles: job \([0-9]*\); merge: job \([0-9]*\)$/\1/p')
 merge_job=$(echo "$submitted" | sed -n 's/^tiles: job \([0-9]*\); merge: job \([0-9]*\)$/\2/p')
-[ -n "$tiles_job" ] && [ -n "$merge_job" ] || die "submit.sh did not name its two jobs"
-jobs_submitted="$tiles_job $merge_job"
+if [ -z "$tiles_job" ] || [ -z "$merge_job" ]; then
+    die "submit.sh did not name its two jobs"
+fi
+jobs_submitted=("$tiles_job" "$merge_job")
 ok "submit.sh submitted the job array $tiles_job and the merge $merge_job (afterok)"
 
 # No accounting, so no sacct: squeue lists the jobs until they end, and scontrol
@@ -167,7 +193,7 @@ while [ -n "$(squeue -h -t PD,CF,R,CG,S -j "$tiles_job,$merge_job" -o %i 2>/dev/
     }
     sleep 1
 done
-jobs_submitted=""
+jobs_submitted=()
 ok "both jobs ended in $((SECONDS - t)) s"
 ended=$(scontrol -o show job "$tiles_job" | grep -c 'JobState=COMPLETED .*ExitCode=0:0' || true)
 if [ "$ended" -eq 4 ]; then
