@@ -174,7 +174,7 @@ test-blender: $(BUILD)/weathering
 # make test-cluster: `weathering tiles --slurm`'s job array and its merge run
 # on a real one-node Slurm cluster (munged, slurmctld and slurmd started by
 # tests/cluster/run.sh in a temp folder with tests/cluster/slurm.conf, stopped
-# at its end); about 20 s. Installs Debian's Slurm and MUNGE like deps, after
+# at its end); 10 to 15 s. Installs Debian's Slurm and MUNGE like deps, after
 # the build. Outputs and the daemons' logs in $(BUILD)/cluster-test/.
 CLUSTER_DEB_PACKAGES := munge slurmctld slurmd slurm-client
 test-cluster: $(BUILD)/weathering
