@@ -3,6 +3,9 @@
 #   make test     build and run the test suite
 #   make test-blender
 #                 docs/mask.md's Blender recipe, run headless in Blender
+#   make test-cluster
+#                 2 x 2 tiles as a Slurm job array on a one-node Slurm cluster
+#                 started on this machine (docs/cluster.md)
 #   make run      run the shipped default scene into out/building/
 #   make gallery  every preset on every shipped model: docs/images/gallery.png
 #   make previews the other pictures of docs/images, from today's code
@@ -54,7 +57,7 @@ VIEWER_LIB_OBJ := $(filter-out $(BUILD)/obj/viewer/main.o,$(VIEWER_OBJ))
 # `weathering bake` in a child process when a scene's maps are still to bake.
 VIEWER_LIBS := -lglfw -lGL -lOpenEXRCore-3_1 -lxml2 -lpng -lm -lpthread
 
-.PHONY: all deps bench-deps test test-fast test-blender run bench bench-build clean sanitize tsan fuzz valgrind gallery previews
+.PHONY: all deps bench-deps test test-fast test-blender test-cluster run bench bench-build clean sanitize tsan fuzz valgrind gallery previews
 all: $(BUILD)/weathering $(VIEWER_BIN)
 
 # Installs whatever Debian package is missing (apt-get update first), as root or
@@ -167,6 +170,16 @@ BLENDER_DEB_PACKAGES := blender
 test-blender: $(BUILD)/weathering
 	$(call install_missing,$(BLENDER_DEB_PACKAGES))
 	tests/blender/run.sh $(BUILD)
+
+# make test-cluster: `weathering tiles --slurm`'s job array and its merge run
+# on a real one-node Slurm cluster (munged, slurmctld and slurmd started by
+# tests/cluster/run.sh in a temp folder with tests/cluster/slurm.conf, stopped
+# at its end); 10 to 15 s. Installs Debian's Slurm and MUNGE like deps, after
+# the build. Outputs and the daemons' logs in $(BUILD)/cluster-test/.
+CLUSTER_DEB_PACKAGES := munge slurmctld slurmd slurm-client
+test-cluster: $(BUILD)/weathering
+	$(call install_missing,$(CLUSTER_DEB_PACKAGES))
+	tests/cluster/run.sh $(BUILD)
 
 # Like deps, for the packages only the benchmarks need.
 bench-deps:
