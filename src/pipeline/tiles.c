@@ -154,8 +154,10 @@ static wx_result write_slurm(const wx_tiles_def *def, const char *dir, const cha
              "task=${SLURM_ARRAY_TASK_ID:?run this script with sbatch (a job array)}\n"
              "ix=$((task %% %d))\n"
              "iz=$((task / %d))\n"
+             "# As many threads as the task was given cores (sbatch --cpus-per-task), else all.\n"
              "exec '%s' run \"tile_${ix}_${iz}.xml\" --out \"tile_${ix}_${iz}\" "
-             "--stats \"tile_${ix}_${iz}.json\" -q\n",
+             "--stats \"tile_${ix}_${iz}.json\" -q ${SLURM_CPUS_PER_TASK:+--threads "
+             "\"$SLURM_CPUS_PER_TASK\"}\n",
              def->scene_path, name, def->nx * def->nz - 1, dir, def->nx, def->nx, def->program);
     wx_result r = write_text(dir, "tiles.sbatch", text, err);
     if (r == WX_OK) {
