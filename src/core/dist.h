@@ -6,7 +6,7 @@
 // normal build compiles the same functions without MPI as one rank of one
 // (rank 0 of 1: a gather copies, a broadcast returns its argument), so that
 // no other file needs to know which build it is in, and the normal build has
-// no MPI dependency. Only core/dist.c includes <mpi.h> (tests/test_layers.c).
+// no MPI dependency. Only core/dist.c includes the MPI header (tests/test_layers.c).
 //
 // Every collective must be called by every rank, in the same order: the
 // callers (the simulation's step, the run's hand-over after the bake) are
