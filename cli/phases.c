@@ -8,7 +8,6 @@
 
 #include "core/dist.h"
 #include "core/limits.h"
-#include "core/parallel.h"
 #include "core/progress.h"
 #include "io/scene_xml.h"
 #include "io/stats_json.h"
@@ -40,10 +39,6 @@ int cli_load_scene(const cli_args *args, wx_scene *scene, wx_run_def *opts)
     }
     if (args->threads > 0) {
         opts->threads = args->threads;
-    } else if (wx_dist_size() > 1) {
-        // The ranks on one machine share its cores (docs/scale-out.md).
-        int share = wx_cpu_count() / wx_dist_local_size();
-        opts->threads = share > 1 ? share : 1;
     }
     opts->quiet = args->quiet;
     opts->stats_path = args->stats_path;

@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/dist.h"
 #include "core/parallel.h"
 #include "core/progress.h"
 #include "io/exr.h"
@@ -285,7 +286,10 @@ static wx_result create_simulation(const wx_scene *scene, const wx_run_def *opts
 {
     wx_sim_def config = wx_default_sim_def(scene);
     config.seed = opts->seed;
-    config.threads = opts->threads;
+    // The ranks on one machine step at the same time: they share its threads
+    // (rank 0 has them all again for what it does alone: bake, frames, gather).
+    int share = opts->threads / wx_dist_local_size();
+    config.threads = share > 1 ? share : 1;
     config.maps = maps;
     config.distributed = true;
     return wx_sim_create(scene, &config, sim, err);

@@ -12,33 +12,28 @@
 #include "core/dist.h"
 #include "sim/solver_internal.h"
 
-void sim_share(wx_sim *sim)
+// Rank r's share of the particles: whole blocks, in rank order. Whole blocks
+// because the step kernel writes whole blocks (padding lanes too): a share
+// that ended inside a block would overwrite the next rank's first particles.
+static void share_of(const wx_sim *sim, int r, int64_t *begin, int64_t *end)
 {
     int64_t n = sim->particles.count;
-    if (sim->ranks <= 1) {
-        sim->own_begin = 0;
-        sim->own_end = n;
-        return;
-    }
-    // Whole blocks per rank: the step kernel writes whole blocks (padding
-    // lanes too), so a share that ended inside a block would overwrite the
-    // next rank's first particles.
     int64_t blocks = (n + WX_PARTICLE_BLOCK - 1) / WX_PARTICLE_BLOCK;
     int64_t per = (blocks + sim->ranks - 1) / sim->ranks * WX_PARTICLE_BLOCK;
-    int64_t rank = wx_dist_rank();
-    sim->own_begin = rank * per < n ? rank * per : n;
-    sim->own_end = (rank + 1) * per < n ? (rank + 1) * per : n;
+    *begin = r * per < n ? r * per : n;
+    *end = (r + 1) * per < n ? (r + 1) * per : n;
 }
 
-// Rank r's share of the particles, as sim_share computes it there.
-static int64_t share_of(const wx_sim *sim, int r)
+static int64_t share_size(const wx_sim *sim, int r)
 {
-    int64_t n = sim->particles.count;
-    int64_t blocks = (n + WX_PARTICLE_BLOCK - 1) / WX_PARTICLE_BLOCK;
-    int64_t per = (blocks + sim->ranks - 1) / sim->ranks * WX_PARTICLE_BLOCK;
-    int64_t begin = r * per < n ? r * per : n;
-    int64_t end = (r + 1) * per < n ? (r + 1) * per : n;
+    int64_t begin, end;
+    share_of(sim, r, &begin, &end);
     return end - begin;
+}
+
+void sim_share(wx_sim *sim)
+{
+    share_of(sim, sim->ranks > 1 ? wx_dist_rank() : 0, &sim->own_begin, &sim->own_end);
 }
 
 enum { AGREE = 6 }; // sim_agree's numbers per rank (rank_counts holds 6 per rank)
@@ -89,8 +84,9 @@ static int64_t part_words(int64_t particles, int64_t events, int64_t deaths)
 static void moved_arrays(wx_particles *P, uint32_t *moved[MOVED])
 {
     _Static_assert(sizeof *P->x == 4 && sizeof *P->last_slide == 4, "4-byte particle fields");
-    void *arrays[MOVED] = { P->x,  P->y,  P->z,  P->vx, P->vy, P->vz, P->collisions_left,
-                            P->last_slide };
+    void *arrays[MOVED] = {
+        P->x, P->y, P->z, P->vx, P->vy, P->vz, P->collisions_left, P->last_slide
+    };
     for (int k = 0; k < MOVED; ++k) {
         moved[k] = arrays[k];
     }
@@ -117,7 +113,7 @@ wx_result sim_exchange(wx_sim *sim, wx_error *err)
     bool failed = false;
     for (int r = 0; r < R; ++r) {
         const int64_t *g = &gathered[r * COUNTS];
-        words_of[r] = part_words(share_of(sim, r), g[EVENTS], g[DEATHS]);
+        words_of[r] = part_words(share_size(sim, r), g[EVENTS], g[DEATHS]);
         offset = r == me ? words : offset;
         events += g[EVENTS];
         deaths += g[DEATHS];
@@ -130,8 +126,8 @@ wx_result sim_exchange(wx_sim *sim, wx_error *err)
     sim_chunk *all = &sim->all;
     if (!wx_array_reserve((void **)&all->events, &all->event_capacity, events + 1,
                           sizeof *all->events, 4096) ||
-        !wx_array_reserve((void **)&all->dead, &all->dead_capacity, deaths + 1,
-                          sizeof *all->dead, 1024) ||
+        !wx_array_reserve((void **)&all->dead, &all->dead_capacity, deaths + 1, sizeof *all->dead,
+                          1024) ||
         !wx_array_reserve((void **)&sim->exchange, &sim->exchange_capacity, words + 1,
                           sizeof *sim->exchange, 4096)) {
         // The others are already on their way to the gather below: this rank
@@ -175,7 +171,7 @@ wx_result sim_exchange(wx_sim *sim, wx_error *err)
     int64_t begin = 0, at = 0;
     for (int q = 0; q < R; ++q) {
         const int64_t *g = &gathered[q * COUNTS];
-        int64_t n = share_of(sim, q);
+        int64_t n = share_size(sim, q);
         const unsigned char *from = (const unsigned char *)(sim->exchange + at);
         for (int k = 0; k < MOVED && q != me; ++k) {
             memcpy(moved[k] + begin, from + (size_t)k * (size_t)n * 4, (size_t)n * 4);
