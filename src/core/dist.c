@@ -10,11 +10,37 @@
 #ifdef WX_MPI
 
 #include <mpi.h>
+#include <time.h>
 
 static bool started;    // MPI_Init ran here (and MPI_Finalize is still to run)
 static int rank_of = 0; // this process's rank
 static int size_of = 1; // ranks in MPI_COMM_WORLD
 static int local_of = 1;
+
+// Waits for a non-blocking operation without holding a core. Open MPI's
+// blocking calls spin: a rank waiting while rank 0 bakes, writes a frame or
+// gathers (seconds) would take a core from it, and on a machine shared with
+// other work every spinning rank slows the one that is behind. So: a short
+// spin (a step's exchange between ranks that are level ends there), then
+// sleeps growing to a millisecond, testing (which also moves the operation
+// on) between them.
+static void wait_for(MPI_Request *request)
+{
+    long pause_ns = 0;
+    for (int spins = 0;; ++spins) {
+        int done = 0;
+        MPI_Test(request, &done, MPI_STATUS_IGNORE);
+        if (done) {
+            return;
+        }
+        if (spins < 2000) {
+            continue;
+        }
+        pause_ns = pause_ns == 0 ? 20000 : pause_ns >= 500000 ? 1000000 : 2 * pause_ns;
+        struct timespec pause = { 0, pause_ns };
+        nanosleep(&pause, NULL);
+    }
+}
 
 bool wx_dist_init(int *argc, char ***argv)
 {
@@ -40,6 +66,13 @@ void wx_dist_finalize(void)
 {
     if (started) {
         started = false;
+        // MPI_Finalize waits for every rank, spinning: the other ranks, done
+        // with their share, wait here asleep while rank 0 gathers and writes.
+        if (size_of > 1) {
+            MPI_Request request;
+            MPI_Ibarrier(MPI_COMM_WORLD, &request);
+            wait_for(&request);
+        }
         MPI_Finalize();
     }
 }
@@ -70,7 +103,9 @@ int wx_dist_local_size(void)
 int wx_dist_broadcast_int(int value)
 {
     if (size_of > 1) {
-        MPI_Bcast(&value, 1, MPI_INT, 0, MPI_COMM_WORLD);
+        MPI_Request request;
+        MPI_Ibcast(&value, 1, MPI_INT, 0, MPI_COMM_WORLD, &request);
+        wait_for(&request);
     }
     return value;
 }
@@ -78,7 +113,10 @@ int wx_dist_broadcast_int(int value)
 void wx_dist_allgather_i64(const int64_t *mine, int count, int64_t *all)
 {
     if (size_of > 1) {
-        MPI_Allgather(mine, count, MPI_INT64_T, all, count, MPI_INT64_T, MPI_COMM_WORLD);
+        MPI_Request request;
+        MPI_Iallgather(mine, count, MPI_INT64_T, all, count, MPI_INT64_T, MPI_COMM_WORLD,
+                       &request);
+        wait_for(&request);
     } else {
         memmove(all, mine, (size_t)count * sizeof *all);
     }
@@ -114,8 +152,10 @@ wx_result wx_dist_allgatherv(const void *mine, void *all, const int64_t *counts,
     MPI_Datatype item;
     MPI_Type_contiguous((int)size, MPI_BYTE, &item);
     MPI_Type_commit(&item);
-    MPI_Allgatherv(mine != NULL ? mine : MPI_IN_PLACE, n[rank_of], item, all, n, offset, item,
-                   MPI_COMM_WORLD);
+    MPI_Request request;
+    MPI_Iallgatherv(mine != NULL ? mine : MPI_IN_PLACE, n[rank_of], item, all, n, offset, item,
+                    MPI_COMM_WORLD, &request);
+    wait_for(&request);
     MPI_Type_free(&item);
     free(n);
     return WX_OK;
