@@ -114,8 +114,7 @@ void wx_dist_allgather_i64(const int64_t *mine, int count, int64_t *all)
 {
     if (size_of > 1) {
         MPI_Request request;
-        MPI_Iallgather(mine, count, MPI_INT64_T, all, count, MPI_INT64_T, MPI_COMM_WORLD,
-                       &request);
+        MPI_Iallgather(mine, count, MPI_INT64_T, all, count, MPI_INT64_T, MPI_COMM_WORLD, &request);
         wait_for(&request);
     } else {
         memmove(all, mine, (size_t)count * sizeof *all);
