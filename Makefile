@@ -12,6 +12,8 @@
 #   make bench    benchmarks (speed and memory targets)
 #   make sanitize, make tsan, make valgrind, make fuzz
 #                 the reliability checks CI runs (docs/reliability.md)
+#   make mpi      build-mpi/weathering, built with Open MPI (docs/scale-out.md)
+#   make test-mpi the MPI program's outputs for 1 to 4 ranks against the normal one's
 # BUILD=dir puts every build product in another folder.
 
 BUILD ?= build
@@ -57,7 +59,8 @@ VIEWER_LIB_OBJ := $(filter-out $(BUILD)/obj/viewer/main.o,$(VIEWER_OBJ))
 # `weathering bake` in a child process when a scene's maps are still to bake.
 VIEWER_LIBS := -lglfw -lGL -lOpenEXRCore-3_1 -lxml2 -lpng -lm -lpthread
 
-.PHONY: all deps bench-deps test test-fast test-blender test-cluster run bench bench-build clean sanitize tsan fuzz valgrind gallery previews
+.PHONY: all deps bench-deps test test-fast test-blender test-cluster run bench bench-build clean sanitize tsan fuzz valgrind gallery previews \
+    mpi mpi-deps test-mpi
 all: $(BUILD)/weathering $(VIEWER_BIN)
 
 # Installs whatever Debian package is missing (apt-get update first), as root or
@@ -221,6 +224,33 @@ run: $(BUILD)/weathering
 
 clean:
 	rm -rf $(BUILD)
+
+# --- MPI (docs/scale-out.md) -------------------------------------------------
+# make mpi: the program built with Open MPI as $(MPI_BUILD)/weathering, for
+# `mpirun -np N $(MPI_BUILD)/weathering run SCENE.xml`: the normal build's
+# objects with core/dist.c compiled with -DWX_MPI (the only file that uses MPI),
+# linked by Open MPI's mpicc. Installs Debian's Open MPI like deps.
+MPI_BUILD ?= $(BUILD)-mpi
+MPI_DEB_PACKAGES := libopenmpi-dev openmpi-bin
+MPICC ?= mpicc
+mpi-deps: | deps
+	$(call install_missing,$(MPI_DEB_PACKAGES))
+
+mpi: $(MPI_BUILD)/weathering
+
+$(MPI_BUILD)/obj/core/dist.o: src/core/dist.c src/core/dist.h | deps mpi-deps
+	@mkdir -p $(dir $@)
+	$(MPICC) $(filter-out -MMD -MP,$(ALL_CFLAGS)) -DWX_MPI -c $< -o $@
+
+$(MPI_BUILD)/weathering: $(CLI_OBJ) $(filter-out $(BUILD)/obj/core/dist.o,$(LIB_OBJ)) \
+    $(MPI_BUILD)/obj/core/dist.o
+	$(MPICC) $(filter-out -MMD -MP,$(ALL_CFLAGS)) -o $@ $^ $(LIBS)
+
+# make test-mpi: tests/mpi/run.sh: small scenes run by the normal program and
+# by mpirun -np 1, 2, 3 and 4 (more ranks than cores: --oversubscribe); every
+# output file's SHA-256 must be the same. About 30 s on two cores.
+test-mpi: $(BUILD)/weathering $(MPI_BUILD)/weathering
+	tests/mpi/run.sh $(BUILD) $(MPI_BUILD)
 
 # --- Reliability (docs/reliability.md) ---------------------------------------
 # make sanitize: the whole suite built with AddressSanitizer and UBSan in its own

@@ -21,6 +21,7 @@
 #include <unistd.h>
 
 #include "core/atomic_file.h"
+#include "core/dist.h"
 #include "core/limits.h"
 #include "core/usage.h"
 #include "pipeline/preset.h"
@@ -261,14 +262,9 @@ static void install_interrupt_handlers(void)
     }
 }
 
-int main(int argc, char **argv)
+static int dispatch(const cli_args *orig)
 {
-    install_interrupt_handlers();
-    cli_args args;
-    int status = parse_args(argc, argv, &args);
-    if (status >= 0) {
-        return status;
-    }
+    const cli_args args = *orig;
     for (int i = 0; i < COMMAND_COUNT; ++i) {
         if (strcmp(args.command, commands[i].name) == 0) {
             if (args.scene_path == NULL) {
@@ -296,4 +292,50 @@ int main(int argc, char **argv)
         }
     }
     return usage_error("unknown command '%s'", args.command);
+}
+
+// --- ranks (MPI) ------------------------------------------------------------------
+
+// A rank other than 0 of an MPI run (docs/scale-out.md): silent; it waits for
+// rank 0 to check the scene and bake, then joins the simulation of `run` or
+// `simulate` (cli_run_phases) or, when rank 0 runs none, ends. Rank 0 reports.
+static int follow(cli_args *args)
+{
+    if (freopen("/dev/null", "w", stdout) == NULL) {
+        return WX_FAIL;
+    }
+    args->quiet = true;
+    if (wx_dist_wait() != WX_DIST_JOIN) {
+        return 0;
+    }
+    int status = dispatch(args);
+    // This rank failed in the simulation (its message on stderr): none may
+    // wait for it.
+    return status != 0 ? wx_dist_abort(status) : 0;
+}
+
+int main(int argc, char **argv)
+{
+    install_interrupt_handlers();
+    if (!wx_dist_init(&argc, &argv)) {
+        fprintf(stderr, "weathering: MPI could not start\n");
+        return WX_FAIL;
+    }
+    cli_args args;
+    int status = parse_args(argc, argv, &args); // every rank alike
+    if (status < 0 && wx_dist_rank() > 0) {
+        status = follow(&args);
+    } else if (status < 0) {
+        status = dispatch(&args);
+        // The other ranks wait for rank 0 at most once: released here when the
+        // command did not start a simulation.
+        if (wx_dist_released() != WX_DIST_JOIN) {
+            wx_dist_release(status);
+        }
+    }
+    if (status != 0 && wx_dist_released() == WX_DIST_JOIN) {
+        wx_dist_abort(status); // rank 0 failed in the simulation: none may wait for it
+    }
+    wx_dist_finalize();
+    return status;
 }

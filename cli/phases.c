@@ -6,6 +6,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "core/dist.h"
 #include "core/limits.h"
 #include "core/progress.h"
 #include "io/scene_xml.h"
@@ -14,6 +15,7 @@
 #include "pipeline/outputs.h"
 #include "pipeline/pipeline.h"
 #include "pipeline/run.h"
+#include "pipeline/simulate_phase.h"
 
 // Loads the scene and fills the run options from it and the command line.
 int cli_load_scene(const cli_args *args, wx_scene *scene, wx_run_def *opts)
@@ -117,8 +119,15 @@ int cli_run_phases(const cli_args *args, unsigned phases)
     if (status != WX_OK) {
         return status;
     }
-    run.times.load = wx_now_s() - start;
     wx_error err;
+    if (wx_dist_rank() > 0) {
+        // Another rank of an MPI run, released by rank 0 (main.c): its share
+        // of the simulation, no output.
+        wx_result r = wx_simulate_follow(&scene, &opts, &err);
+        wx_scene_free(&scene);
+        return cli_report(r, &err);
+    }
+    run.times.load = wx_now_s() - start;
     wx_result r = WX_OK;
     if ((phases & WX_PHASE_GATHER) && scene.output_index < 0 && scene.texture_count == 0) {
         r = wx_fail(&err, WX_CAUSE_MISSING,

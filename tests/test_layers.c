@@ -8,7 +8,8 @@
 // library is included by the few files of one concept only: libxml2 by the scene
 // loader (scene_xml.c and its table engine's header, which the element groups
 // include), Assimp by the mesh importer, OpenEXR by the EXR files of io/, OSMesa
-// and GL by the bake's GL side, libpng by io/png_preview.c. A folder's private
+// and GL by the bake's GL side, libpng by io/png_preview.c, MPI by core/dist.c
+// (the ranks of `make mpi`'s program; docs/scale-out.md). A folder's private
 // header (NAME_internal.h) is included by the files of that folder only.
 #include <dirent.h>
 #include <stdbool.h>
@@ -165,6 +166,10 @@ static int check_library(const char *rel, const char *text, const char *header, 
 // one that reads the document and in the table engine's header.
 static const char *const libxml_owners = "io/scene_xml.c io/scene_xml_table.h";
 
+// MPI (issue 29): one file, whose functions the normal build compiles as one
+// rank of one, so that nothing else depends on which build it is.
+static const char *const mpi_owner = "core/dist.c";
+
 // The command line (cli/, issue 27) stands on the pipeline: it may include
 // core, model and pipeline headers, and of io only the scene loader and the
 // statistics writer; the maps, meshes and EXR files it reaches through the
@@ -199,7 +204,8 @@ static int check_cli_file(const char *rel, const char *name, const char *text, c
     (void)name;
     (void)ctx;
     return check_cli_includes(rel, text) + check_library(rel, text, "<libxml/", libxml_owners) +
-           check_library(rel, text, "<openexr.h>", "io/exr.c");
+           check_library(rel, text, "<openexr.h>", "io/exr.c") +
+           check_library(rel, text, "<mpi.h>", mpi_owner);
 }
 
 TEST(the_command_line_stands_on_the_pipeline)
@@ -232,6 +238,7 @@ static int check_layer_file(const char *rel, const char *name, const char *text,
     bad += check_library(rel, text, "<openexr.h>", "io/exr.c io/exr_write.c io/exr_internal.h");
     bad += check_library(rel, text, "<GL/", "raster/baker_internal.h");
     bad += check_library(rel, text, "<png.h>", "io/png_preview.c");
+    bad += check_library(rel, text, "<mpi.h>", mpi_owner);
     return bad;
 }
 
@@ -263,6 +270,9 @@ TEST(a_wrong_include_is_caught)
     ENSURE(check_library("raster/bake.c", gl, "<GL/", "raster/bake.c raster/bake_gl.c") == 0);
     ENSURE(check_library("raster/bake.cc", gl, "<GL/", "raster/bake.c raster/bake_gl.c") == 1);
     ENSURE(check_library("sim/bake.c", gl, "<GL/", "raster/bake.c") == 1);
+    const char *mpi = "#include <mpi.h>\n";
+    ENSURE(check_library("sim/exchange.c", mpi, "<mpi.h>", mpi_owner) == 1);
+    ENSURE(check_library("core/dist.c", mpi, "<mpi.h>", mpi_owner) == 0);
 }
 
 // --- private headers ------------------------------------------------------------
@@ -374,6 +384,7 @@ static int check_viewer_file(const char *name, const char *text)
     bad += check_library(rel, text, "<assimp/", "io/mesh_import.c");
     bad += check_library(rel, text, "<openexr.h>", "io/exr.c");
     bad += check_library(rel, text, "<png.h>", "io/png_preview.c");
+    bad += check_library(rel, text, "<mpi.h>", mpi_owner);
     for (size_t k = 0; k < sizeof viewer_gl_free / sizeof viewer_gl_free[0]; ++k) {
         if (strncmp(name, viewer_gl_free[k], strlen(viewer_gl_free[k])) != 0) {
             continue;

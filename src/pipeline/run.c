@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/dist.h"
 #include "core/progress.h"
 #include "model/geometry.h"
 #include "pipeline/bake_phase.h"
@@ -158,6 +159,11 @@ wx_result wx_run_phases(wx_scene *scene, const wx_run_def *opts, unsigned phases
         report->times.bake = wx_now_s() - t0;
     }
     wx_geometry_free(&geometry);
+    if (r == WX_OK && (phases & WX_PHASE_SIMULATE)) {
+        // An MPI run's other ranks join the simulation now that the maps are
+        // baked (wx_simulate_follow; nothing with one process).
+        wx_dist_release(WX_DIST_JOIN);
+    }
     if (r == WX_OK && (phases & WX_PHASE_SIMULATE)) {
         double t0 = wx_now_s();
         maps = calloc((size_t)scene->input_count + 1, sizeof *maps);

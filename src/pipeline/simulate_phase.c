@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/dist.h"
 #include "core/parallel.h"
 #include "core/progress.h"
 #include "io/exr.h"
@@ -278,6 +279,28 @@ wx_result wx_write_dirt_maps(const wx_scene *scene, const wx_run_def *opts, cons
     return r;
 }
 
+// The run's simulation on `maps`, spread over the ranks of an MPI run (all of
+// them create it alike: wx_simulate_follow).
+static wx_result create_simulation(const wx_scene *scene, const wx_run_def *opts,
+                                   const wx_maps *maps, wx_sim **sim, wx_error *err)
+{
+    wx_sim_def config = wx_default_sim_def(scene);
+    config.seed = opts->seed;
+    // The ranks on one machine step at the same time: they share its threads
+    // (rank 0 has them all again for what it does alone: bake, frames, gather).
+    int share = opts->threads / wx_dist_local_size();
+    config.threads = share > 1 ? share : 1;
+    config.maps = maps;
+    config.distributed = true;
+    return wx_sim_create(scene, &config, sim, err);
+}
+
+static int64_t total_steps(const wx_scene *scene)
+{
+    int64_t iterations = scene->iterations > 1 ? scene->iterations : 1;
+    return scene->steps * iterations;
+}
+
 wx_result wx_simulate_maps(const wx_scene *scene, const wx_run_def *opts, wx_maps *maps,
                            const wx_maps *out_maps, const wx_textures *textures,
                            wx_mask_context *masks, wx_sim_stats *stats, wx_phase_detail *detail,
@@ -286,12 +309,8 @@ wx_result wx_simulate_maps(const wx_scene *scene, const wx_run_def *opts, wx_map
     wx_phase_detail local;
     detail = detail != NULL ? detail : &local;
     double t0 = wx_now_s();
-    wx_sim_def config = wx_default_sim_def(scene);
-    config.seed = opts->seed;
-    config.threads = opts->threads;
-    config.maps = maps;
     wx_sim *sim = NULL;
-    wx_result r = wx_sim_create(scene, &config, &sim, err);
+    wx_result r = create_simulation(scene, opts, maps, &sim, err);
     double t1 = wx_now_s();
     detail->setup = t1 - t0;
     if (r != WX_OK) {
@@ -313,8 +332,7 @@ wx_result wx_simulate_maps(const wx_scene *scene, const wx_run_def *opts, wx_map
         out_maps = &read_out;
     }
     double frames_s = 0.0;
-    int64_t iterations = scene->iterations > 1 ? scene->iterations : 1;
-    int64_t total = scene->steps * iterations;
+    int64_t total = total_steps(scene);
     wx_progress progress;
     wx_progress_begin(&progress, "simulate", total, opts->quiet);
     for (int64_t s = 0; s < total && r == WX_OK; ++s) {
@@ -375,6 +393,34 @@ wx_result wx_simulate_scene(const wx_scene *scene, const wx_run_def *opts,
     if (r == WX_OK) {
         r = wx_simulate_maps(scene, opts, maps, NULL, NULL, NULL, stats, NULL, err);
     }
+    for (int c = 0; c < scene->input_count; ++c) {
+        wx_maps_free(&maps[c]);
+    }
+    free(maps);
+    return r;
+}
+
+wx_result wx_simulate_follow(wx_scene *scene, const wx_run_def *opts, wx_error *err)
+{
+    wx_maps *maps = calloc((size_t)scene->input_count + 1, sizeof *maps);
+    if (maps == NULL) {
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (maps)");
+    }
+    // Rank 0 has baked what the scene does not give into the output folder
+    // (or an earlier `bake` had): the maps its own simulation reads.
+    wx_result r = wx_use_baked_maps(scene, opts, err);
+    if (r == WX_OK) {
+        r = wx_load_simulation_maps(scene, opts->threads, maps, err);
+    }
+    wx_sim *sim = NULL;
+    if (r == WX_OK) {
+        r = create_simulation(scene, opts, maps, &sim, err);
+    }
+    int64_t total = total_steps(scene);
+    for (int64_t s = 0; s < total && r == WX_OK; ++s) {
+        r = wx_sim_step(sim, err);
+    }
+    wx_sim_destroy(sim);
     for (int c = 0; c < scene->input_count; ++c) {
         wx_maps_free(&maps[c]);
     }

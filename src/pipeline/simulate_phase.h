@@ -52,4 +52,11 @@ wx_result wx_simulate_maps(const wx_scene *scene, const wx_run_def *opts, wx_map
 wx_result wx_simulate_scene(const wx_scene *scene, const wx_run_def *opts,
                             wx_sim_stats *stats, wx_error *err);
 
+/// The simulation of a rank other than 0 in an MPI run (docs/scale-out.md),
+/// once rank 0 has released it (core/dist.h): reads the maps rank 0's run
+/// reads (the scene's, and those it baked into opts->out_dir), creates the same
+/// simulation and steps it with rank 0's, each rank its share of the particles.
+/// Writes nothing: rank 0 writes the outputs.
+wx_result wx_simulate_follow(wx_scene *scene, const wx_run_def *opts, wx_error *err);
+
 #endif

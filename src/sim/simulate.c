@@ -19,6 +19,11 @@
 //  3. dead particles are removed, highest index first (swap with the last);
 //  4. emitters emit up to the new time.
 //
+// With several ranks (MPI, docs/scale-out.md) each rank steps only its share
+// of the particles in phase 1, and phase 2 waits for the exchange (exchange.c)
+// that gives every rank every rank's moved particles, events and deaths: every
+// rank then applies them all, in the same particle order.
+//
 // The step kernel (phase 1) is in step.c, the ageing rules in ageing.c; this
 // file runs the pool, applies the events in order, emits, and creates the
 // solver.
@@ -31,6 +36,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/dist.h"
 #include "sim/solver_internal.h"
 
 enum {
@@ -119,14 +125,14 @@ static void step_chunks(int64_t begin, int64_t end, int worker, void *context)
 {
     wx_sim *sim = context;
     sim_worker *w = &sim->workers[worker];
-    int64_t n = sim->particles.count;
+    int64_t n = sim->own_end; // this rank's share: all of them with one rank
     for (int64_t c = begin; c < end; ++c) {
-        int64_t first = c * sim->chunk_particles;
+        int64_t first = sim->own_begin + c * sim->chunk_particles;
         int64_t last = n - first < sim->chunk_particles ? n : first + sim->chunk_particles;
         w->chunk = &sim->chunks[c];
         sim_step_range(sim, w, first, last);
         atomic_store_explicit(&sim->chunks[c].done, 1, memory_order_release);
-        if (worker == 0) {
+        if (worker == 0 && sim->ranks == 1) {
             apply_ready(sim, false);
         }
     }
@@ -141,15 +147,17 @@ static wx_result prepare_chunks(wx_sim *sim, wx_error *err)
     // least CHUNKS_PER_THREAD a thread, so that no thread waits for one long
     // chunk: whole blocks, at most the configured size. Results do not depend
     // on the chunk size (the events are applied in particle order).
+    sim_share(sim);
+    int64_t particles = sim->own_end - sim->own_begin;
     int64_t size = sim->chunk_limit;
     if (sim->thread_count > 1) {
         int64_t parts = (int64_t)sim->thread_count * CHUNKS_PER_THREAD;
-        int64_t share = (sim->particles.count + parts - 1) / parts;
+        int64_t share = (particles + parts - 1) / parts;
         share = (share + WX_PARTICLE_BLOCK - 1) / WX_PARTICLE_BLOCK * WX_PARTICLE_BLOCK;
         size = share < WX_PARTICLE_BLOCK ? WX_PARTICLE_BLOCK : share < size ? share : size;
     }
     sim->chunk_particles = size;
-    int64_t count = (sim->particles.count + sim->chunk_particles - 1) / sim->chunk_particles;
+    int64_t count = (particles + sim->chunk_particles - 1) / sim->chunk_particles;
     if (count > sim->chunk_capacity) {
         int64_t capacity = count + count / 2;
         sim_chunk *bigger = realloc(sim->chunks, (size_t)capacity * sizeof *bigger);
@@ -177,12 +185,15 @@ static wx_result prepare_chunks(wx_sim *sim, wx_error *err)
     return WX_OK;
 }
 
-// Steps every particle and applies every event (phases 1 and 2): the pool's
-// workers claim chunks in turn, the calling thread applies them in order.
+// Steps this rank's particles and, with one rank, applies every event (phases
+// 1 and 2): the pool's workers claim chunks in turn, the calling thread applies
+// them in order.
 static void run_workers(wx_sim *sim)
 {
     wx_pool_for(sim->pool, sim->chunk_count, 1, step_chunks, sim);
-    apply_ready(sim, true);
+    if (sim->ranks == 1) {
+        apply_ready(sim, true);
+    }
 }
 
 // --- the serial phases -----------------------------------------------------------
@@ -207,10 +218,11 @@ static void reorder_cameras(wx_sim *sim)
     }
 }
 
-static void remove_dead(wx_sim *sim)
+// The deaths of the step's records `chunks[0, count)` (in particle order).
+static void remove_dead(wx_sim *sim, const sim_chunk *chunks, int64_t count)
 {
-    for (int64_t c = 0; c < sim->chunk_count; ++c) {
-        const sim_chunk *ch = &sim->chunks[c];
+    for (int64_t c = 0; c < count; ++c) {
+        const sim_chunk *ch = &chunks[c];
         for (int64_t k = 0; k < ch->dead_count; ++k) {
             if (ch->dead[k] & 1) {
                 int64_t i = ch->dead[k] >> 1;
@@ -231,8 +243,8 @@ static void remove_dead(wx_sim *sim)
         }
     }
     // Highest index first, so the particle moved into a hole is always alive.
-    for (int64_t c = sim->chunk_count - 1; c >= 0; --c) {
-        const sim_chunk *ch = &sim->chunks[c];
+    for (int64_t c = count - 1; c >= 0; --c) {
+        const sim_chunk *ch = &chunks[c];
         for (int64_t k = ch->dead_count - 1; k >= 0; --k) {
             wx_particles_remove(&sim->particles, ch->dead[k] >> 1);
         }
@@ -316,18 +328,36 @@ wx_result wx_sim_step(wx_sim *sim, wx_error *err)
 {
     int64_t n = sim->particles.count;
     if (n > 0) {
+        // Every rank takes this branch and the same calls below (collectives).
         wx_result r = prepare_chunks(sim, err);
-        if (r != WX_OK) {
+        if (r != WX_OK && sim->ranks == 1) {
             return r;
         }
-        run_workers(sim);
+        if (r != WX_OK) { // told to the other ranks by the exchange
+            sim->chunk_count = 0;
+            sim->workers[0].failed = true;
+        } else {
+            run_workers(sim);
+        }
+        if (sim->ranks > 1) {
+            // Every rank's records, then all of them applied here in order.
+            r = sim_exchange(sim, err);
+            if (r != WX_OK) {
+                return r;
+            }
+            apply_chunk(sim, &sim->all);
+        }
         for (int t = 0; t < sim->thread_count; ++t) {
             if (sim->workers[t].failed) {
                 return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (collision events)");
             }
         }
         sim->stats.particle_steps += n;
-        remove_dead(sim);
+        if (sim->ranks > 1) {
+            remove_dead(sim, &sim->all, 1);
+        } else {
+            remove_dead(sim, sim->chunks, sim->chunk_count);
+        }
         reorder_cameras(sim);
     }
     sim->step++;
@@ -407,6 +437,7 @@ wx_result wx_sim_create(const wx_scene *scene, const wx_sim_def *config, wx_sim 
     int64_t chunk = config->chunk_particles > 0 ? config->chunk_particles : DEFAULT_CHUNK;
     sim->chunk_limit = (chunk + WX_PARTICLE_BLOCK - 1) / WX_PARTICLE_BLOCK * WX_PARTICLE_BLOCK;
     sim->chunk_particles = sim->chunk_limit;
+    sim->ranks = config->distributed ? wx_dist_size() : 1;
 
     wx_result r = WX_OK;
     if (!(sim->dt > 0.0) || !isfinite(sim->dt)) {
@@ -414,6 +445,12 @@ wx_result wx_sim_create(const wx_scene *scene, const wx_sim_def *config, wx_sim 
     } else if (scene->emitter_count >= PSEUDO_EMITTER) {
         r = wx_fail(err, WX_CAUSE_TOO_MANY, "%s: too many emitters (%d)", scene->path,
                          scene->emitter_count);
+    }
+    if (sim->ranks > 1) {
+        sim->rank_counts = calloc((size_t)sim->ranks * 6, sizeof *sim->rank_counts);
+        if (sim->rank_counts == NULL) {
+            wx_dist_abort(WX_FAIL); // the other ranks would wait in sim_agree
+        }
     }
     if (r == WX_OK) {
         sim->emitted = calloc((size_t)(scene->emitter_count + 1), sizeof *sim->emitted);
@@ -515,6 +552,9 @@ wx_result wx_sim_create(const wx_scene *scene, const wx_sim_def *config, wx_sim 
     if (r == WX_OK) {
         r = start_pool(sim, err);
     }
+    if (sim->ranks > 1) {
+        r = sim_agree(sim, r, err);
+    }
     if (r != WX_OK) {
         wx_sim_destroy(sim);
         return r;
@@ -540,6 +580,10 @@ void wx_sim_destroy(wx_sim *sim)
         free(sim->chunks[c].dead);
     }
     free(sim->chunks);
+    free(sim->all.events);
+    free(sim->all.dead);
+    free(sim->rank_counts);
+    free(sim->exchange);
     if (sim->dirt != NULL) {
         for (int c = 0; c < sim->view_count; ++c) {
             wx_dirt_map_free(&sim->dirt[c]);

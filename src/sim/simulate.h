@@ -38,6 +38,11 @@ typedef struct wx_sim_def {
     /// simulation; depth, normal and impact needed, dirt planes optional). NULL
     /// only for a scene without input cameras.
     const wx_maps *maps;
+    /// Spread the stepping over the ranks of an MPI run (core/dist.h,
+    /// docs/scale-out.md): every rank creates its simulation with the same
+    /// scene, maps and seed and steps it as often; the results are those of
+    /// one process, on every rank. False (default): this process alone.
+    bool distributed;
 } wx_sim_def;
 
 /// Default configuration for a scene: its seed, one thread per core.

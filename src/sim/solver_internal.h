@@ -122,6 +122,17 @@ struct wx_sim {
     int64_t chunk_count, chunk_capacity; ///< chunks of this step, allocated
     int64_t applied;                     ///< chunks whose events are applied
     wx_pool *pool;                       ///< the threads (core/parallel.h)
+    // Ranks (core/dist.h, docs/scale-out.md): every rank holds every particle
+    // and the same maps, and steps only particles [own_begin, own_end) (whole
+    // blocks, its share by index); with more than one rank the step's records
+    // of all ranks are gathered (exchange.c) into `all` and applied from there,
+    // in particle order as one rank would.
+    int ranks;
+    int64_t own_begin, own_end;
+    sim_chunk all;
+    int64_t *rank_counts; ///< exchange.c's counts: 6 per rank (ranks > 1)
+    uint64_t *exchange;   ///< exchange.c's buffer: every rank's part of a step
+    int64_t exchange_capacity;
 };
 
 // The input camera of view v.
@@ -137,6 +148,22 @@ static inline int sim_view_camera(const wx_sim *sim, int v)
 // step.c: steps particles [begin, end) into the records of the worker's chunk
 // (emptied by prepare_chunks).
 void sim_step_range(wx_sim *sim, sim_worker *w, int64_t begin, int64_t end);
+
+// exchange.c: this rank's share of the particles for the step (own_begin,
+// own_end), from the particle count and the rank.
+void sim_share(wx_sim *sim);
+
+// exchange.c: with more than one rank, at the end of wx_sim_create on every
+// rank: `r` is this rank's result so far. Fails on every rank when any rank
+// failed or when the ranks' simulations differ (views, texels, substances,
+// emitters, seed).
+wx_result sim_agree(wx_sim *sim, wx_result r, wx_error *err);
+
+// exchange.c: with more than one rank, after the step's stepping: every rank's
+// moved particles into every rank's arrays, and every rank's events and deaths
+// into sim->all, in particle order. Fails on every rank when one ran out of
+// memory.
+wx_result sim_exchange(wx_sim *sim, wx_error *err);
 
 // ageing.c: view c's ageing state, set up once its dirt map is.
 wx_result sim_setup_ageing(wx_sim *sim, int c, wx_error *err);
