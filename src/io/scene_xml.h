@@ -31,6 +31,8 @@ typedef struct wx_tile_scene_edit {
     int view_count;
     const char *const *view_names;
     const wx_view *views;
+    /// The output camera's new <View> and <OutputMap> size, or NULL to keep it.
+    const wx_view *output_view;
 } wx_tile_scene_edit;
 
 /// The text of the tile scene that `edit` makes of the scene file `path`

@@ -133,6 +133,17 @@ static wx_result edit_cameras(parser *p, xmlNode *maps, const wx_tile_scene_edit
         xmlChar *out = xmlGetProp(ortho, (const xmlChar *)"out");
         bool is_output = out != NULL && strcmp((const char *)out, "true") == 0;
         xmlFree(out);
+        xmlNode *output_map = is_output ? child_named(ortho, "OutputMap") : NULL;
+        xmlNode *output_view = is_output ? child_named(ortho, "View") : NULL;
+        if (output_view != NULL && output_map != NULL && edit->output_view != NULL) {
+            const wx_view *v = edit->output_view;
+            set_view(output_view, v);
+            char text[32];
+            snprintf(text, sizeof text, "%d", v->width_px);
+            xmlSetProp(output_map, (const xmlChar *)"width", (const xmlChar *)text);
+            snprintf(text, sizeof text, "%d", v->height_px);
+            xmlSetProp(output_map, (const xmlChar *)"height", (const xmlChar *)text);
+        }
         if (!is_output) {
             xmlChar *name = xmlGetProp(ortho, (const xmlChar *)"cameraName");
             const wx_view *v = name != NULL ? view_of(edit, (const char *)name) : NULL;

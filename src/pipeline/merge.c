@@ -6,6 +6,7 @@
 
 #include <dirent.h>
 #include <inttypes.h>
+#include <stdint.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -15,6 +16,7 @@
 #include "io/maps_file.h"
 #include "io/png_preview.h"
 #include "io/scene_xml.h"
+#include "gather/gather.h"
 #include "model/naming.h"
 #include "pipeline/outputs.h"
 
@@ -147,9 +149,79 @@ static int classify(const wx_scene *scene, const char *name, bool *mask)
     return 0;
 }
 
-// The sum of every tile's file `name`: they must agree in size and channels.
-static wx_result sum_tiles(const tile_ref *tiles, int count, const char *name, wx_image *sum,
-                           wx_error *err)
+// Where each tile's mask lies on the whole output camera's pixel grid: the
+// tiles' output cameras are crops of it (tiles.c), so tile k's first pixel
+// falls on pixel (x[k], y[k]) of the first tile's camera; the canvas is their
+// union, `view` the whole camera over it.
+typedef struct mask_layout {
+    int *x, *y;
+    int width, height;
+    wx_view view;
+    wx_camera camera;
+} mask_layout;
+
+static wx_result layout_masks(const wx_scene *scenes, int count, mask_layout *out,
+                              wx_error *err)
+{
+    memset(out, 0, sizeof *out);
+    out->x = calloc((size_t)count, sizeof *out->x);
+    out->y = calloc((size_t)count, sizeof *out->y);
+    if (out->x == NULL || out->y == NULL) {
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "merge: out of memory");
+    }
+    const wx_scene_camera *ref = &scenes[0].cameras[scenes[0].output_index];
+    const int W0 = ref->output_width, H0 = ref->output_height;
+    int x0 = INT32_MAX, y0 = INT32_MAX, x1 = INT32_MIN, y1 = INT32_MIN;
+    for (int k = 0; k < count; ++k) {
+        const wx_scene_camera *c = &scenes[k].cameras[scenes[k].output_index];
+        float uvd[3] = { 0.5f / (float)c->output_width, 1.0f - 0.5f / (float)c->output_height,
+                         0.0f };
+        float p[3];
+        wx_camera_map_to_world(&c->camera, uvd, p);
+        wx_camera_world_to_map(&ref->camera, p, uvd);
+        out->x[k] = (int)floor((double)uvd[0] * W0);
+        out->y[k] = (int)floor((1.0 - (double)uvd[1]) * H0);
+        x0 = out->x[k] < x0 ? out->x[k] : x0;
+        y0 = out->y[k] < y0 ? out->y[k] : y0;
+        x1 = out->x[k] + c->output_width > x1 ? out->x[k] + c->output_width : x1;
+        y1 = out->y[k] + c->output_height > y1 ? out->y[k] + c->output_height : y1;
+    }
+    out->width = x1 - x0;
+    out->height = y1 - y0;
+    for (int k = 0; k < count; ++k) {
+        out->x[k] -= x0;
+        out->y[k] -= y0;
+    }
+    // The camera over the union: the first tile's, moved by whole pixels.
+    float centre[3] = { (float)((x0 + x1) / (2.0 * W0)), (float)(1.0 - (y0 + y1) / (2.0 * H0)),
+                        0.0f };
+    float eye[3];
+    wx_camera_map_to_world(&ref->camera, centre, eye);
+    out->view = ref->view;
+    for (int a = 0; a < 3; ++a) {
+        out->view.target[a] = eye[a] + (ref->view.target[a] - ref->view.eye[a]);
+        out->view.eye[a] = eye[a];
+    }
+    out->view.width_px = out->width;
+    out->view.height_px = out->height;
+    out->view.width_ws = (float)(ref->view.width_ws * (double)out->width / W0);
+    out->view.height_ws = (float)(ref->view.height_ws * (double)out->height / H0);
+    wx_result r = wx_camera_from_view(&out->view, &out->camera, err);
+    out->camera.width = out->width;
+    out->camera.height = out->height;
+    return r;
+}
+
+static void free_layout(mask_layout *layout)
+{
+    free(layout->x);
+    free(layout->y);
+}
+
+// The sum of every tile's file `name`: they must agree in channels, and in
+// size unless `layout` places them (the masks) on its canvas.
+static wx_result sum_tiles(const tile_ref *tiles, int count, const char *name,
+                           const mask_layout *layout, wx_image *sum, wx_error *err)
 {
     wx_result r = WX_OK;
     for (int k = 0; k < count && r == WX_OK; ++k) {
@@ -160,30 +232,43 @@ static wx_result sum_tiles(const tile_ref *tiles, int count, const char *name, w
         }
         wx_image img;
         memset(&img, 0, sizeof img);
-        r = wx_exr_read_all(path, k == 0 ? sum : &img, err);
+        r = wx_exr_read_all(path, &img, err);
         if (r != WX_OK) {
             wx_error_prefix(err, "merge: tile %d %d", tiles[k].ix, tiles[k].iz);
             break;
         }
+        const int W = layout != NULL ? layout->width : img.width;
+        const int H = layout != NULL ? layout->height : img.height;
+        const int ox = layout != NULL ? layout->x[k] : 0, oy = layout != NULL ? layout->y[k] : 0;
         if (k == 0) {
-            continue;
+            const char *names[WX_IMAGE_MAX_CHANNELS];
+            for (int c = 0; c < img.channel_count; ++c) {
+                names[c] = img.channel_names[c];
+            }
+            r = wx_image_alloc(sum, W, H, img.channel_count, names, err);
+            for (int a = 0; r == WX_OK && a < img.attr_count; ++a) {
+                sum->attrs[a] = img.attrs[a];
+            }
+            sum->attr_count = img.attr_count;
         }
-        bool same = img.width == sum->width && img.height == sum->height &&
-                    img.channel_count == sum->channel_count;
+        bool same = r == WX_OK && img.channel_count == sum->channel_count &&
+                    ox + img.width <= W && oy + img.height <= H &&
+                    (layout != NULL || (img.width == W && img.height == H));
         for (int c = 0; same && c < img.channel_count; ++c) {
             same = strcmp(img.channel_names[c], sum->channel_names[c]) == 0;
         }
-        if (!same) {
+        if (r == WX_OK && !same) {
             r = wx_fail(err, WX_CAUSE_MAP_SIZE,
                         "%s: its size or channels differ from the first tile's (%s/%s)", path,
                         tiles[0].folder, name);
         }
-        const size_t n = (size_t)img.width * (size_t)img.height;
         for (int c = 0; r == WX_OK && c < img.channel_count; ++c) {
-            float *to = sum->channels[c];
-            const float *from = img.channels[c];
-            for (size_t i = 0; i < n; ++i) {
-                to[i] += from[i];
+            for (int j = 0; j < img.height; ++j) {
+                float *to = sum->channels[c] + (size_t)(oy + j) * (size_t)W + (size_t)ox;
+                const float *from = img.channels[c] + (size_t)j * (size_t)img.width;
+                for (int i = 0; i < img.width; ++i) {
+                    to[i] += from[i];
+                }
             }
         }
         wx_image_free(&img);
@@ -211,39 +296,45 @@ static wx_result write_previews(const wx_scene *scene, const char *out_dir, cons
 }
 
 // The transparent texels of a merged preview: for the mask, the background of
-// the output camera's depth map (every tile bakes the whole output camera);
-// for a texture, the texels no tile wrote: neither seen nor holding a value
-// (covered texels no camera sees included, which a run's preview shows black).
-static float *preview_surface(const wx_scene *scene, const tile_ref *first, bool mask,
-                              const wx_image *image, int threads)
+// the tiles' output depth maps placed as their masks are; for a texture, the
+// texels no tile wrote: neither seen nor holding a value (covered texels no
+// camera sees included, which a run's preview shows black).
+static float *preview_surface(const wx_scene *scenes, const tile_ref *tiles, int count,
+                              const mask_layout *layout, const wx_image *image, int threads)
 {
     const size_t n = (size_t)image->width * (size_t)image->height;
-    if (mask) {
-        const wx_scene_camera *out = &scene->cameras[scene->output_index];
-        char path[WX_PATH_MAX], name[WX_OUTPUT_NAME_MAX];
-        bool fits;
-        if (out->depth_path != NULL) {
-            int len = snprintf(path, sizeof path, "%s", out->depth_path);
-            fits = len > 0 && (size_t)len < sizeof path;
-        } else {
-            wx_map_file_name(out->name, WX_MAP_DEPTH, name, sizeof name);
-            fits = join_path(path, sizeof path, first->folder, name);
+    if (layout != NULL) {
+        float *surface = malloc(n * sizeof *surface);
+        for (size_t i = 0; surface != NULL && i < n; ++i) {
+            surface[i] = INFINITY;
         }
-        if (!fits) {
-            return NULL;
-        }
-        wx_maps maps;
-        memset(&maps, 0, sizeof maps);
-        wx_error err;
-        float *surface = NULL;
-        if (wx_maps_load(&maps, WX_MAPS_DEPTH, threads, path, NULL, NULL, NULL, &err) == WX_OK &&
-            maps.width == image->width && maps.height == image->height) {
-            surface = malloc(n * sizeof *surface);
-            if (surface != NULL) {
-                memcpy(surface, maps.depth, n * sizeof *surface);
+        for (int k = 0; surface != NULL && k < count; ++k) {
+            const wx_scene_camera *out = &scenes[k].cameras[scenes[k].output_index];
+            char path[WX_PATH_MAX], name[WX_OUTPUT_NAME_MAX];
+            bool fits;
+            if (out->depth_path != NULL) {
+                int len = snprintf(path, sizeof path, "%s", out->depth_path);
+                fits = len > 0 && (size_t)len < sizeof path;
+            } else {
+                wx_map_file_name(out->name, WX_MAP_DEPTH, name, sizeof name);
+                fits = join_path(path, sizeof path, tiles[k].folder, name);
             }
+            wx_maps maps;
+            memset(&maps, 0, sizeof maps);
+            wx_error err;
+            if (fits &&
+                wx_maps_load(&maps, WX_MAPS_DEPTH, threads, path, NULL, NULL, NULL, &err) == WX_OK &&
+                layout->x[k] + maps.width <= image->width &&
+                layout->y[k] + maps.height <= image->height) {
+                for (int j = 0; j < maps.height; ++j) {
+                    memcpy(surface + (size_t)(layout->y[k] + j) * (size_t)image->width +
+                               (size_t)layout->x[k],
+                           maps.depth + (size_t)j * (size_t)maps.width,
+                           (size_t)maps.width * sizeof *surface);
+                }
+            }
+            wx_maps_free(&maps);
         }
-        wx_maps_free(&maps);
         return surface;
     }
     const float *seen = NULL;
@@ -292,13 +383,29 @@ wx_result wx_merge_tiles(const wx_merge_def *def, wx_error *err)
     if (r != WX_OK) {
         return r;
     }
-    // The first tile's scene names the outputs; every tile must have run.
-    wx_scene scene;
-    memset(&scene, 0, sizeof scene);
-    r = wx_scene_load(tiles[0].scene, &scene, err);
-    if (r == WX_OK && !scene.tile.present) {
-        r = wx_fail(err, WX_CAUSE_BAD_SCENE, "%s: not a tile scene (it has no <Tile>)",
-                    tiles[0].scene);
+    // The first tile's scene names the outputs; every tile must be a tile
+    // scene, and must have run.
+    wx_scene *scenes = calloc((size_t)count, sizeof *scenes);
+    if (scenes == NULL) {
+        free(tiles);
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "merge: out of memory");
+    }
+    for (int k = 0; k < count && r == WX_OK; ++k) {
+        r = wx_scene_load(tiles[k].scene, &scenes[k], err);
+        if (r == WX_OK && !scenes[k].tile.present) {
+            r = wx_fail(err, WX_CAUSE_BAD_SCENE, "%s: not a tile scene (it has no <Tile>)",
+                        tiles[k].scene);
+        }
+        if (r == WX_OK && (scenes[k].output_index < 0) != (scenes[0].output_index < 0)) {
+            r = wx_fail(err, WX_CAUSE_BAD_SCENE, "%s: its output camera differs from %s's",
+                        tiles[k].scene, tiles[0].scene);
+        }
+    }
+    const wx_scene *scene = &scenes[0];
+    mask_layout layout;
+    memset(&layout, 0, sizeof layout);
+    if (r == WX_OK && scene->output_index >= 0) {
+        r = layout_masks(scenes, count, &layout, err);
     }
     for (int k = 0; k < count && r == WX_OK; ++k) {
         DIR *d = opendir(tiles[k].folder);
@@ -326,13 +433,25 @@ wx_result wx_merge_tiles(const wx_merge_def *def, wx_error *err)
     for (struct dirent *e = d != NULL ? readdir(d) : NULL; e != NULL && r == WX_OK;
          e = readdir(d)) {
         bool mask = false;
-        int kind = classify(&scene, e->d_name, &mask);
+        int kind = classify(scene, e->d_name, &mask);
         if (kind == 0) {
             continue;
         }
         wx_image sum;
         memset(&sum, 0, sizeof sum);
-        r = sum_tiles(tiles, count, e->d_name, &sum, err);
+        r = sum_tiles(tiles, count, e->d_name, mask ? &layout : NULL, &sum, err);
+        // A mask's header: the whole output camera over the tiles' union.
+        if (r == WX_OK && mask) {
+            const wx_scene_camera *out = &scene->cameras[scene->output_index];
+            float m[16];
+            wx_mask_world_to_camera(&layout.camera, m);
+            wx_image_set_m44f(&sum, "worldToCamera", m);
+            wx_mask_world_to_ndc(&layout.camera, m);
+            wx_image_set_m44f(&sum, "worldToNDC", m);
+            wx_image_set_m44f(&sum, "WTCMatrix", layout.camera.wtc);
+            wx_image_set_m44f(&sum, "CTWMatrix", layout.camera.ctw);
+            wx_image_set_string(&sum, "cameraName", out->name);
+        }
         char path[WX_PATH_MAX];
         if (r == WX_OK && !join_path(path, sizeof path, out_dir, e->d_name)) {
             r = wx_fail(err, WX_CAUSE_PATH_TOO_LONG, "%s: output folder path too long", out_dir);
@@ -342,8 +461,9 @@ wx_result wx_merge_tiles(const wx_merge_def *def, wx_error *err)
             r = wx_exr_write(path, &sum, err);
         }
         if (r == WX_OK && kind == 1) {
-            float *surface = preview_surface(&scene, &tiles[0], mask, &sum, def->threads);
-            r = write_previews(&scene, out_dir, e->d_name, &sum, surface, err);
+            float *surface = preview_surface(scenes, tiles, count, mask ? &layout : NULL, &sum,
+                                             def->threads);
+            r = write_previews(scene, out_dir, e->d_name, &sum, surface, err);
             free(surface);
         }
         wx_image_free(&sum);
@@ -366,7 +486,11 @@ wx_result wx_merge_tiles(const wx_merge_def *def, wx_error *err)
         }
         fprintf(stderr, "\n");
     }
-    wx_scene_free(&scene);
+    for (int k = 0; k < count; ++k) {
+        wx_scene_free(&scenes[k]);
+    }
+    free(scenes);
+    free_layout(&layout);
     free(tiles);
     return r;
 }

@@ -223,6 +223,16 @@ static wx_result write_tile(const wx_tiles_def *def, const wx_scene *scene, cons
             names[count++] = sc->name;
         }
     }
+    // The output camera over the tile and its halo too: the gather smooths
+    // across the tile's border as the whole run does, the tile writes only its
+    // own pixels, and merge places the crops on the whole camera's pixel grid.
+    wx_view output_view;
+    bool crop_output = false;
+    if (scene->output_index >= 0) {
+        const wx_scene_camera *out = &scene->cameras[scene->output_index];
+        crop_output = out->has_view && out->depth_path == NULL &&
+                      crop_view(&out->view, box_lo, box_hi, &output_view);
+    }
     char name[64], file[80];
     snprintf(name, sizeof name, "tile_%d_%d", ix, iz);
     snprintf(file, sizeof file, "%s.xml", name);
@@ -238,7 +248,8 @@ static wx_result write_tile(const wx_tiles_def *def, const wx_scene *scene, cons
                                 .to_dir = dir,
                                 .view_count = count,
                                 .view_names = names,
-                                .views = views };
+                                .views = views,
+                                .output_view = crop_output ? &output_view : NULL };
     char *text = NULL;
     size_t size = 0;
     if (r == WX_OK) {
