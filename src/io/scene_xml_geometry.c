@@ -103,6 +103,8 @@ static const child_spec surface_children[] = {
     { "Transfer", xml_parse_transfer, true },
     { "Decay", xml_parse_decay, true },
     { "Grow", xml_parse_grow, true },
+    { "Seed", xml_parse_seed, true },
+    { "Spread", xml_parse_spread, true },
 };
 
 static wx_result parse_surface(parser *p, const xmlNode *node, void *user)
