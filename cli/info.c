@@ -55,8 +55,18 @@ static void print_rule(const wx_scene *scene, const wx_rule *rule)
     case WX_RULE_SPREAD:
         printf("Spread %s radius %g probability %g", name, rule->radius, rule->probability);
         break;
+    case WX_RULE_CRACK:
+        printf("Crack %s radius %g strength %g", name, rule->radius, rule->strength);
+        break;
+    case WX_RULE_PEEL:
+        printf("Peel %s from %s radius %g probability %g", name,
+               rule->to >= 0 && rule->to < scene->substance_count ? scene->substances[rule->to]
+                                                                  : "?",
+               rule->radius, rule->probability);
+        break;
     }
-    if ((rule->kind == WX_RULE_SEED || rule->kind == WX_RULE_SPREAD) && rule->where >= 0 &&
+    if (rule->kind != WX_RULE_TRANSFER && rule->kind != WX_RULE_DECAY &&
+        rule->kind != WX_RULE_GROW && rule->where >= 0 &&
         rule->where < scene->substance_count) {
         printf(" where %s >= %g per m^2", scene->substances[rule->where], rule->min);
     }

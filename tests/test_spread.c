@@ -7,6 +7,8 @@
 //    next to the seam reaches the texels on both sides of it;
 //  - Seed's density gives the Poisson expectation of seeds, sum over the
 //    points of 1 - exp(-density * area), within 3 standard deviations;
+//  - a <Crack> grows one point per tip per iteration, a line whose points lie
+//    within its radius of each other, and <Peel> spreads from it;
 //  - the ledger balances with what was seeded and spread counted as grown;
 //  - 1 and 2 threads give the same bytes.
 #include <math.h>
@@ -354,6 +356,82 @@ TEST(spread_crosses_the_texture_seam_around_a_cylinder)
     }
 }
 
+// Crack and Peel on the plane: the seed square (4 texels) holds "rust" as a
+// crack; each tip takes one point 1.5 to 3 cm away per iteration, so after 4
+// iterations the crack holds 5 to 20 points, each (but the square's) within
+// 3 cm of another; "spot" peels from the crack with probability 1 within 2 cm
+// per iteration, so after 4 lies within 8 cm of a crack point.
+TEST(a_crack_grows_a_line_and_paint_peels_from_it)
+{
+    const char *dir = run_plane("spread_crack",
+                                "    <Crack substance=\"rust\" radius=\"0.03\" strength=\"0.5\"/>\n"
+                                "    <Peel substance=\"spot\" from=\"rust\" radius=\"0.02\"/>\n",
+                                "");
+    ENSURE(dir != NULL);
+    if (dir == NULL) {
+        return;
+    }
+    char path[4400];
+    snprintf(path, sizeof path, "%s/out/mask.exr", dir);
+    int w = 0, h = 0;
+    float *crack = ensure_read_channel(path, "rust.Y", &w, &h);
+    float *peel = ensure_read_channel(path, "spot.Y", &w, &h);
+    ENSURE(crack != NULL && peel != NULL);
+    if (crack == NULL || peel == NULL) {
+        free(crack);
+        free(peel);
+        return;
+    }
+    enum { MAX_CRACK = 64 };
+    double cx[MAX_CRACK], cz[MAX_CRACK];
+    int n = 0, peeled = 0, stray = 0, lonely = 0;
+    for (int t = 0; t < w * h; ++t) {
+        if (crack[t] > 0.5f && n < MAX_CRACK) {
+            cx[n] = ((t % w + 0.5) / w - 0.5) * 2.4;
+            cz[n++] = ((t / w + 0.5) / h - 0.5) * 2.4;
+        }
+    }
+    for (int a = 0; a < n; ++a) {
+        bool seed = fabs(cx[a]) < 0.01 && fabs(cz[a]) < 0.01;
+        bool near = false;
+        for (int b = 0; b < n && !seed; ++b) {
+            double d = hypot(cx[a] - cx[b], cz[a] - cz[b]);
+            near = near || (b != a && d <= 0.03 + 1e-6);
+        }
+        lonely += !seed && !near;
+    }
+    for (int t = 0; t < w * h; ++t) {
+        if (!(peel[t] > 0.5f)) {
+            continue;
+        }
+        peeled++;
+        double x = ((t % w + 0.5) / w - 0.5) * 2.4, z = ((t / w + 0.5) / h - 0.5) * 2.4;
+        double nearest = 1e9;
+        for (int a = 0; a < n; ++a) {
+            nearest = fmin(nearest, hypot(x - cx[a], z - cz[a]));
+        }
+        stray += nearest > 4 * 0.02 + TEXEL_M;
+    }
+    printf("        crack: %d points (%d not within 3 cm of another); peel: %d points, %d "
+           "farther than 8 cm from the crack\n",
+           n, lonely, peeled, stray);
+    ENSURE(n > 4 && n <= 4 + 4 * 4);
+    ENSURE(lonely == 0);
+    ENSURE(peeled > 0 && stray == 0);
+    free(crack);
+    free(peel);
+    snprintf(path, sizeof path, "%s/stats.json", dir);
+    char *json = ensure_read_file(path);
+    ENSURE(json != NULL);
+    const char *names[2] = { "\"rust\": {", "\"spot\": {" };
+    for (int s = 0; s < 2 && json != NULL; ++s) {
+        double in, out;
+        ensure_ledger_sides(strstr(json, names[s]), &in, &out);
+        ENSURE(fabs(in - out) <= 1e-9 * (fabs(in) + 1.0));
+    }
+    free(json);
+}
+
 int main(void)
 {
     RUN(spread_grows_a_disc_by_the_radius_every_iteration);
@@ -361,5 +439,6 @@ int main(void)
     RUN(the_ledger_counts_seeded_and_spread_amounts_as_grown);
     RUN(one_and_two_threads_give_the_same_bytes);
     RUN(spread_crosses_the_texture_seam_around_a_cylinder);
+    RUN(a_crack_grows_a_line_and_paint_peels_from_it);
     return ensure_summary();
 }

@@ -105,6 +105,8 @@ static const child_spec surface_children[] = {
     { "Grow", xml_parse_grow, true },
     { "Seed", xml_parse_seed, true },
     { "Spread", xml_parse_spread, true },
+    { "Crack", xml_parse_crack, true },
+    { "Peel", xml_parse_peel, true },
 };
 
 static wx_result parse_surface(parser *p, const xmlNode *node, void *user)

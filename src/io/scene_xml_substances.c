@@ -149,7 +149,7 @@ wx_result xml_find_substance(parser *p, const xmlNode *node, const char *attr,
 typedef struct rule_def {
     char from[SCENE_REF_MAX], to[SCENE_REF_MAX], substance[SCENE_REF_MAX];
     char where[SCENE_REF_MAX];
-    float rate, amount, min, density, radius, probability;
+    float rate, amount, min, density, radius, probability, strength;
 } rule_def;
 
 static const attr_spec transfer_attrs[] = {
@@ -187,6 +187,25 @@ static const attr_spec spread_attrs[] = {
     { "min", T_FLOAT, offsetof(rule_def, min), .range = R_NONNEG },
 };
 
+static const attr_spec crack_attrs[] = {
+    { "substance", T_TEXT, offsetof(rule_def, substance), .size = SCENE_REF_MAX,
+      .required = true },
+    { "radius", T_FLOAT, offsetof(rule_def, radius), .range = R_POSITIVE, .required = true },
+    { "strength", T_FLOAT, offsetof(rule_def, strength), .range = R_UNIT },
+    { "where", T_TEXT, offsetof(rule_def, where), .size = SCENE_REF_MAX },
+    { "min", T_FLOAT, offsetof(rule_def, min), .range = R_NONNEG },
+};
+
+static const attr_spec peel_attrs[] = {
+    { "substance", T_TEXT, offsetof(rule_def, substance), .size = SCENE_REF_MAX,
+      .required = true },
+    { "from", T_TEXT, offsetof(rule_def, from), .size = SCENE_REF_MAX, .required = true },
+    { "radius", T_FLOAT, offsetof(rule_def, radius), .range = R_POSITIVE, .required = true },
+    { "probability", T_FLOAT, offsetof(rule_def, probability), .range = R_UNIT },
+    { "where", T_TEXT, offsetof(rule_def, where), .size = SCENE_REF_MAX },
+    { "min", T_FLOAT, offsetof(rule_def, min), .range = R_NONNEG },
+};
+
 /// Seed's and Spread's `where` (none: anywhere) and `min` (only with where).
 static wx_result find_where(parser *p, const xmlNode *node, const rule_def *d, wx_rule *rule)
 {
@@ -207,7 +226,7 @@ static wx_result find_where(parser *p, const xmlNode *node, const rule_def *d, w
 static wx_result parse_rule(parser *p, const xmlNode *node, wx_rule_kind kind, void *user)
 {
     rule_list *list = user;
-    rule_def d = { .rate = 0.0f, .probability = 1.0f };
+    rule_def d = { .rate = 0.0f, .probability = 1.0f, .strength = 0.5f };
     wx_result r = WX_OK;
     wx_rule rule = { .kind = kind, .substance = -1, .to = -1, .where = -1, .line = line_of(node) };
     switch (kind) {
@@ -240,6 +259,25 @@ static wx_result parse_rule(parser *p, const xmlNode *node, wx_rule_kind kind, v
             r = find_where(p, node, &d, &rule);
         }
         break;
+    case WX_RULE_CRACK:
+        if ((r = LEAF(crack_attrs, &d, NULL)) == WX_OK &&
+            (r = xml_find_substance(p, node, "substance", d.substance, &rule.substance)) ==
+                WX_OK) {
+            r = find_where(p, node, &d, &rule);
+        }
+        break;
+    case WX_RULE_PEEL:
+        if ((r = LEAF(peel_attrs, &d, NULL)) == WX_OK &&
+            (r = xml_find_substance(p, node, "substance", d.substance, &rule.substance)) ==
+                WX_OK &&
+            (r = xml_find_substance(p, node, "from", d.from, &rule.to)) == WX_OK) {
+            r = find_where(p, node, &d, &rule);
+        }
+        if (r == WX_OK && rule.substance == rule.to) {
+            return fail(p, node, WX_CAUSE_BAD_VALUE,
+                        "<Peel> from and substance are the same substance '%s'", d.from);
+        }
+        break;
     }
     if (r != WX_OK) {
         return r;
@@ -248,6 +286,7 @@ static wx_result parse_rule(parser *p, const xmlNode *node, wx_rule_kind kind, v
     rule.density = d.density;
     rule.radius = d.radius;
     rule.probability = d.probability;
+    rule.strength = d.strength;
     rule.rate = kind == WX_RULE_TRANSFER || kind == WX_RULE_DECAY ? d.rate : 0.0f;
     rule.amount = kind == WX_RULE_GROW ? d.amount : 0.0f;
     r = xml_grow_list(p, node, (void **)list->rules, *list->count, list->capacity, sizeof rule,
@@ -284,10 +323,21 @@ wx_result xml_parse_spread(parser *p, const xmlNode *node, void *user)
     return parse_rule(p, node, WX_RULE_SPREAD, user);
 }
 
+wx_result xml_parse_crack(parser *p, const xmlNode *node, void *user)
+{
+    return parse_rule(p, node, WX_RULE_CRACK, user);
+}
+
+wx_result xml_parse_peel(parser *p, const xmlNode *node, void *user)
+{
+    return parse_rule(p, node, WX_RULE_PEEL, user);
+}
+
 static const child_spec ageing_children[] = {
     { "Transfer", xml_parse_transfer, true }, { "Decay", xml_parse_decay, true },
     { "Grow", xml_parse_grow, true },         { "Seed", xml_parse_seed, true },
-    { "Spread", xml_parse_spread, true },
+    { "Spread", xml_parse_spread, true },     { "Crack", xml_parse_crack, true },
+    { "Peel", xml_parse_peel, true },
 };
 
 /// <Ageing>: the global rules, run on every surface texel after each iteration.

@@ -84,8 +84,7 @@ bool wx_scene_has_ageing(const wx_scene *scene)
 static bool rules_grow(const wx_rule *rules, int count)
 {
     for (int r = 0; r < count; ++r) {
-        if (rules[r].kind == WX_RULE_GROW || rules[r].kind == WX_RULE_SEED ||
-            rules[r].kind == WX_RULE_SPREAD) {
+        if (rules[r].kind != WX_RULE_TRANSFER && rules[r].kind != WX_RULE_DECAY) {
             return true;
         }
     }
@@ -95,7 +94,8 @@ static bool rules_grow(const wx_rule *rules, int count)
 static bool rules_automata(const wx_rule *rules, int count)
 {
     for (int r = 0; r < count; ++r) {
-        if (rules[r].kind == WX_RULE_SEED || rules[r].kind == WX_RULE_SPREAD) {
+        if (rules[r].kind != WX_RULE_TRANSFER && rules[r].kind != WX_RULE_DECAY &&
+            rules[r].kind != WX_RULE_GROW) {
             return true;
         }
     }

@@ -95,6 +95,8 @@ void sim_run_rules(const wx_rule *rules, int count, double *a, double *b, double
         }
         case WX_RULE_SEED:
         case WX_RULE_SPREAD:
+        case WX_RULE_CRACK:
+        case WX_RULE_PEEL:
             break; // surface_automata.c runs them over the whole surface
         }
     }

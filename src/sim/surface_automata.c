@@ -1,7 +1,9 @@
 // surface_automata.c: the ageing rules that read other surface points
 // (docs/design.md section 15): <Seed> starts a substance at random points,
 // <Spread> lets it advance along the surface to the points within a radius of
-// those that hold it (Gobron's surface cellular automata). The surface points
+// those that hold it, <Crack> grows a line from each crack tip to its weakest
+// neighbour, <Peel> spreads from a crack's edges where it is wet (Gobron's
+// surface cellular automata). The surface points
 // are the texels of every view (input camera and layer) that own some surface
 // (the area the bake records, so a point two cameras see counts once); their
 // neighbours are found in world space, through a uniform grid of cells as large
@@ -55,6 +57,9 @@ struct sim_surface {
     float *area;         ///< per point: the area it owns (0: it takes no part)
     int *surface;        ///< per point: global <Surface> index, -1 none
     uint8_t *flag;       ///< scratch: holds (bit 0), takes (bit 1)
+    /// Per point, bit s: a crack tip of substance s (it held s when the
+    /// automata first ran, or took it since, and no Crack has grown from it).
+    uint8_t *tip;
     int grid_count;
     point_grid grids[WX_MAX_GRIDS];
 };
@@ -174,6 +179,7 @@ void sim_surface_free(sim_surface *sf)
     free(sf->area);
     free(sf->surface);
     free(sf->flag);
+    free(sf->tip);
     free(sf);
 }
 
@@ -200,8 +206,9 @@ static wx_result surface_build(wx_sim *sim, sim_surface **out, wx_error *err)
     sf->area = malloc(m * sizeof *sf->area);
     sf->surface = malloc(m * sizeof *sf->surface);
     sf->flag = malloc(m * sizeof *sf->flag);
+    sf->tip = calloc(m, sizeof *sf->tip);
     if (sf->view == NULL || sf->texel == NULL || sf->pos == NULL || sf->normal == NULL ||
-        sf->area == NULL || sf->surface == NULL || sf->flag == NULL) {
+        sf->area == NULL || sf->surface == NULL || sf->flag == NULL || sf->tip == NULL) {
         sim_surface_free(sf);
         return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (surface points)");
     }
@@ -230,6 +237,16 @@ static wx_result surface_build(wx_sim *sim, sim_surface **out, wx_error *err)
                 sf->area[k] = isfinite(a) && a > 0.0f ? a : 0.0f;
                 int id = sim->surface_of[c] != NULL ? (int)sim->surface_of[c][t] - 1 : -1;
                 sf->surface[k] = id >= 0 && id < known ? id : -1;
+            }
+        }
+    }
+    // What the points hold when the automata first run are crack tips.
+    for (int64_t k = 0; k < sf->count; ++k) {
+        for (int q = 0; q < sim->substances && sf->area[k] > 0.0f; ++q) {
+            const wx_dirt_texel *x =
+                &sim->dirt[sf->view[k]].texels[(size_t)sf->texel[k] * (size_t)sim->substances];
+            if (x[q].dirt >= HOLD_SHARE * (double)sf->area[k]) {
+                sf->tip[k] |= (uint8_t)(1u << q);
             }
         }
     }
@@ -285,9 +302,10 @@ static bool holds(wx_sim *sim, const sim_surface *sf, int64_t k, int s)
 
 // Point k takes 1 per square metre of the rule's substance: its area, on the
 // real amounts and on the baseline (like Grow: not the particles' doing, so
-// the gather keeps it exactly), counted as grown.
-static void take(wx_sim *sim, const sim_surface *sf, int64_t k, int s)
+// the gather keeps it exactly), counted as grown; it becomes a crack tip.
+static void take(wx_sim *sim, sim_surface *sf, int64_t k, int s)
 {
+    sf->tip[k] |= (uint8_t)(1u << s);
     double g = (double)sf->area[k];
     *amount_at(sim, sf, k, s) += g;
     double *b = baseline_at(sim, sf, k, s);
@@ -303,6 +321,15 @@ static double draw(const wx_sim *sim, const sim_surface *sf, int64_t k, uint64_t
     uint64_t point = (uint64_t)sim->slide_base[sf->view[k]] + sf->texel[k];
     uint64_t h = wx_mix64(sim->seed ^ wx_mix64(point ^ wx_mix64((uint64_t)sim->iterations_done ^
                                                                  wx_mix64(rule_id + 1))));
+    return (double)(h >> 11) * (1.0 / 9007199254740992.0);
+}
+
+// A point's flaw for Crack: uniform in [0, 1), a hash of the seed and the
+// point alone, so a crack follows the same weak line whatever the iteration.
+static double flaw(const wx_sim *sim, const sim_surface *sf, int64_t k)
+{
+    uint64_t point = (uint64_t)sim->slide_base[sf->view[k]] + sf->texel[k];
+    uint64_t h = wx_mix64(sim->seed ^ wx_mix64(point ^ UINT64_C(0xc7ac4f1a3d5b2e69)));
     return (double)(h >> 11) * (1.0 / 9007199254740992.0);
 }
 
@@ -372,6 +399,7 @@ static bool near_holder(const sim_surface *sf, const point_grid *g, int64_t i, d
     return false;
 }
 
+// Spread, and Peel (whose sources also hold `from`: a crack's edges).
 static wx_result run_spread(wx_sim *sim, sim_surface *sf, const wx_rule *rule, int surface,
                             uint64_t rule_id, wx_error *err)
 {
@@ -381,18 +409,89 @@ static wx_result run_spread(wx_sim *sim, sim_surface *sf, const wx_rule *rule, i
         return r;
     }
     int s = rule->substance;
+    int from = rule->kind == WX_RULE_PEEL ? rule->to : -1;
     memset(g->holders, 0, (size_t)g->cells * sizeof *g->holders);
     for (int64_t k = 0; k < sf->count; ++k) {
-        sf->flag[k] = sf->area[k] > 0.0f && holds(sim, sf, k, s);
-        g->holders[g->cell_of[k]] += sf->flag[k];
+        bool own = sf->area[k] > 0.0f && holds(sim, sf, k, s);
+        bool source = own || (sf->area[k] > 0.0f && from >= 0 && holds(sim, sf, k, from));
+        sf->flag[k] = (uint8_t)(source | (own << 2));
+        g->holders[g->cell_of[k]] += source;
     }
     for (int64_t k = 0; k < sf->count; ++k) {
-        if (!in_scope(sf, k, surface) || (sf->flag[k] & 1) || !meets_where(sim, sf, k, rule) ||
+        if (!in_scope(sf, k, surface) || (sf->flag[k] & 4) || !meets_where(sim, sf, k, rule) ||
             !(draw(sim, sf, k, rule_id) < (double)rule->probability)) {
             continue;
         }
         if (near_holder(sf, g, k, (double)rule->radius)) {
             sf->flag[k] |= 2;
+        }
+    }
+    for (int64_t k = 0; k < sf->count; ++k) {
+        if (sf->flag[k] & 2) {
+            take(sim, sf, k, s);
+        }
+    }
+    return WX_OK;
+}
+
+// Crack: each tip (a point that took the substance since the last Crack) takes
+// the weakest point of the annulus [radius / 2, radius] around it that does
+// not hold it, when that point's flaw is below `strength` and it meets
+// where/min; then it is no longer a tip. Ties go to the lower point index.
+static wx_result run_crack(wx_sim *sim, sim_surface *sf, const wx_rule *rule, int surface,
+                           wx_error *err)
+{
+    point_grid *g = NULL;
+    wx_result r = grid_for(sf, (double)rule->radius, &g, err);
+    if (r != WX_OK) {
+        return r;
+    }
+    int s = rule->substance;
+    uint8_t bit = (uint8_t)(1u << s);
+    double radius = (double)rule->radius;
+    for (int64_t k = 0; k < sf->count; ++k) {
+        sf->flag[k] = sf->area[k] > 0.0f && holds(sim, sf, k, s);
+    }
+    for (int64_t i = 0; i < sf->count; ++i) {
+        if (!(sf->tip[i] & bit) || !(sf->flag[i] & 1)) {
+            continue;
+        }
+        sf->tip[i] &= (uint8_t)~bit;
+        int c[3];
+        pack_cell(&sf->pos[3 * i], g->cell, c);
+        int64_t best = -1;
+        double weakest = (double)rule->strength;
+        for (int dz = -1; dz <= 1; ++dz) {
+            for (int dy = -1; dy <= 1; ++dy) {
+                for (int dx = -1; dx <= 1; ++dx) {
+                    int q[3] = { c[0] + dx, c[1] + dy, c[2] + dz };
+                    int64_t cell = find_cell(g, key_of(q));
+                    for (int64_t e = cell < 0 ? 0 : g->start[cell];
+                         cell >= 0 && e < g->start[cell + 1]; ++e) {
+                        int64_t j = g->order[e];
+                        if ((sf->flag[j] & 1) || !in_scope(sf, j, surface) ||
+                            !neighbours(sf, j, i, radius)) {
+                            continue;
+                        }
+                        const float *pi = &sf->pos[3 * i], *pj = &sf->pos[3 * j];
+                        double d2 = 0.0;
+                        for (int a = 0; a < 3; ++a) {
+                            d2 += ((double)pi[a] - pj[a]) * ((double)pi[a] - pj[a]);
+                        }
+                        if (d2 < 0.25 * radius * radius) {
+                            continue;
+                        }
+                        double w = flaw(sim, sf, j);
+                        if (w < weakest || (w == weakest && best >= 0 && j < best)) {
+                            weakest = w;
+                            best = j;
+                        }
+                    }
+                }
+            }
+        }
+        if (best >= 0 && meets_where(sim, sf, best, rule)) {
+            sf->flag[best] |= 2;
         }
     }
     for (int64_t k = 0; k < sf->count; ++k) {
@@ -413,7 +512,10 @@ static wx_result run_one(wx_sim *sim, sim_surface *sf, const wx_rule *rule, int 
         run_seed(sim, sf, rule, surface, rule_id);
         return WX_OK;
     case WX_RULE_SPREAD:
+    case WX_RULE_PEEL:
         return run_spread(sim, sf, rule, surface, rule_id, err);
+    case WX_RULE_CRACK:
+        return run_crack(sim, sf, rule, surface, err);
     default:
         break;
     }
