@@ -1570,6 +1570,8 @@ TEST(schema_rejects_bad_values)
         // docs/design.md section 15 (issue 28).
         "seed_density_negative", "seed_without_density", "spread_radius_zero",
         "spread_without_radius", "spread_probability_above_one", "spread_min_negative",
+        "crack_radius_negative", "crack_strength_above_one", "crack_without_radius",
+        "peel_without_from", "peel_probability_negative",
     };
     int failures = 0;
     for (size_t i = 0; i < sizeof invalid / sizeof invalid[0]; ++i) {
