@@ -51,7 +51,9 @@ static void print_rule(const wx_scene *scene, const wx_rule *rule)
         break;
     case WX_RULE_DECAY: printf("Decay %s %g", name, rule->rate); break;
     case WX_RULE_GROW: printf("Grow %s %g per m^2", name, rule->amount); break;
-    case WX_RULE_SEED: printf("Seed %s %g per m^2", name, rule->density); break;
+    case WX_RULE_SEED:
+        printf("Seed %s %g per m^2", name, rule->density);
+        break;
     case WX_RULE_SPREAD:
         printf("Spread %s radius %g probability %g", name, rule->radius, rule->probability);
         break;
@@ -66,8 +68,7 @@ static void print_rule(const wx_scene *scene, const wx_rule *rule)
         break;
     }
     if (rule->kind != WX_RULE_TRANSFER && rule->kind != WX_RULE_DECAY &&
-        rule->kind != WX_RULE_GROW && rule->where >= 0 &&
-        rule->where < scene->substance_count) {
+        rule->kind != WX_RULE_GROW && rule->where >= 0 && rule->where < scene->substance_count) {
         printf(" where %s >= %g per m^2", scene->substances[rule->where], rule->min);
     }
 }

@@ -19,7 +19,7 @@
 
 #include "ensure.h"
 
-#define TEXEL_M 0.01
+#define TEXEL_M  0.01
 #define RADIUS_M 0.05
 // The seed square covers 2 x 2 texels, whose centres lie 5 mm off its axes.
 #define SEED_HALF_M 0.005
@@ -217,8 +217,8 @@ TEST(the_ledger_counts_seeded_and_spread_amounts_as_grown)
     double final = rust != NULL ? ensure_json_number(rust, NULL, "final_surface") : 0.0;
     double lo = 3.14159265 * 0.19 * 0.19 + 4 * 0.01 * 0.19 + 0.01 * 0.01;
     double hi = 3.14159265 * 0.21 * 0.21 + 4 * 0.01 * 0.21 + 0.01 * 0.01;
-    printf("        rust over the plane: %.5f m^2 (the disc within a texel: %.5f to %.5f)\n",
-           final, lo, hi);
+    printf("        rust over the plane: %.5f m^2 (the disc within a texel: %.5f to %.5f)\n", final,
+           lo, hi);
     ENSURE(final > lo && final < hi);
     free(json);
 }

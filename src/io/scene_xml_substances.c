@@ -171,16 +171,14 @@ static const attr_spec grow_attrs[] = {
 };
 
 static const attr_spec seed_attrs[] = {
-    { "substance", T_TEXT, offsetof(rule_def, substance), .size = SCENE_REF_MAX,
-      .required = true },
+    { "substance", T_TEXT, offsetof(rule_def, substance), .size = SCENE_REF_MAX, .required = true },
     { "density", T_FLOAT, offsetof(rule_def, density), .range = R_NONNEG, .required = true },
     { "where", T_TEXT, offsetof(rule_def, where), .size = SCENE_REF_MAX },
     { "min", T_FLOAT, offsetof(rule_def, min), .range = R_NONNEG },
 };
 
 static const attr_spec spread_attrs[] = {
-    { "substance", T_TEXT, offsetof(rule_def, substance), .size = SCENE_REF_MAX,
-      .required = true },
+    { "substance", T_TEXT, offsetof(rule_def, substance), .size = SCENE_REF_MAX, .required = true },
     { "radius", T_FLOAT, offsetof(rule_def, radius), .range = R_POSITIVE, .required = true },
     { "probability", T_FLOAT, offsetof(rule_def, probability), .range = R_UNIT },
     { "where", T_TEXT, offsetof(rule_def, where), .size = SCENE_REF_MAX },
@@ -188,8 +186,7 @@ static const attr_spec spread_attrs[] = {
 };
 
 static const attr_spec crack_attrs[] = {
-    { "substance", T_TEXT, offsetof(rule_def, substance), .size = SCENE_REF_MAX,
-      .required = true },
+    { "substance", T_TEXT, offsetof(rule_def, substance), .size = SCENE_REF_MAX, .required = true },
     { "radius", T_FLOAT, offsetof(rule_def, radius), .range = R_POSITIVE, .required = true },
     { "strength", T_FLOAT, offsetof(rule_def, strength), .range = R_UNIT },
     { "where", T_TEXT, offsetof(rule_def, where), .size = SCENE_REF_MAX },
@@ -197,8 +194,7 @@ static const attr_spec crack_attrs[] = {
 };
 
 static const attr_spec peel_attrs[] = {
-    { "substance", T_TEXT, offsetof(rule_def, substance), .size = SCENE_REF_MAX,
-      .required = true },
+    { "substance", T_TEXT, offsetof(rule_def, substance), .size = SCENE_REF_MAX, .required = true },
     { "from", T_TEXT, offsetof(rule_def, from), .size = SCENE_REF_MAX, .required = true },
     { "radius", T_FLOAT, offsetof(rule_def, radius), .range = R_POSITIVE, .required = true },
     { "probability", T_FLOAT, offsetof(rule_def, probability), .range = R_UNIT },
@@ -254,22 +250,19 @@ static wx_result parse_rule(parser *p, const xmlNode *node, wx_rule_kind kind, v
     case WX_RULE_SPREAD:
         r = kind == WX_RULE_SEED ? LEAF(seed_attrs, &d, NULL) : LEAF(spread_attrs, &d, NULL);
         if (r == WX_OK &&
-            (r = xml_find_substance(p, node, "substance", d.substance, &rule.substance)) ==
-                WX_OK) {
+            (r = xml_find_substance(p, node, "substance", d.substance, &rule.substance)) == WX_OK) {
             r = find_where(p, node, &d, &rule);
         }
         break;
     case WX_RULE_CRACK:
         if ((r = LEAF(crack_attrs, &d, NULL)) == WX_OK &&
-            (r = xml_find_substance(p, node, "substance", d.substance, &rule.substance)) ==
-                WX_OK) {
+            (r = xml_find_substance(p, node, "substance", d.substance, &rule.substance)) == WX_OK) {
             r = find_where(p, node, &d, &rule);
         }
         break;
     case WX_RULE_PEEL:
         if ((r = LEAF(peel_attrs, &d, NULL)) == WX_OK &&
-            (r = xml_find_substance(p, node, "substance", d.substance, &rule.substance)) ==
-                WX_OK &&
+            (r = xml_find_substance(p, node, "substance", d.substance, &rule.substance)) == WX_OK &&
             (r = xml_find_substance(p, node, "from", d.from, &rule.to)) == WX_OK) {
             r = find_where(p, node, &d, &rule);
         }

@@ -109,7 +109,7 @@ struct wx_sim {
     const float **surface_of;    ///< the maps' surface planes (NULL entries: none)
     const wx_surface **surfaces; ///< the scene's <Surface>s by global index (the rules')
     int64_t iterations_done;
-    sim_surface *surface; ///< NULL until a Seed or Spread first runs
+    sim_surface *surface;                   ///< NULL until a Seed or Spread first runs
     int camera_order[WX_MAX_INPUT_CAMERAS]; ///< coarse test order (speed only)
     /// Texel numbering for the particles' last slide: view v's texel t is
     /// slide_base[v] + t; slide_base[view_count] is the total.

@@ -27,7 +27,7 @@
 // 120 degrees (a box's edge is crossed, the two faces of a thin wall or plate,
 // whose normals are opposite, are not), and the chord between them does not
 // run along both normals (two surfaces stacked or facing across a gap).
-#define NORMAL_AGREEMENT (-0.5f)
+#define NORMAL_AGREEMENT   (-0.5f)
 #define CHORD_ALONG_NORMAL 0.8f
 // Positions come from single-precision depths and cameras: a neighbour exactly
 // `radius` away (a whole number of texels on a plane) must not be lost to
@@ -320,7 +320,7 @@ static double draw(const wx_sim *sim, const sim_surface *sf, int64_t k, uint64_t
 {
     uint64_t point = (uint64_t)sim->slide_base[sf->view[k]] + sf->texel[k];
     uint64_t h = wx_mix64(sim->seed ^ wx_mix64(point ^ wx_mix64((uint64_t)sim->iterations_done ^
-                                                                 wx_mix64(rule_id + 1))));
+                                                                wx_mix64(rule_id + 1))));
     return (double)(h >> 11) * (1.0 / 9007199254740992.0);
 }
 

@@ -61,8 +61,8 @@ int main(void)
         return 1;
     }
     char cmd[2 * PATH_MAX];
-    snprintf(cmd, sizeof cmd, "cp xml_scenes/meshes/tank.obj xml_scenes/meshes/tank.mtl '%s/meshes/'",
-             dir);
+    snprintf(cmd, sizeof cmd,
+             "cp xml_scenes/meshes/tank.obj xml_scenes/meshes/tank.mtl '%s/meshes/'", dir);
     char *scene = ensure_read_file("xml_scenes/rusty_tank.xml");
     if (system(cmd) != 0 || scene == NULL) {
         fprintf(stderr, "bench_spread: run from the repository's root\n");
@@ -75,12 +75,20 @@ int main(void)
         memmove(masks, masks_end, strlen(masks_end) + 1);
     }
     const char *plain[] = {
-        "every=\"1\"", "every=\"0\"", "iterations=\"10\"", "iterations=\"20\"",
-        "<Substance name=\"moss\"/>", "<Substance name=\"moss\"/><Substance name=\"bloom\"/>",
+        "every=\"1\"",
+        "every=\"0\"",
+        "iterations=\"10\"",
+        "iterations=\"20\"",
+        "<Substance name=\"moss\"/>",
+        "<Substance name=\"moss\"/><Substance name=\"bloom\"/>",
     };
     const char *spread[] = {
-        "every=\"1\"", "every=\"0\"", "iterations=\"10\"", "iterations=\"20\"",
-        "<Substance name=\"moss\"/>", "<Substance name=\"moss\"/><Substance name=\"bloom\"/>",
+        "every=\"1\"",
+        "every=\"0\"",
+        "iterations=\"10\"",
+        "iterations=\"20\"",
+        "<Substance name=\"moss\"/>",
+        "<Substance name=\"moss\"/><Substance name=\"bloom\"/>",
         "<Decay substance=\"water\" rate=\"0.5\"/>",
         "<Decay substance=\"water\" rate=\"0.5\"/>"
         "<Seed substance=\"bloom\" where=\"water\" min=\"0.2\" density=\"2\"/>"
