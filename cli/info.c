@@ -35,7 +35,8 @@ static const char *field_name(wx_field_kind kind)
 }
 
 // The rule as the scene writes it: "Transfer water -> rust 0.2", "Decay water
-// 0.5", "Grow moss 2 per m^2".
+// 0.5", "Grow moss 2 per m^2", "Spread rust radius 0.02 probability 0.5 where
+// water >= 0.2 per m^2".
 static void print_rule(const wx_scene *scene, const wx_rule *rule)
 {
     const char *name = rule->substance >= 0 && rule->substance < scene->substance_count
@@ -50,6 +51,25 @@ static void print_rule(const wx_scene *scene, const wx_rule *rule)
         break;
     case WX_RULE_DECAY: printf("Decay %s %g", name, rule->rate); break;
     case WX_RULE_GROW: printf("Grow %s %g per m^2", name, rule->amount); break;
+    case WX_RULE_SEED:
+        printf("Seed %s %g per m^2", name, rule->density);
+        break;
+    case WX_RULE_SPREAD:
+        printf("Spread %s radius %g probability %g", name, rule->radius, rule->probability);
+        break;
+    case WX_RULE_CRACK:
+        printf("Crack %s radius %g strength %g", name, rule->radius, rule->strength);
+        break;
+    case WX_RULE_PEEL:
+        printf("Peel %s from %s radius %g probability %g", name,
+               rule->to >= 0 && rule->to < scene->substance_count ? scene->substances[rule->to]
+                                                                  : "?",
+               rule->radius, rule->probability);
+        break;
+    }
+    if (rule->kind != WX_RULE_TRANSFER && rule->kind != WX_RULE_DECAY &&
+        rule->kind != WX_RULE_GROW && rule->where >= 0 && rule->where < scene->substance_count) {
+        printf(" where %s >= %g per m^2", scene->substances[rule->where], rule->min);
     }
 }
 

@@ -1567,6 +1567,11 @@ TEST(schema_rejects_bad_values)
         "mask_name_reserved_seen", "mask_name_reserved_y", "mask_name_with_a_dot",
         "mask_without_name", "combine_without_terms", "combine_too_many_terms", "masks_too_many",
         "masks_twice", "mask_unknown_element",
+        // docs/design.md section 15 (issue 28).
+        "seed_density_negative", "seed_without_density", "spread_radius_zero",
+        "spread_without_radius", "spread_probability_above_one", "spread_min_negative",
+        "crack_radius_negative", "crack_strength_above_one", "crack_without_radius",
+        "peel_without_from", "peel_probability_negative",
     };
     int failures = 0;
     for (size_t i = 0; i < sizeof invalid / sizeof invalid[0]; ++i) {

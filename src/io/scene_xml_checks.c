@@ -13,9 +13,11 @@
 // ---------------------------------------------------------------------------
 // <Weathering> and the checks that need the whole scene
 
-static const char *const rule_elements[] = { [WX_RULE_TRANSFER] = "Transfer",
-                                             [WX_RULE_DECAY] = "Decay",
-                                             [WX_RULE_GROW] = "Grow" };
+static const char *const rule_elements[] = {
+    [WX_RULE_TRANSFER] = "Transfer", [WX_RULE_DECAY] = "Decay",   [WX_RULE_GROW] = "Grow",
+    [WX_RULE_SEED] = "Seed",         [WX_RULE_SPREAD] = "Spread", [WX_RULE_CRACK] = "Crack",
+    [WX_RULE_PEEL] = "Peel"
+};
 
 /// A surface's own rules need the bake to record which <Surface> each texel of
 /// every input camera shows; maps the scene names were made elsewhere and do

@@ -99,10 +99,10 @@ static wx_result parse_exchange(parser *p, const xmlNode *node, void *user)
 }
 
 static const child_spec surface_children[] = {
-    { "Exchange", parse_exchange, true },
-    { "Transfer", xml_parse_transfer, true },
-    { "Decay", xml_parse_decay, true },
-    { "Grow", xml_parse_grow, true },
+    { "Exchange", parse_exchange, true }, { "Transfer", xml_parse_transfer, true },
+    { "Decay", xml_parse_decay, true },   { "Grow", xml_parse_grow, true },
+    { "Seed", xml_parse_seed, true },     { "Spread", xml_parse_spread, true },
+    { "Crack", xml_parse_crack, true },   { "Peel", xml_parse_peel, true },
 };
 
 static wx_result parse_surface(parser *p, const xmlNode *node, void *user)

@@ -82,6 +82,10 @@ wx_result xml_parse_transfer(parser *p, const xmlNode *node, void *user);
 wx_result xml_parse_decay(parser *p, const xmlNode *node, void *user);
 
 wx_result xml_parse_grow(parser *p, const xmlNode *node, void *user);
+wx_result xml_parse_seed(parser *p, const xmlNode *node, void *user);
+wx_result xml_parse_spread(parser *p, const xmlNode *node, void *user);
+wx_result xml_parse_crack(parser *p, const xmlNode *node, void *user);
+wx_result xml_parse_peel(parser *p, const xmlNode *node, void *user);
 
 /// <Ageing>: the global rules, run on every surface texel after each iteration.
 wx_result xml_parse_ageing(parser *p, const xmlNode *node, void *user);

@@ -148,7 +148,8 @@ wx_result xml_find_substance(parser *p, const xmlNode *node, const char *attr,
 
 typedef struct rule_def {
     char from[SCENE_REF_MAX], to[SCENE_REF_MAX], substance[SCENE_REF_MAX];
-    float rate, amount;
+    char where[SCENE_REF_MAX];
+    float rate, amount, min, density, radius, probability, strength;
 } rule_def;
 
 static const attr_spec transfer_attrs[] = {
@@ -169,14 +170,61 @@ static const attr_spec grow_attrs[] = {
     { "amount", T_FLOAT, offsetof(rule_def, amount), .range = R_NONNEG, .required = true },
 };
 
+static const attr_spec seed_attrs[] = {
+    { "substance", T_TEXT, offsetof(rule_def, substance), .size = SCENE_REF_MAX, .required = true },
+    { "density", T_FLOAT, offsetof(rule_def, density), .range = R_NONNEG, .required = true },
+    { "where", T_TEXT, offsetof(rule_def, where), .size = SCENE_REF_MAX },
+    { "min", T_FLOAT, offsetof(rule_def, min), .range = R_NONNEG },
+};
+
+static const attr_spec spread_attrs[] = {
+    { "substance", T_TEXT, offsetof(rule_def, substance), .size = SCENE_REF_MAX, .required = true },
+    { "radius", T_FLOAT, offsetof(rule_def, radius), .range = R_POSITIVE, .required = true },
+    { "probability", T_FLOAT, offsetof(rule_def, probability), .range = R_UNIT },
+    { "where", T_TEXT, offsetof(rule_def, where), .size = SCENE_REF_MAX },
+    { "min", T_FLOAT, offsetof(rule_def, min), .range = R_NONNEG },
+};
+
+static const attr_spec crack_attrs[] = {
+    { "substance", T_TEXT, offsetof(rule_def, substance), .size = SCENE_REF_MAX, .required = true },
+    { "radius", T_FLOAT, offsetof(rule_def, radius), .range = R_POSITIVE, .required = true },
+    { "strength", T_FLOAT, offsetof(rule_def, strength), .range = R_UNIT },
+    { "where", T_TEXT, offsetof(rule_def, where), .size = SCENE_REF_MAX },
+    { "min", T_FLOAT, offsetof(rule_def, min), .range = R_NONNEG },
+};
+
+static const attr_spec peel_attrs[] = {
+    { "substance", T_TEXT, offsetof(rule_def, substance), .size = SCENE_REF_MAX, .required = true },
+    { "from", T_TEXT, offsetof(rule_def, from), .size = SCENE_REF_MAX, .required = true },
+    { "radius", T_FLOAT, offsetof(rule_def, radius), .range = R_POSITIVE, .required = true },
+    { "probability", T_FLOAT, offsetof(rule_def, probability), .range = R_UNIT },
+    { "where", T_TEXT, offsetof(rule_def, where), .size = SCENE_REF_MAX },
+    { "min", T_FLOAT, offsetof(rule_def, min), .range = R_NONNEG },
+};
+
+/// Seed's and Spread's `where` (none: anywhere) and `min` (only with where).
+static wx_result find_where(parser *p, const xmlNode *node, const rule_def *d, wx_rule *rule)
+{
+    rule->where = -1;
+    if (d->where[0] == '\0') {
+        if (d->min > 0.0f) {
+            return fail(p, node, WX_CAUSE_BAD_VALUE,
+                        "<%s> min=\"%g\" needs where= (the substance it is the least amount of)",
+                        name_of(node), (double)d->min);
+        }
+        return WX_OK;
+    }
+    return xml_find_substance(p, node, "where", d->where, &rule->where);
+}
+
 /// Appends the rule `node` gives to `user` (a rule_list, or a struct that
 /// starts with one).
 static wx_result parse_rule(parser *p, const xmlNode *node, wx_rule_kind kind, void *user)
 {
     rule_list *list = user;
-    rule_def d = { .rate = 0.0f };
+    rule_def d = { .rate = 0.0f, .probability = 1.0f, .strength = 0.5f };
     wx_result r = WX_OK;
-    wx_rule rule = { .kind = kind, .substance = -1, .to = -1, .line = line_of(node) };
+    wx_rule rule = { .kind = kind, .substance = -1, .to = -1, .where = -1, .line = line_of(node) };
     switch (kind) {
     case WX_RULE_TRANSFER:
         if ((r = LEAF(transfer_attrs, &d, NULL)) == WX_OK &&
@@ -198,11 +246,41 @@ static wx_result parse_rule(parser *p, const xmlNode *node, wx_rule_kind kind, v
             r = xml_find_substance(p, node, "substance", d.substance, &rule.substance);
         }
         break;
+    case WX_RULE_SEED:
+    case WX_RULE_SPREAD:
+        r = kind == WX_RULE_SEED ? LEAF(seed_attrs, &d, NULL) : LEAF(spread_attrs, &d, NULL);
+        if (r == WX_OK &&
+            (r = xml_find_substance(p, node, "substance", d.substance, &rule.substance)) == WX_OK) {
+            r = find_where(p, node, &d, &rule);
+        }
+        break;
+    case WX_RULE_CRACK:
+        if ((r = LEAF(crack_attrs, &d, NULL)) == WX_OK &&
+            (r = xml_find_substance(p, node, "substance", d.substance, &rule.substance)) == WX_OK) {
+            r = find_where(p, node, &d, &rule);
+        }
+        break;
+    case WX_RULE_PEEL:
+        if ((r = LEAF(peel_attrs, &d, NULL)) == WX_OK &&
+            (r = xml_find_substance(p, node, "substance", d.substance, &rule.substance)) == WX_OK &&
+            (r = xml_find_substance(p, node, "from", d.from, &rule.to)) == WX_OK) {
+            r = find_where(p, node, &d, &rule);
+        }
+        if (r == WX_OK && rule.substance == rule.to) {
+            return fail(p, node, WX_CAUSE_BAD_VALUE,
+                        "<Peel> from and substance are the same substance '%s'", d.from);
+        }
+        break;
     }
     if (r != WX_OK) {
         return r;
     }
-    rule.rate = kind == WX_RULE_GROW ? 0.0f : d.rate;
+    rule.min = d.min;
+    rule.density = d.density;
+    rule.radius = d.radius;
+    rule.probability = d.probability;
+    rule.strength = d.strength;
+    rule.rate = kind == WX_RULE_TRANSFER || kind == WX_RULE_DECAY ? d.rate : 0.0f;
     rule.amount = kind == WX_RULE_GROW ? d.amount : 0.0f;
     r = xml_grow_list(p, node, (void **)list->rules, *list->count, list->capacity, sizeof rule,
                       SCENE_MAX_RULES, "ageing rules");
@@ -228,10 +306,31 @@ wx_result xml_parse_grow(parser *p, const xmlNode *node, void *user)
     return parse_rule(p, node, WX_RULE_GROW, user);
 }
 
+wx_result xml_parse_seed(parser *p, const xmlNode *node, void *user)
+{
+    return parse_rule(p, node, WX_RULE_SEED, user);
+}
+
+wx_result xml_parse_spread(parser *p, const xmlNode *node, void *user)
+{
+    return parse_rule(p, node, WX_RULE_SPREAD, user);
+}
+
+wx_result xml_parse_crack(parser *p, const xmlNode *node, void *user)
+{
+    return parse_rule(p, node, WX_RULE_CRACK, user);
+}
+
+wx_result xml_parse_peel(parser *p, const xmlNode *node, void *user)
+{
+    return parse_rule(p, node, WX_RULE_PEEL, user);
+}
+
 static const child_spec ageing_children[] = {
-    { "Transfer", xml_parse_transfer, true },
-    { "Decay", xml_parse_decay, true },
-    { "Grow", xml_parse_grow, true },
+    { "Transfer", xml_parse_transfer, true }, { "Decay", xml_parse_decay, true },
+    { "Grow", xml_parse_grow, true },         { "Seed", xml_parse_seed, true },
+    { "Spread", xml_parse_spread, true },     { "Crack", xml_parse_crack, true },
+    { "Peel", xml_parse_peel, true },
 };
 
 /// <Ageing>: the global rules, run on every surface texel after each iteration.

@@ -84,8 +84,35 @@ bool wx_scene_has_ageing(const wx_scene *scene)
 static bool rules_grow(const wx_rule *rules, int count)
 {
     for (int r = 0; r < count; ++r) {
-        if (rules[r].kind == WX_RULE_GROW) {
+        if (rules[r].kind != WX_RULE_TRANSFER && rules[r].kind != WX_RULE_DECAY) {
             return true;
+        }
+    }
+    return false;
+}
+
+static bool rules_automata(const wx_rule *rules, int count)
+{
+    for (int r = 0; r < count; ++r) {
+        if (rules[r].kind != WX_RULE_TRANSFER && rules[r].kind != WX_RULE_DECAY &&
+            rules[r].kind != WX_RULE_GROW) {
+            return true;
+        }
+    }
+    return false;
+}
+
+bool wx_scene_has_surface_automata(const wx_scene *scene)
+{
+    if (rules_automata(scene->rules, scene->rule_count)) {
+        return true;
+    }
+    for (int m = 0; m < scene->mesh_count; ++m) {
+        for (int k = 0; k < scene->meshes[m].surface_count; ++k) {
+            const wx_surface *sf = &scene->meshes[m].surfaces[k];
+            if (rules_automata(sf->rules, sf->rule_count)) {
+                return true;
+            }
         }
     }
     return false;

@@ -120,6 +120,12 @@ typedef enum wx_rule_kind {
     WX_RULE_TRANSFER, ///< t = rate * s_from; s_from -= t; s_to += t
     WX_RULE_DECAY,    ///< s -= rate * s
     WX_RULE_GROW,     ///< s += amount per square metre of surface
+    /// Surface cellular automata (docs/design.md section 15): they read other
+    /// surface points, so each runs over the whole surface before the next.
+    WX_RULE_SEED,   ///< starts 1 per m^2 with probability 1 - exp(-density * area)
+    WX_RULE_SPREAD, ///< takes 1 per m^2 within radius of a holder, with probability
+    WX_RULE_CRACK,  ///< each crack tip takes its weakest neighbour within radius
+    WX_RULE_PEEL,   ///< Spread from the points holding `from` (crack edges) or it
 } wx_rule_kind;
 
 /// One ageing rule (docs/design.md section 9), run on every surface texel
@@ -127,9 +133,15 @@ typedef enum wx_rule_kind {
 typedef struct wx_rule {
     wx_rule_kind kind;
     int substance; ///< Transfer: from; Decay, Grow: the substance (index)
-    int to;        ///< Transfer: to (index); else -1
+    int to;        ///< Transfer: to (index); Peel: from (index); else -1
     float rate;    ///< Transfer, Decay: in [0, 1]
     float amount;  ///< Grow: per square metre, >= 0
+    int where;     ///< Seed, Spread: the substance that must lie there (index); -1: anywhere
+    float min;     ///< Seed, Spread: the least amount of `where` per square metre
+    float density; ///< Seed: seeds per square metre per iteration, >= 0
+    float radius;  ///< Spread, Crack, Peel: world units along the surface, > 0
+    float probability; ///< Spread, Peel: per point per iteration, in [0, 1]
+    float strength;    ///< Crack: a point cracks when its flaw value is below it, [0, 1]
     int line;
 } wx_rule;
 
@@ -405,8 +417,14 @@ bool wx_scene_has_ageing(const wx_scene *scene);
 /// surface each texel shows.
 bool wx_scene_has_surface_rules(const wx_scene *scene);
 
-/// True when some rule (global or per surface) grows a substance.
+/// True when some rule (global or per surface) grows a substance (Grow and the
+/// surface automata: each needs the area each texel owns).
 bool wx_scene_has_grow(const wx_scene *scene);
+
+/// True when some rule (global or per surface) reads other surface points
+/// (Seed, Spread, Crack, Peel): the ageing then runs rule by rule over the
+/// whole surface.
+bool wx_scene_has_surface_automata(const wx_scene *scene);
 
 /// Whether an input camera holds more than one layer (docs/design.md section 14).
 bool wx_scene_has_layers(const wx_scene *scene);

@@ -54,9 +54,9 @@ wx_result sim_setup_ageing(wx_sim *sim, int c, wx_error *err)
 
 // Runs `rules` on one texel's amounts a[] (and its baseline b[], may be NULL),
 // in order, each seeing the result of the one before (docs/design.md section 9);
-// `area` is the surface the texel grows on.
-static void run_rules(const wx_rule *rules, int count, double *a, double *b, double area,
-                      wx_substance_ledger *ledger)
+// `area` is the surface the texel grows on. Seed and Spread are skipped.
+void sim_run_rules(const wx_rule *rules, int count, double *a, double *b, double area,
+                   wx_substance_ledger *ledger)
 {
     for (int k = 0; k < count; ++k) {
         const wx_rule *r = &rules[k];
@@ -93,19 +93,28 @@ static void run_rules(const wx_rule *rules, int count, double *a, double *b, dou
             }
             break;
         }
+        case WX_RULE_SEED:
+        case WX_RULE_SPREAD:
+        case WX_RULE_CRACK:
+        case WX_RULE_PEEL:
+            break; // surface_automata.c runs them over the whole surface
         }
     }
 }
 
 // After an iteration's last step: the global rules, then the texel's own
 // surface's, on every surface texel of every input camera, in texel order (one
-// thread: the ledger's sums are the same for any thread count).
-void sim_age(wx_sim *sim)
+// thread: the ledger's sums are the same for any thread count). A scene with
+// surface automata (Seed, Spread) runs rule by rule (surface_automata.c).
+wx_result sim_age(wx_sim *sim, wx_error *err)
 {
     const wx_scene *scene = sim->scene;
     bool surface_rules = wx_scene_has_surface_rules(scene);
     if (scene->rule_count == 0 && !surface_rules) {
-        return;
+        return WX_OK;
+    }
+    if (wx_scene_has_surface_automata(scene)) {
+        return sim_age_automata(sim, err);
     }
     // Surface rules by global surface index.
     const wx_surface **by_index = sim->surfaces;
@@ -129,15 +138,16 @@ void sim_age(wx_sim *sim)
             }
             double *b = baseline != NULL ? &baseline[t * (size_t)S] : NULL;
             double grow = area != NULL ? (double)area[t] : 0.0;
-            run_rules(scene->rules, scene->rule_count, a, b, grow, sim->stats.substance);
+            sim_run_rules(scene->rules, scene->rule_count, a, b, grow, sim->stats.substance);
             int id = surface != NULL ? (int)surface[t] - 1 : -1;
             if (id >= 0 && id < known) {
-                run_rules(by_index[id]->rules, by_index[id]->rule_count, a, b, grow,
-                          sim->stats.substance);
+                sim_run_rules(by_index[id]->rules, by_index[id]->rule_count, a, b, grow,
+                              sim->stats.substance);
             }
             for (int s = 0; s < S; ++s) {
                 x[s].dirt = a[s];
             }
         }
     }
+    return WX_OK;
 }

@@ -365,7 +365,7 @@ wx_result wx_sim_step(wx_sim *sim, wx_error *err)
     const wx_scene *scene = sim->scene;
     if (r == WX_OK && scene->steps > 0 && sim->step % scene->steps == 0 &&
         sim->iterations_done < (scene->iterations > 1 ? scene->iterations : 1)) {
-        sim_age(sim);
+        r = sim_age(sim, err);
         sim->iterations_done++;
     }
     return r;
@@ -599,6 +599,7 @@ void wx_sim_destroy(wx_sim *sim)
             free(sim->grow_area[c]);
         }
     }
+    sim_surface_free(sim->surface);
     free(sim->views);
     free(sim->baseline);
     free(sim->grow_area);

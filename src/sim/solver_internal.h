@@ -68,6 +68,12 @@ typedef struct sim_worker {
     uint32_t credit[WX_MAX_INPUT_CAMERAS]; ///< lanes each camera cleared first
 } sim_worker;
 
+// surface_automata.c: the surface points and their grids (docs/design.md
+// section 15), built the first time a Seed or Spread runs.
+typedef struct sim_surface sim_surface;
+// Grids kept at once, one per distinct Spread radius.
+#define WX_MAX_GRIDS 4
+
 struct wx_sim {
     const wx_scene *scene;
     // Configuration.
@@ -103,6 +109,7 @@ struct wx_sim {
     const float **surface_of;    ///< the maps' surface planes (NULL entries: none)
     const wx_surface **surfaces; ///< the scene's <Surface>s by global index (the rules')
     int64_t iterations_done;
+    sim_surface *surface;                   ///< NULL until a Seed or Spread first runs
     int camera_order[WX_MAX_INPUT_CAMERAS]; ///< coarse test order (speed only)
     /// Texel numbering for the particles' last slide: view v's texel t is
     /// slide_base[v] + t; slide_base[view_count] is the total.
@@ -168,7 +175,18 @@ wx_result sim_exchange(wx_sim *sim, wx_error *err);
 // ageing.c: view c's ageing state, set up once its dirt map is.
 wx_result sim_setup_ageing(wx_sim *sim, int c, wx_error *err);
 
-// ageing.c: the rules after an iteration's last step.
-void sim_age(wx_sim *sim);
+// ageing.c: the rules after an iteration's last step. WX_FAIL when out of
+// memory (the surface automata's points and grids).
+wx_result sim_age(wx_sim *sim, wx_error *err);
+
+// ageing.c: `count` rules on one texel's amounts a[] and baseline b[] (may be
+// NULL), `area` the surface it grows on; Seed and Spread are not run here.
+void sim_run_rules(const wx_rule *rules, int count, double *a, double *b, double area,
+                   wx_substance_ledger *ledger);
+
+// surface_automata.c: every rule, one after the other over the whole surface,
+// for a scene with Seed or Spread rules.
+wx_result sim_age_automata(wx_sim *sim, wx_error *err);
+void sim_surface_free(sim_surface *surface);
 
 #endif
