@@ -13,6 +13,10 @@
 // Directions are stratified per point (a Hammersley set rotated by a hash of
 // the seed, the mask and the point), so the result is the same for any thread
 // count and 32-64 rays give a smooth mask without a second pass.
+// Accessibility goes coarse to fine over the grid of points: every fourth
+// point of every fourth row first, and a point between four that lie on its
+// surface and agree within 1/16 takes their interpolation without a ray
+// (masks.c, REFINE_STRIDE), so the open expanses cost a sixteenth of their rays.
 #ifndef WX_MASKS_H
 #define WX_MASKS_H
 
