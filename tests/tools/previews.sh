@@ -17,7 +17,7 @@ dir=$build/previews
 mkdir -p "$dir"
 w=$build/weathering
 
-for scene in building teapot bunny spot rusty_tank stained_house; do
+for scene in building teapot bunny spot rusty_tank stained_house old_house; do
     echo "previews: $scene" >&2
     rm -rf "${dir:?}/$scene"
     "$w" run "xml_scenes/$scene.xml" --out "$dir/$scene" -q
@@ -29,6 +29,8 @@ for m in ao dirt moss mossy rust sun water; do
     cp "$dir/rusty_tank/mask_$m.png" "$images/rusty_tank-$m.png"
 done
 cp "$dir/stained_house/mask_stains.png" "$images/stained_house-stains.png"
+# The old house's seasons 4, 8, 12 and 20, painted (rust, cracks, peeling, stains).
+python3 tests/tools/old_house_seasons.py "$build" "$dir/old_house" "$images/old_house-seasons.png"
 
 # The TextureMaps: the layout as written, and drawn on the model.
 cp "$dir/building/building_texture.png" "$images/building-texture-layout.png"
