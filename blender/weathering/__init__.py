@@ -1,5 +1,5 @@
-"""Weathering: particle-driven dirt, dust, soot, moss, rust and peeling paint for the selected
-meshes, computed by the `weathering` command line (docs/blender.md).
+"""Weathering: particle-driven dirt, dust, soot, moss, rust and peeling paint
+for the selected meshes, computed by the `weathering` command line (docs/blender.md).
 
 View3D > Sidebar > Weathering: a preset, a particle count, a resolution, Run.
 bpy.ops.weathering.run() does the same from a script; under `blender -b` it
