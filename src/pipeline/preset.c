@@ -148,8 +148,8 @@ static void put(text *t, const char *fmt, ...)
 // A camera looking along -axis at the box centre c, from `distance` away, with
 // a frame of `w` x `h` at `texel` world units a texel.
 static void camera(text *t, const char *name, const double c[3], const double axis[3],
-                   const double up[3], double distance, double w, double h, double texel,
-                   bool out, int out_px, int layers, int every)
+                   const double up[3], double distance, double w, double h, double texel, bool out,
+                   int out_px, int layers, int every)
 {
     int pw = out ? out_px : (int)fmin(16384.0, fmax(16.0, ceil(w / texel)));
     int ph = out ? out_px : (int)fmin(16384.0, fmax(16.0, ceil(h / texel)));
@@ -752,17 +752,15 @@ static wx_result generate(const wx_init_def *def, const preset *p, int pi,
             "       shelter and shade. -->\n"
             "  <Substances>\n    <Substance name=\"water\"/>\n  </Substances>\n");
     } else if (pi == PRESET_RUST) {
-        put(&t,
-            "  <!-- The rain carries water; rust grows where it lingers (<Ageing> below). -->\n"
-            "  <Substances>\n    <Substance name=\"water\"/>\n    <Substance name=\"rust\"/>\n"
-            "  </Substances>\n");
+        put(&t, "  <!-- The rain carries water; rust grows where it lingers (<Ageing> below). -->\n"
+                "  <Substances>\n    <Substance name=\"water\"/>\n    <Substance name=\"rust\"/>\n"
+                "  </Substances>\n");
     } else if (pi == PRESET_OLD_PAINT) {
-        put(&t,
-            "  <!-- The rain carries water; the paint's cracks and its peeled flakes are\n"
-            "       substances of their own, so the mask has crack.Y and peel.Y (<Ageing>\n"
-            "       below). -->\n"
-            "  <Substances>\n    <Substance name=\"water\"/>\n    <Substance name=\"crack\"/>\n"
-            "    <Substance name=\"peel\"/>\n  </Substances>\n");
+        put(&t, "  <!-- The rain carries water; the paint's cracks and its peeled flakes are\n"
+                "       substances of their own, so the mask has crack.Y and peel.Y (<Ageing>\n"
+                "       below). -->\n"
+                "  <Substances>\n    <Substance name=\"water\"/>\n    <Substance name=\"crack\"/>\n"
+                "    <Substance name=\"peel\"/>\n  </Substances>\n");
     }
     put(&t,
         "  <Solver>\n"
@@ -890,7 +888,8 @@ static wx_result generate(const wx_init_def *def, const preset *p, int pi,
             "       rain's, the older spells' halved again each time. -->\n"
             "  <Ageing>\n    <Decay substance=\"water\" rate=\"0.5\"/>\n  </Ageing>\n");
     } else if (automata_preset(pi)) {
-        ageing_automata(&t, pi, size, in_texel, rate * emit / ((e_hi[0] - e_lo[0]) * (e_hi[2] - e_lo[2])));
+        ageing_automata(&t, pi, size, in_texel,
+                        rate * emit / ((e_hi[0] - e_lo[0]) * (e_hi[2] - e_lo[2])));
     }
     put(&t,
         "  <Geometry>\n"
