@@ -74,7 +74,8 @@ static void print_usage(FILE *out)
             "  --threads N        worker threads (default: all cores)\n"
             "  --stats FILE.json  write run statistics as JSON\n"
             "  -q, --quiet        no progress bars or notes on stderr\n"
-            "  --preset P         init, run MESH: rain (default), dust, soot or moss\n"
+            "  --preset P         init, run MESH: rain (default), dust, soot, moss, rust or\n"
+            "                     old_paint\n"
             "  -o SCENE.xml       init: the scene to write (default: MESH's name .xml here)\n"
             "  --resolution PX    init, run MESH: texels across the largest frame (1024)\n"
             "  --units U          init, run MESH: the mesh's unit: m (default), cm, mm, in, ft\n"
@@ -160,7 +161,8 @@ static int parse_args(int argc, char **argv, cli_args *args)
         } else if (is_option(arg, "--preset")) {
             args->preset = option_value(argc, argv, &i, "--preset", &missing);
             if (!missing && wx_preset_find(args->preset) < 0) {
-                return usage_error("unknown preset '%s' (presets: rain, dust, soot, moss)",
+                return usage_error("unknown preset '%s' (presets: rain, dust, soot, moss, rust, "
+                                   "old_paint)",
                                    args->preset);
             }
         } else if (strcmp(arg, "-o") == 0 || is_option(arg, "--output")) {

@@ -2,7 +2,8 @@
 // (src/pipeline/preset.c, docs/presets.md): valid scenes that frame the mesh,
 // sizes that follow it, and what every preset promises on any model: its
 // particles land or leave before the run ends, its output camera looks at the
-// side it weathers most, and moss grows where it is wet and sheltered.
+// side it weathers most, moss grows where it is wet and sheltered, rust
+// blooms where it is wet, and old paint cracks and peels.
 // test_init.c tests the commands around it (init, run MESH, split).
 #define _XOPEN_SOURCE 700 // realpath
 #include <limits.h>
@@ -41,8 +42,8 @@ TEST(presets_make_valid_scenes_and_rain_dirties_the_top)
 {
     SLOW();
     const char *dir = ensure_tmpdir();
-    static const char *const presets[4] = { "rain", "dust", "soot", "moss" };
-    for (int p = 0; p < 4; ++p) {
+    static const char *const presets[6] = { "rain", "dust", "soot", "moss", "rust", "old_paint" };
+    for (int p = 0; p < 6; ++p) {
         char name[64], path[PATH_MAX + 64];
         snprintf(name, sizeof name, "cube_%s.xml", presets[p]);
         char args[256];
@@ -426,6 +427,110 @@ TEST(moss_grows_where_wet_and_sheltered)
     ENSURE(res.moss_low >= 2.0 * res.moss_high);
 }
 
+// Runs the preset `preset` on uv_sphere.obj at 96 texels in dir/NAME
+// (NAME.xml, the outputs in dir/NAME/), after checking that the schema
+// accepts its scene. False when a step fails.
+static bool run_sphere(const char *dir, const char *preset)
+{
+    char args[256], path[PATH_MAX + 64];
+    snprintf(args, sizeof args, "init '%%s' --preset %s --resolution 96 -o %%s --force -q", preset);
+    char scene[64];
+    snprintf(scene, sizeof scene, "%s.xml", preset);
+    if (run_in(dir, args, data_file("uv_sphere.obj"), scene) != 0) {
+        return false;
+    }
+    snprintf(path, sizeof path, "%s/%s", dir, scene);
+    if (!schema_accepts(path)) {
+        return false;
+    }
+    return run_in(dir, "run %s --out %s -q", scene, preset) == 0;
+}
+
+// Texels of a channel above 0 (-1 when the channel cannot be read).
+static long nonzero_texels(const char *path, const char *channel)
+{
+    int w = 0, h = 0;
+    float *v = ensure_read_channel(path, channel, &w, &h);
+    if (v == NULL) {
+        return -1;
+    }
+    long n = 0;
+    for (size_t i = 0; i < (size_t)w * (size_t)h; ++i) {
+        n += v[i] > 0.0f;
+    }
+    free(v);
+    return n;
+}
+
+// The rust preset on a sphere: a valid scene, a frame per spell whose rust
+// covers more of the sphere each spell, and rust only where water is (it seeds
+// and spreads where the rain's water stays).
+TEST(rust_blooms_where_wet_and_grows_each_spell)
+{
+    SLOW(); // 2.3 s on an idle machine, 8 s on a busy one
+    const char *dir = ensure_tmpdir();
+    ENSURE(run_sphere(dir, "rust"));
+    char path[PATH_MAX + 64];
+    long last = 0;
+    for (int f = 1; f <= 6; ++f) {
+        snprintf(path, sizeof path, "%s/rust/mask.%04d.exr", dir, f);
+        long n = nonzero_texels(path, "rust.Y");
+        printf("        spell %d: rust on %ld texels\n", f, n);
+        ENSURE(n > last);
+        last = n;
+    }
+    snprintf(path, sizeof path, "%s/rust/mask.exr", dir);
+    int w = 0, h = 0, w2 = -1, h2 = -1;
+    float *rust = ensure_read_channel(path, "rust.Y", &w, &h);
+    float *water = ensure_read_channel(path, "water.Y", &w2, &h2);
+    ENSURE(rust != NULL && water != NULL && w == w2 && h == h2);
+    if (rust != NULL && water != NULL && w == w2 && h == h2) {
+        long dry = 0;
+        for (size_t i = 0; i < (size_t)w * (size_t)h; ++i) {
+            dry += rust[i] > 0.0f && !(water[i] > 0.0f);
+        }
+        ENSURE(dry == 0);
+    }
+    free(rust);
+    free(water);
+}
+
+// The old_paint preset on a sphere: a valid scene whose mask has crack.Y and
+// peel.Y, both somewhere, the peeling growing over the spells, and peel only
+// where there is a crack or water (it starts at cracks' edges where wet).
+TEST(old_paint_cracks_and_peels_where_wet)
+{
+    SLOW(); // 2.3 s on an idle machine, 8 s on a busy one
+    const char *dir = ensure_tmpdir();
+    ENSURE(run_sphere(dir, "old_paint"));
+    char path[PATH_MAX + 64];
+    snprintf(path, sizeof path, "%s/old_paint/mask.0001.exr", dir);
+    long first = nonzero_texels(path, "peel.Y");
+    snprintf(path, sizeof path, "%s/old_paint/mask.exr", dir);
+    int w = 0, h = 0, w2 = -1, h2 = -1, w3 = -2, h3 = -2;
+    float *crack = ensure_read_channel(path, "crack.Y", &w, &h);
+    float *peel = ensure_read_channel(path, "peel.Y", &w2, &h2);
+    float *water = ensure_read_channel(path, "water.Y", &w3, &h3);
+    ENSURE(crack != NULL && peel != NULL && water != NULL && w == w2 && h == h2 && w == w3 &&
+           h == h3);
+    if (crack != NULL && peel != NULL && water != NULL && w == w2 && h == h2 && w == w3 &&
+        h == h3) {
+        long cracked = 0, peeled = 0, stray = 0;
+        for (size_t i = 0; i < (size_t)w * (size_t)h; ++i) {
+            cracked += crack[i] > 0.0f;
+            peeled += peel[i] > 0.0f;
+            stray += peel[i] > 0.0f && !(crack[i] > 0.0f) && !(water[i] > 0.0f);
+        }
+        printf("        cracked %ld texels, peeled %ld (%ld after the first spell)\n", cracked,
+               peeled, first);
+        ENSURE(cracked > 0 && peeled > first && first >= 0);
+        ENSURE(stray == 0);
+    }
+    free(crack);
+    free(peel);
+    free(water);
+}
+
 int main(void)
 {
     RUN(presets_make_valid_scenes_and_rain_dirties_the_top);
@@ -433,5 +538,7 @@ int main(void)
     RUN(the_output_camera_faces_the_wind);
     RUN(every_preset_lands_its_particles_and_faces_its_weathered_side);
     RUN(moss_grows_where_wet_and_sheltered);
+    RUN(rust_blooms_where_wet_and_grows_each_spell);
+    RUN(old_paint_cracks_and_peels_where_wet);
     return ensure_summary();
 }

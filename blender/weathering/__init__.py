@@ -1,5 +1,5 @@
-"""Weathering: particle-driven dirt, dust, soot and moss for the selected
-meshes, computed by the `weathering` command line (docs/blender.md).
+"""Weathering: particle-driven dirt, dust, soot, moss, rust and peeling paint
+for the selected meshes, computed by the `weathering` command line (docs/blender.md).
 
 View3D > Sidebar > Weathering: a preset, a particle count, a resolution, Run.
 bpy.ops.weathering.run() does the same from a script; under `blender -b` it
@@ -12,7 +12,7 @@ bl_info = {
     "version": (1, 0, 0),
     "blender": (3, 4, 0),
     "location": "View3D > Sidebar > Weathering",
-    "description": "Particle-driven weathering masks (rain, dust, soot, moss) from the "
+    "description": "Particle-driven weathering masks (rain, dust, soot, moss, rust, paint) from the "
                    "weathering command line, loaded back as textures and a camera mask",
     "category": "Material",
 }
@@ -35,6 +35,8 @@ PRESETS = (
     ("dust", "Dust", "Dust settling from still air: tops and ledges gather it"),
     ("soot", "Soot", "Soot on a turbulent breeze: a film on the windward side, some underneath"),
     ("moss", "Moss", "Five rainy spells: moss grows where the water stays, sheltered and shaded"),
+    ("rust", "Rust", "Six rainy spells: rust blooms where the water stays, spreading while wet"),
+    ("old_paint", "Old paint", "Six rainy spells: paint cracks where the rain beats, peels if wet"),
 )
 
 

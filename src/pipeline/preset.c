@@ -18,10 +18,10 @@
 #include "pipeline/bake_phase.h"
 #include "pipeline/pipeline.h"
 
-const char *const wx_preset_names[] = { "rain", "dust", "soot", "moss" };
-const int wx_preset_count = 4;
+const char *const wx_preset_names[] = { "rain", "dust", "soot", "moss", "rust", "old_paint" };
+const int wx_preset_count = 6;
 
-enum { PRESET_RAIN, PRESET_DUST, PRESET_SOOT, PRESET_MOSS };
+enum { PRESET_RAIN, PRESET_DUST, PRESET_SOOT, PRESET_MOSS, PRESET_RUST, PRESET_OLD_PAINT };
 
 /// What a preset sets: the physics of its particles (relative to the mesh's
 /// size s and the fall's duration) and its surfaces.
@@ -57,7 +57,30 @@ static const preset presets[] = {
                       "where it stays wet in shelter and shade",
                       2.0, 1.0, 8.0, 0.3, { -1.0, 0.0, -0.4 }, 0.0, 400000, 5, false,
                       0.3, 0.1, 0.5, 0.1, 0.2, 0.9 },
+    [PRESET_RUST] = { "six rainy spells: the rain's water lingers, rust seeds where it stays and "
+                      "blooms outwards along the wet surface, a frame per spell",
+                      2.0, 1.0, 8.0, 0.3, { -1.0, 0.0, -0.4 }, 0.0, 400000, 6, false,
+                      0.3, 0.1, 0.5, 0.1, 0.2, 0.9 },
+    [PRESET_OLD_PAINT] = { "six rainy spells on old paint: it cracks, mostly where the rain "
+                           "beats, and peels from the cracks where the water stays, a frame "
+                           "per spell",
+                           2.0, 1.0, 8.0, 0.3, { -1.0, 0.0, -0.4 }, 0.0, 400000, 6, false,
+                           0.3, 0.1, 0.5, 0.1, 0.2, 0.9 },
 };
+
+// Whether a preset's rain carries water (a substance "water", an <Exchange>
+// and its evaporation between spells).
+static bool wet_preset(int pi)
+{
+    return pi == PRESET_MOSS || pi == PRESET_RUST || pi == PRESET_OLD_PAINT;
+}
+
+// Whether a preset grows its look with the surface automata (Seed, Spread,
+// Crack, Peel: docs/design.md section 15), on inputs of half the resolution.
+static bool automata_preset(int pi)
+{
+    return pi == PRESET_RUST || pi == PRESET_OLD_PAINT;
+}
 
 int wx_preset_find(const char *name)
 {
@@ -125,8 +148,8 @@ static void put(text *t, const char *fmt, ...)
 // A camera looking along -axis at the box centre c, from `distance` away, with
 // a frame of `w` x `h` at `texel` world units a texel.
 static void camera(text *t, const char *name, const double c[3], const double axis[3],
-                   const double up[3], double distance, double w, double h, double texel,
-                   bool out, int out_px, int layers)
+                   const double up[3], double distance, double w, double h, double texel, bool out,
+                   int out_px, int layers, int every)
 {
     int pw = out ? out_px : (int)fmin(16384.0, fmax(16.0, ceil(w / texel)));
     int ph = out ? out_px : (int)fmin(16384.0, fmax(16.0, ceil(h / texel)));
@@ -143,7 +166,11 @@ static void camera(text *t, const char *name, const double c[3], const double ax
         name, extra, c[0] + axis[0] * distance, c[1] + axis[1] * distance,
         c[2] + axis[2] * distance, c[0], c[1], c[2], up[0], up[1], up[2], w, h, pw, ph);
     if (out) {
-        put(t, "        <OutputMap file=\"mask.exr\"/>\n");
+        if (every > 0) {
+            put(t, "        <OutputMap file=\"mask.exr\" every=\"%d\"/>\n", every);
+        } else {
+            put(t, "        <OutputMap file=\"mask.exr\"/>\n");
+        }
     }
     put(t, "      </Ortho>\n");
 }
@@ -175,6 +202,68 @@ static const double VIEW_LOW = 20.0, VIEW_HIGH = 60.0;
 // meet a surface: one alone is as often a graze.
 enum { MOSS_RAYS = 12 };
 static const double MOSS_SCALE = 1.3;
+
+// Rust and old paint (docs/presets.md): the surface automata after each spell
+// (docs/design.md section 15), every length a multiple of the mesh's size s or
+// of the input cameras' texel (itself one of s), every density per s^2, every
+// amount of water a share of a spell's rain on open ground (`rain`, per square
+// unit), so the look is the same at any size and unit.
+static void ageing_automata(text *t, int pi, double s, double in_texel, double rain)
+{
+    const double s2 = s * s;
+    if (pi == PRESET_RUST) {
+        // Seeds where a fifth of a spell's open-ground rain stays, 30 per s^2
+        // a spell; blooms growing up to s/100 (at least two texels) a spell
+        // with probability 0.4, over surfaces that hold a twentieth.
+        double seed_min = 0.2 * rain, spread_min = 0.05 * rain;
+        double radius = fmax(0.01 * s, 2.0 * in_texel);
+        put(t,
+            "  <!-- After each spell: rust starts at random where a fifth of a spell's rain\n"
+            "       on open ground (%.4g a square unit) or more stays, %.4g seeds a square\n"
+            "       unit (30 over s x s) a spell; each bloom creeps %.4g (s/100, at least\n"
+            "       two input texels) a spell over the surface that holds a twentieth\n"
+            "       (%.4g), each point there taking it with probability 0.4, so the blooms'\n"
+            "       edges fray; then half the water evaporates (docs/design.md section 15).\n"
+            "       The frames mask.0001.exr ... show the blooms grow. -->\n"
+            "  <Ageing>\n"
+            "    <Seed substance=\"rust\" density=\"%.6g\" where=\"water\" min=\"%.6g\"/>\n"
+            "    <Spread substance=\"rust\" radius=\"%.6g\" probability=\"0.4\" where=\"water\" "
+            "min=\"%.6g\"/>\n"
+            "    <Decay substance=\"water\" rate=\"0.5\"/>\n"
+            "  </Ageing>\n",
+            seed_min, 30.0 / s2, radius, spread_min, 30.0 / s2, seed_min, radius, spread_min);
+        return;
+    }
+    // Old paint: cracks start mostly where the rain beats (a twentieth of a
+    // spell's open-ground rain), a few anywhere; each grows three steps of
+    // 1.5 input texels (neighbouring texels: a continuous line) a spell; the
+    // paint peels from them where a fifth of a spell's rain stays.
+    double beaten = 0.05 * rain, soaked = 0.2 * rain;
+    double step = 1.5 * in_texel, flake = fmax(0.005 * s, 2.0 * in_texel);
+    put(t,
+        "  <!-- After each spell: cracks start where the rain beats (%.4g of water a square\n"
+        "       unit, a twentieth of a spell's rain on open ground: the exposed surfaces),\n"
+        "       %.4g a square unit (20 over s x s) a spell, and a fifth of that anywhere;\n"
+        "       each crack then grows three steps of %.4g (1.5 input texels, so its\n"
+        "       points touch) along the weakest paint, %.0f%% of which can crack. Where a\n"
+        "       fifth of a spell's rain (%.4g) stays, the paint peels from the cracks'\n"
+        "       edges and on from the flakes, %.4g a spell (s/200, at least two texels),\n"
+        "       with probability 0.3 a point; then half the water evaporates\n"
+        "       (docs/design.md section 15). The frames mask.0001.exr ... show it age. -->\n"
+        "  <Ageing>\n"
+        "    <Seed substance=\"crack\" density=\"%.6g\" where=\"water\" min=\"%.6g\"/>\n"
+        "    <Seed substance=\"crack\" density=\"%.6g\"/>\n",
+        beaten, 20.0 / s2, step, 60.0, soaked, flake, 20.0 / s2, beaten, 4.0 / s2);
+    for (int k = 0; k < 3; ++k) {
+        put(t, "    <Crack substance=\"crack\" radius=\"%.6g\" strength=\"0.6\"/>\n", step);
+    }
+    put(t,
+        "    <Peel substance=\"peel\" from=\"crack\" radius=\"%.6g\" probability=\"0.3\" "
+        "where=\"water\" min=\"%.6g\"/>\n"
+        "    <Decay substance=\"water\" rate=\"0.5\"/>\n"
+        "  </Ageing>\n",
+        flake, soaked);
+}
 
 // The steepness of a Combine term's sigmoid (docs/masks.md) that goes from 0.1
 // to 0.9 over its offset +- w: S(o + w) = 0.9 when w sqrt(s) = 4/3.
@@ -426,7 +515,8 @@ wx_result wx_scene_generate(const wx_init_def *def, char **out_text, wx_error *e
     *out_text = NULL;
     int pi = wx_preset_find(def->preset != NULL ? def->preset : "rain");
     if (pi < 0) {
-        return wx_fail(err, WX_CAUSE_USAGE, "unknown preset '%s' (presets: rain, dust, soot, moss)",
+        return wx_fail(err, WX_CAUSE_USAGE,
+                       "unknown preset '%s' (presets: rain, dust, soot, moss, rust, old_paint)",
                        def->preset);
     }
     const preset *p = &presets[pi];
@@ -520,9 +610,12 @@ static wx_result generate(const wx_init_def *def, const preset *p, int pi,
         return wx_fail(err, WX_CAUSE_BAD_MESH, "%s: the mesh %s", def->mesh_path, why);
     }
     // The input cameras' texel: moss's at a quarter of the resolution, at
-    // least 256 texels across (below).
+    // least 256 texels across (below); rust's and old paint's at half, at
+    // least 256 across: their automata's points are these texels, and a
+    // bloom's or a crack's edge is one of them wide.
     const double in_texel = pi == PRESET_MOSS && R > 256 ? texel * R / fmax(256.0, 0.25 * R)
-                                                         : texel;
+                            : automata_preset(pi) && R > 256 ? texel * R / fmax(256.0, 0.5 * R)
+                                                             : texel;
 
     // The fall: from H above the top at the preset's speed under its gravity;
     // the wind's drift over it widens the emitter upwind.
@@ -658,6 +751,16 @@ static wx_result generate(const wx_init_def *def, const preset *p, int pi,
             "  <!-- The rain carries water; the mask 'moss' below says where it lingers in\n"
             "       shelter and shade. -->\n"
             "  <Substances>\n    <Substance name=\"water\"/>\n  </Substances>\n");
+    } else if (pi == PRESET_RUST) {
+        put(&t, "  <!-- The rain carries water; rust grows where it lingers (<Ageing> below). -->\n"
+                "  <Substances>\n    <Substance name=\"water\"/>\n    <Substance name=\"rust\"/>\n"
+                "  </Substances>\n");
+    } else if (pi == PRESET_OLD_PAINT) {
+        put(&t, "  <!-- The rain carries water; the paint's cracks and its peeled flakes are\n"
+                "       substances of their own, so the mask has crack.Y and peel.Y (<Ageing>\n"
+                "       below). -->\n"
+                "  <Substances>\n    <Substance name=\"water\"/>\n    <Substance name=\"crack\"/>\n"
+                "    <Substance name=\"peel\"/>\n  </Substances>\n");
     }
     put(&t,
         "  <Solver>\n"
@@ -705,8 +808,8 @@ static wx_result generate(const wx_init_def *def, const preset *p, int pi,
         "                speed=\"%.6g\" maxCollisions=\"%d\"%s>\n",
         0.75, p->particles, wx_preset_names[pi], e_lo[0], e_lo[1], e_lo[2], e_hi[0], e_hi[1],
         e_hi[2], edir[0], edir[1], edir[2], p->spread, rate, emit, v, MAX_COLLISIONS,
-        pi == PRESET_MOSS ? "" : " dirt=\"1\"");
-    if (pi == PRESET_MOSS) {
+        wet_preset(pi) ? "" : " dirt=\"1\"");
+    if (wet_preset(pi)) {
         put(&t, "      <Load substance=\"water\" amount=\"1\"/>\n");
     }
     put(&t, "    </BoxEmitter>\n  </Emitters>\n");
@@ -718,7 +821,13 @@ static wx_result generate(const wx_init_def *def, const preset *p, int pi,
         "           texel (a resolution of %d across the largest). -->\n",
         p->resilience, p->friction, p->bottom ? " and below" : "", in_texel,
         (int)ceil((size + 2.0 * margin) / in_texel - 1e-9));
-    if (in_texel > texel) {
+    if (in_texel > texel && automata_preset(pi)) {
+        put(&t,
+            "      <!-- Half the output's and the texture's resolution (at least 256 across):\n"
+            "           the %s rules' points are these texels, a quarter as many as at the\n"
+            "           full resolution, so each spell's rules cost a quarter. -->\n",
+            pi == PRESET_RUST ? "rust's" : "paint's");
+    } else if (in_texel > texel) {
         put(&t,
             "      <!-- A quarter of the output's and the texture's resolution (at least 256\n"
             "           across): moss is a soft mask, its water smoothed over many texels and\n"
@@ -737,14 +846,14 @@ static wx_result generate(const wx_init_def *def, const preset *p, int pi,
         "      <!-- Layers: the surfaces a ray along the camera's axis crosses, at most %d\n"
         "           (the mesh's depth complexity along z, x, y: %d, %d, %d). -->\n",
         INIT_LAYERS, lz, lx, ly);
-    camera(&t, "front", c, (const double[3]){ 0, 0, 1 }, Y, d, fx, fy, in_texel, false, 0, lz);
-    camera(&t, "back", c, (const double[3]){ 0, 0, -1 }, Y, d, fx, fy, in_texel, false, 0, lz);
-    camera(&t, "left", c, (const double[3]){ -1, 0, 0 }, Y, d, fz, fy, in_texel, false, 0, lx);
-    camera(&t, "right", c, (const double[3]){ 1, 0, 0 }, Y, d, fz, fy, in_texel, false, 0, lx);
-    camera(&t, "top", c, Y, NZ, d, fx, fz, in_texel, false, 0, ly);
+    camera(&t, "front", c, (const double[3]){ 0, 0, 1 }, Y, d, fx, fy, in_texel, false, 0, lz, 0);
+    camera(&t, "back", c, (const double[3]){ 0, 0, -1 }, Y, d, fx, fy, in_texel, false, 0, lz, 0);
+    camera(&t, "left", c, (const double[3]){ -1, 0, 0 }, Y, d, fz, fy, in_texel, false, 0, lx, 0);
+    camera(&t, "right", c, (const double[3]){ 1, 0, 0 }, Y, d, fz, fy, in_texel, false, 0, lx, 0);
+    camera(&t, "top", c, Y, NZ, d, fx, fz, in_texel, false, 0, ly, 0);
     if (p->bottom) {
         camera(&t, "bottom", c, (const double[3]){ 0, -1, 0 }, PZ, d, fx, fz, in_texel, false, 0,
-               ly);
+               ly, 0);
     }
     // The output camera looks at the side the particles come at: against their
     // velocity where they reach the mesh (the wind's side; the front right
@@ -771,13 +880,16 @@ static wx_result generate(const wx_init_def *def, const preset *p, int pi,
         "      <!-- The output camera: a three-quarter view of the side the particles come at,\n"
         "           from azimuth %.0f degrees (from +X towards +Z), %.0f degrees up. -->\n",
         atan2(hz, hx) / DEG, elevation);
-    camera(&t, "shot", c, q, Y, d, diag, diag, texel, true, R, 1);
+    camera(&t, "shot", c, q, Y, d, diag, diag, texel, true, R, 1, automata_preset(pi) ? 1 : 0);
     put(&t, "    </ProjectedMaps>\n  </Collider>\n");
     if (pi == PRESET_MOSS) {
         put(&t,
             "  <!-- Between spells half the water evaporates: what is left is the recent\n"
             "       rain's, the older spells' halved again each time. -->\n"
             "  <Ageing>\n    <Decay substance=\"water\" rate=\"0.5\"/>\n  </Ageing>\n");
+    } else if (automata_preset(pi)) {
+        ageing_automata(&t, pi, size, in_texel,
+                        rate * emit / ((e_hi[0] - e_lo[0]) * (e_hi[2] - e_lo[2])));
     }
     put(&t,
         "  <Geometry>\n"
@@ -785,7 +897,7 @@ static wx_result generate(const wx_init_def *def, const preset *p, int pi,
         "      <!-- Every material alike: edit or add <Surface material=\"NAME\"> per material. -->\n"
         "      <Surface material=\"*\" absorption=\"%.6g\" bounce=\"%.6g\"",
         mesh_attr, p->absorption, p->bounce);
-    if (pi == PRESET_MOSS) {
+    if (wet_preset(pi)) {
         put(&t, ">\n        <Exchange substance=\"water\" deposit=\"%.6g\" erosion=\"%.6g\"/>\n"
                 "      </Surface>\n",
             p->deposit, p->erosion);
