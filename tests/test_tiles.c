@@ -166,8 +166,8 @@ static void compare(const char *dir, const char *name, const char *channel, bool
     float *sa = has_seen ? ensure_read_channel(whole, "seen", &w[0], &h[0]) : NULL;
     float *sb = has_seen ? ensure_read_channel(other, "seen", &w[1], &h[1]) : NULL;
     float *sm = has_seen ? ensure_read_channel(merged, "seen", &w[2], &h[2]) : NULL;
-    bool ok = a != NULL && b != NULL && m != NULL && w[0] == w[1] && w[0] == w[2] &&
-              h[0] == h[1] && h[0] == h[2] && (!has_seen || (sa && sb && sm));
+    bool ok = a != NULL && b != NULL && m != NULL && w[0] == w[1] && w[0] == w[2] && h[0] == h[1] &&
+              h[0] == h[2] && (!has_seen || (sa && sb && sm));
     ENSURE(ok);
     if (ok && has_seen) {
         // No texel written by two tiles: seen is 0 or 1, and as the whole run's.

@@ -122,8 +122,7 @@ static const wx_view *view_of(const wx_tile_scene_edit *edit, const char *camera
 static wx_result edit_cameras(parser *p, xmlNode *maps, const wx_tile_scene_edit *edit,
                               const char *scene_dir)
 {
-    static const char *const map_elements[] = { "DepthMap", "NormalMap", "ImpactMap",
-                                                 "DirtMap" };
+    static const char *const map_elements[] = { "DepthMap", "NormalMap", "ImpactMap", "DirtMap" };
     xmlNode *next = NULL;
     for (xmlNode *ortho = maps->children; ortho != NULL; ortho = next) {
         next = ortho->next;

@@ -29,7 +29,7 @@ static bool join_path(char *out, size_t cap, const char *dir, const char *name)
 
 typedef struct tile_ref {
     int ix, iz;
-    char scene[WX_PATH_MAX]; ///< DIR/tile_IX_IZ.xml
+    char scene[WX_PATH_MAX];  ///< DIR/tile_IX_IZ.xml
     char folder[WX_PATH_MAX]; ///< DIR/tile_IX_IZ
 } tile_ref;
 
@@ -82,8 +82,7 @@ static wx_result find_tiles(const char *dir, tile_ref **out, int *count, wx_erro
     closedir(d);
     if (r == WX_OK && n == 0) {
         r = wx_fail(err, WX_CAUSE_FILE_MISSING,
-                    "%s: no tile scenes (tile_IX_IZ.xml, as `weathering tiles` writes them)",
-                    dir);
+                    "%s: no tile scenes (tile_IX_IZ.xml, as `weathering tiles` writes them)", dir);
     }
     if (r != WX_OK) {
         free(tiles);
@@ -102,8 +101,7 @@ static int digit_groups(const char *name, const char *file)
 {
     size_t base = wx_output_base_length(file);
     size_t len = strlen(name);
-    if (strncmp(name, file, base) != 0 || len < base + 4 ||
-        strcmp(name + len - 4, ".exr") != 0) {
+    if (strncmp(name, file, base) != 0 || len < base + 4 || strcmp(name + len - 4, ".exr") != 0) {
         return -1;
     }
     int groups = 0;
@@ -160,8 +158,7 @@ typedef struct mask_layout {
     wx_camera camera;
 } mask_layout;
 
-static wx_result layout_masks(const wx_scene *scenes, int count, mask_layout *out,
-                              wx_error *err)
+static wx_result layout_masks(const wx_scene *scenes, int count, mask_layout *out, wx_error *err)
 {
     memset(out, 0, sizeof *out);
     out->x = calloc((size_t)count, sizeof *out->x);
@@ -251,9 +248,8 @@ static wx_result sum_tiles(const tile_ref *tiles, int count, const char *name,
             }
             sum->attr_count = img.attr_count;
         }
-        bool same = r == WX_OK && img.channel_count == sum->channel_count &&
-                    ox + img.width <= W && oy + img.height <= H &&
-                    (layout != NULL || (img.width == W && img.height == H));
+        bool same = r == WX_OK && img.channel_count == sum->channel_count && ox + img.width <= W &&
+                    oy + img.height <= H && (layout != NULL || (img.width == W && img.height == H));
         for (int c = 0; same && c < img.channel_count; ++c) {
             same = strcmp(img.channel_names[c], sum->channel_names[c]) == 0;
         }
@@ -289,8 +285,8 @@ static wx_result write_previews(const wx_scene *scene, const char *out_dir, cons
         if (!join_path(path, sizeof path, out_dir, previews[c])) {
             return wx_fail(err, WX_CAUSE_PATH_TOO_LONG, "%s: folder path too long", out_dir);
         }
-        r = wx_preview_write_png(path, image->channels[c], surface, image->width,
-                                 image->height, err);
+        r = wx_preview_write_png(path, image->channels[c], surface, image->width, image->height,
+                                 err);
     }
     return r;
 }
@@ -323,7 +319,8 @@ static float *preview_surface(const wx_scene *scenes, const tile_ref *tiles, int
             memset(&maps, 0, sizeof maps);
             wx_error err;
             if (fits &&
-                wx_maps_load(&maps, WX_MAPS_DEPTH, threads, path, NULL, NULL, NULL, &err) == WX_OK &&
+                wx_maps_load(&maps, WX_MAPS_DEPTH, threads, path, NULL, NULL, NULL, &err) ==
+                    WX_OK &&
                 layout->x[k] + maps.width <= image->width &&
                 layout->y[k] + maps.height <= image->height) {
                 for (int j = 0; j < maps.height; ++j) {
@@ -461,8 +458,8 @@ wx_result wx_merge_tiles(const wx_merge_def *def, wx_error *err)
             r = wx_exr_write(path, &sum, err);
         }
         if (r == WX_OK && kind == 1) {
-            float *surface = preview_surface(scenes, tiles, count, mask ? &layout : NULL, &sum,
-                                             def->threads);
+            float *surface =
+                preview_surface(scenes, tiles, count, mask ? &layout : NULL, &sum, def->threads);
             r = write_previews(scene, out_dir, e->d_name, &sum, surface, err);
             free(surface);
         }
@@ -478,8 +475,8 @@ wx_result wx_merge_tiles(const wx_merge_def *def, wx_error *err)
             long long p = tile_particles(&tiles[k]);
             particles = p >= 0 ? particles + p : -1;
         }
-        fprintf(stderr, "merge: %d tiles of %s joined into %s: %d files", count, def->dir,
-                out_dir, files);
+        fprintf(stderr, "merge: %d tiles of %s joined into %s: %d files", count, def->dir, out_dir,
+                files);
         if (particles >= 0) {
             fprintf(stderr, "; %lld particles, each counted in the one tile it starts in",
                     particles);

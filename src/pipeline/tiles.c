@@ -192,8 +192,8 @@ static wx_result write_slurm(const wx_tiles_def *def, const char *dir, const cha
     return r;
 }
 
-static wx_result write_tile(const wx_tiles_def *def, const wx_scene *scene, const char *dir,
-                            int ix, int iz, int *cameras_out, wx_error *err)
+static wx_result write_tile(const wx_tiles_def *def, const wx_scene *scene, const char *dir, int ix,
+                            int iz, int *cameras_out, wx_error *err)
 {
     const double half = 0.5 * (double)scene->bbox_size;
     double lo[3], hi[3];
@@ -291,8 +291,8 @@ wx_result wx_tiles_write(const wx_tiles_def *def, wx_error *err)
     }
     if (scene.tile.present) {
         r = wx_fail(err, WX_CAUSE_BAD_SCENE,
-                    "%s:%d: the scene is already a tile (<Tile>): cut the whole scene",
-                    scene.path, scene.tile.line);
+                    "%s:%d: the scene is already a tile (<Tile>): cut the whole scene", scene.path,
+                    scene.tile.line);
     }
     for (int c = 0; c < scene.camera_count && r == WX_OK; ++c) {
         const wx_scene_camera *sc = &scene.cameras[c];

@@ -24,16 +24,16 @@ void wx_tile_restrict_camera(const wx_scene *scene, const wx_camera *camera, con
 /// A TextureMap: zeroes every channel of every texel whose surface point
 /// (position, 3 doubles a texel; valid where covered[i]) the tile does not own.
 /// Texels without a point keep their values (0). Nothing happens without a <Tile>.
-void wx_tile_restrict_points(const wx_scene *scene, const double *position,
-                             const float *seen, wx_image *image);
+void wx_tile_restrict_points(const wx_scene *scene, const double *position, const float *seen,
+                             wx_image *image);
 
 /// What `weathering tiles` is asked for.
 typedef struct wx_tiles_def {
     const char *scene_path;
-    int nx, nz;       ///< tiles along x and z, >= 1
-    double halo;      ///< world units, >= 0
+    int nx, nz;  ///< tiles along x and z, >= 1
+    double halo; ///< world units, >= 0
     const char *out_dir;
-    bool slurm;       ///< also write tiles.sbatch, merge.sbatch and submit.sh
+    bool slurm;          ///< also write tiles.sbatch, merge.sbatch and submit.sh
     const char *program; ///< the weathering program the job scripts run
     bool quiet;
 } wx_tiles_def;

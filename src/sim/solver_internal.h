@@ -179,7 +179,7 @@ wx_result sim_setup_ageing(wx_sim *sim, int c, wx_error *err);
 // memory (the surface automata's points and grids).
 wx_result sim_age(wx_sim *sim, wx_error *err);
 
-// ageing.c: `count` rules on one texel's amounts a[] and baseline b[] (may be
+// point_rules.c: `count` rules on one texel's amounts a[] and baseline b[] (may be
 // NULL), `area` the surface it grows on; Seed and Spread are not run here.
 void sim_run_rules(const wx_rule *rules, int count, double *a, double *b, double area,
                    wx_substance_ledger *ledger);
