@@ -268,6 +268,16 @@ TEST(tiles_and_merge_refuse_what_they_cannot_do)
     ENSURE(strstr(out, "already a tile") != NULL);
     ENSURE(run_in(dir, "merge t%s%s", "", "") == 2);
     ENSURE(strstr(out, "run the tile first") != NULL);
+    // Never over the scene it cuts, nor into a tile's own folder.
+    char cmd[PATH_MAX + 64];
+    snprintf(cmd, sizeof cmd, "cp '%s/street.xml' '%s/tile_0_0.xml'", dir, dir);
+    ENSURE(system(cmd) == 0);
+    ENSURE(run_in(dir, "tiles tile_0_0.xml --tiles 1 1 --out .%s%s", "", "") == 2);
+    ENSURE(strstr(out, "would replace the scene itself") != NULL);
+    snprintf(cmd, sizeof cmd, "mkdir -p '%s/t/tile_0_0' '%s/t/tile_1_0'", dir, dir);
+    ENSURE(system(cmd) == 0);
+    ENSURE(run_in(dir, "merge t --out t/tile_1_0%s%s", "", "") == 2);
+    ENSURE(strstr(out, "write over tile 1 0") != NULL);
 }
 
 int main(void)

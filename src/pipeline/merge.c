@@ -2,6 +2,7 @@
 // every final file and frame, joined into one. Each tile wrote only the points
 // it owns and zero elsewhere, so the join is the sum of the tiles' files: each
 // texel takes the one tile's value that is not zero.
+#define _XOPEN_SOURCE 700 // realpath
 #include "pipeline/tiles.h"
 
 #include <dirent.h>
@@ -423,6 +424,18 @@ wx_result wx_merge_tiles(const wx_merge_def *def, wx_error *err)
     }
     if (r == WX_OK) {
         r = wx_make_folders(out_dir, created, err);
+    }
+    // Never into a tile's own folder: its files are the merge's inputs.
+    char real_out[WX_PATH_MAX], real_tile[WX_PATH_MAX];
+    if (r == WX_OK && realpath(out_dir, real_out) != NULL) {
+        for (int k = 0; k < count && r == WX_OK; ++k) {
+            if (realpath(tiles[k].folder, real_tile) != NULL && strcmp(real_out, real_tile) == 0) {
+                r = wx_fail(err, WX_CAUSE_OUTPUT_CONFLICT,
+                            "%s: the merge would write over tile %d %d's own files: use another "
+                            "--out",
+                            out_dir, tiles[k].ix, tiles[k].iz);
+            }
+        }
     }
     // Every output of the first tile's folder that is a mask's or a texture's.
     DIR *d = r == WX_OK ? opendir(tiles[0].folder) : NULL;

@@ -272,7 +272,16 @@ static wx_result write_tile(const wx_tiles_def *def, const wx_scene *scene, cons
         }
     }
     if (r == WX_OK) {
-        r = wx_write_file_atomic(path, text, size, err);
+        // Never over the scene it was cut from.
+        char a[WX_PATH_MAX], b[WX_PATH_MAX];
+        if (realpath(def->scene_path, a) != NULL && realpath(path, b) != NULL &&
+            strcmp(a, b) == 0) {
+            r = wx_fail(err, WX_CAUSE_OUTPUT_CONFLICT,
+                        "%s: the tile scene %s would replace the scene itself: use another --out",
+                        def->scene_path, path);
+        } else {
+            r = wx_write_file_atomic(path, text, size, err);
+        }
     }
     *cameras_out = count;
     free(text);
