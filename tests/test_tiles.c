@@ -13,6 +13,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "block_rms.h"
 #include "ensure.h"
 #include "run_fixture.h"
 
@@ -118,38 +119,15 @@ static long long stats_value(const char *path, const char *key)
     return at != NULL && sscanf(at + strlen(quoted), "%lld", &v) == 1 ? v : -1;
 }
 
-// RMS of the differences of k x k block means of a and b (over blocks where
-// both are seen, `seen` NULL: everywhere), relative to their mean.
+// RMS of the differences of k x k block means of a and b (block_rms.h),
+// relative to their mean.
 static double block_rms(const float *a, const float *b, const float *seen_a, const float *seen_b,
                         int w, int h, int k)
 {
-    double sum = 0.0, total = 0.0;
-    long blocks = 0, texels = 0;
-    for (int by = 0; by + k <= h; by += k) {
-        for (int bx = 0; bx + k <= w; bx += k) {
-            double da = 0.0, db = 0.0;
-            int n = 0;
-            for (int y = by; y < by + k; ++y) {
-                for (int x = bx; x < bx + k; ++x) {
-                    size_t i = (size_t)y * (size_t)w + (size_t)x;
-                    if (seen_a == NULL || (seen_a[i] > 0.5f && seen_b[i] > 0.5f)) {
-                        da += a[i];
-                        db += b[i];
-                        n++;
-                    }
-                }
-            }
-            if (2 * n >= k * k && n > 0) {
-                double d = (da - db) / n;
-                sum += d * d;
-                total += da + db;
-                texels += 2 * n;
-                blocks++;
-            }
-        }
-    }
-    double mean = texels > 0 ? total / (double)texels : 0.0;
-    return blocks > 0 && mean > 0.0 ? sqrt(sum / (double)blocks) / mean : INFINITY;
+    double mean = wx_block_mean(a, b, seen_a, seen_b, w, h, NULL);
+    long blocks = 0;
+    double rms = wx_block_rms(a, b, seen_a, seen_b, w, h, k, &blocks);
+    return blocks > 0 && mean > 0.0 ? rms / mean : INFINITY;
 }
 
 // The merged file against the whole run's, and two seeds of the whole run.

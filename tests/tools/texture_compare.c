@@ -16,6 +16,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../block_rms.h"
 #include "io/exr.h"
 #include "model/image.h"
 
@@ -57,43 +58,12 @@ int main(int argc, char **argv)
     float *sa = read_channel(argv[1], "seen", &w2, &h2, true);
     float *sb = read_channel(argv[2], "seen", &w2, &h2, true);
     int w = wa, h = ha;
-    double sum = 0.0;
     long count = 0;
-    for (long i = 0; i < (long)w * h; ++i) {
-        bool seen = (sa == NULL || sa[i] > 0.5f) && (sb == NULL || sb[i] > 0.5f);
-        if (seen && isfinite(a[i]) && isfinite(b[i])) {
-            sum += 0.5 * ((double)a[i] + (double)b[i]);
-            count++;
-        }
-    }
-    double mean = count > 0 ? sum / (double)count : 0.0;
+    double mean = wx_block_mean(a, b, sa, sb, w, h, &count);
     printf("texels %ld, mean %.6g\n", count, mean);
     for (int k = 1; k <= 32; k *= 2) {
-        double sq = 0.0;
         long blocks = 0;
-        for (int by = 0; by + k <= h; by += k) {
-            for (int bx = 0; bx + k <= w; bx += k) {
-                double da = 0.0, db = 0.0;
-                int n = 0;
-                for (int y = by; y < by + k; ++y) {
-                    for (int x = bx; x < bx + k; ++x) {
-                        long i = (long)y * w + x;
-                        bool seen = (sa == NULL || sa[i] > 0.5f) && (sb == NULL || sb[i] > 0.5f);
-                        if (seen && isfinite(a[i]) && isfinite(b[i])) {
-                            da += a[i];
-                            db += b[i];
-                            n++;
-                        }
-                    }
-                }
-                if (2 * n >= k * k && n > 0) {
-                    double d = (da - db) / n;
-                    sq += d * d;
-                    blocks++;
-                }
-            }
-        }
-        double rms = blocks > 0 ? sqrt(sq / (double)blocks) : 0.0;
+        double rms = wx_block_rms(a, b, sa, sb, w, h, k, &blocks);
         printf("block %2d: rms/mean %.4f over %ld blocks\n", k, mean > 0.0 ? rms / mean : 0.0,
                blocks);
     }
