@@ -21,13 +21,6 @@
 #include "model/naming.h"
 #include "pipeline/outputs.h"
 
-// DIR/NAME into `out` (cap bytes); false when it does not fit.
-static bool join_path(char *out, size_t cap, const char *dir, const char *name)
-{
-    int n = snprintf(out, cap, "%s/%s", dir, name);
-    return n > 0 && (size_t)n < cap;
-}
-
 typedef struct tile_ref {
     int ix, iz;
     char scene[WX_PATH_MAX];  ///< DIR/tile_IX_IZ.xml
@@ -191,19 +184,7 @@ static wx_result layout_masks(const wx_scene *scenes, int count, mask_layout *ou
         out->y[k] -= y0;
     }
     // The camera over the union: the first tile's, moved by whole pixels.
-    float centre[3] = { (float)((x0 + x1) / (2.0 * W0)), (float)(1.0 - (y0 + y1) / (2.0 * H0)),
-                        0.0f };
-    float eye[3];
-    wx_camera_map_to_world(&ref->camera, centre, eye);
-    out->view = ref->view;
-    for (int a = 0; a < 3; ++a) {
-        out->view.target[a] = eye[a] + (ref->view.target[a] - ref->view.eye[a]);
-        out->view.eye[a] = eye[a];
-    }
-    out->view.width_px = out->width;
-    out->view.height_px = out->height;
-    out->view.width_ws = (float)(ref->view.width_ws * (double)out->width / W0);
-    out->view.height_ws = (float)(ref->view.height_ws * (double)out->height / H0);
+    wx_view_window(&ref->view, &ref->camera, x0, x1, y0, y1, &out->view);
     wx_result r = wx_camera_from_view(&out->view, &out->camera, err);
     out->camera.width = out->width;
     out->camera.height = out->height;
@@ -224,7 +205,7 @@ static wx_result sum_tiles(const tile_ref *tiles, int count, const char *name,
     wx_result r = WX_OK;
     for (int k = 0; k < count && r == WX_OK; ++k) {
         char path[WX_PATH_MAX];
-        if (!join_path(path, sizeof path, tiles[k].folder, name)) {
+        if (!wx_tiles_join(path, sizeof path, tiles[k].folder, name)) {
             return wx_fail(err, WX_CAUSE_PATH_TOO_LONG, "%s: folder path too long",
                            tiles[k].folder);
         }
@@ -283,7 +264,7 @@ static wx_result write_previews(const wx_scene *scene, const char *out_dir, cons
     wx_result r = WX_OK;
     for (int c = 0; c < count && c < image->channel_count && r == WX_OK; ++c) {
         char path[WX_PATH_MAX];
-        if (!join_path(path, sizeof path, out_dir, previews[c])) {
+        if (!wx_tiles_join(path, sizeof path, out_dir, previews[c])) {
             return wx_fail(err, WX_CAUSE_PATH_TOO_LONG, "%s: folder path too long", out_dir);
         }
         r = wx_preview_write_png(path, image->channels[c], surface, image->width, image->height,
@@ -314,7 +295,7 @@ static float *preview_surface(const wx_scene *scenes, const tile_ref *tiles, int
                 fits = len > 0 && (size_t)len < sizeof path;
             } else {
                 wx_map_file_name(out->name, WX_MAP_DEPTH, name, sizeof name);
-                fits = join_path(path, sizeof path, tiles[k].folder, name);
+                fits = wx_tiles_join(path, sizeof path, tiles[k].folder, name);
             }
             wx_maps maps;
             memset(&maps, 0, sizeof maps);
@@ -463,7 +444,7 @@ wx_result wx_merge_tiles(const wx_merge_def *def, wx_error *err)
             wx_image_set_string(&sum, "cameraName", out->name);
         }
         char path[WX_PATH_MAX];
-        if (r == WX_OK && !join_path(path, sizeof path, out_dir, e->d_name)) {
+        if (r == WX_OK && !wx_tiles_join(path, sizeof path, out_dir, e->d_name)) {
             r = wx_fail(err, WX_CAUSE_PATH_TOO_LONG, "%s: output folder path too long", out_dir);
         }
         if (r == WX_OK) {

@@ -75,6 +75,32 @@ static void tile_bounds(double lo, double hi, int n, int k, double *min, double 
     *max = k == n - 1 ? INFINITY : lo + step * (k + 1);
 }
 
+void wx_view_window(const wx_view *view, const wx_camera *cam, int i0, int i1, int j0, int j1,
+                    wx_view *out)
+{
+    const double W = view->width_px, H = view->height_px;
+    // The window's centre on the eye plane; the view direction and up stay.
+    float centre[3] = { (float)((i0 + i1) / (2.0 * W)), (float)(1.0 - (j0 + j1) / (2.0 * H)),
+                        0.0f };
+    float eye[3];
+    wx_camera_map_to_world(cam, centre, eye);
+    *out = *view;
+    for (int a = 0; a < 3; ++a) {
+        out->eye[a] = eye[a];
+        out->target[a] = eye[a] + (view->target[a] - view->eye[a]);
+    }
+    out->width_px = i1 - i0;
+    out->height_px = j1 - j0;
+    out->width_ws = (float)(view->width_ws * (double)out->width_px / W);
+    out->height_ws = (float)(view->height_ws * (double)out->height_px / H);
+}
+
+bool wx_tiles_join(char *out, size_t cap, const char *dir, const char *name)
+{
+    int n = snprintf(out, cap, "%s/%s", dir, name);
+    return n > 0 && (size_t)n < cap;
+}
+
 // Input camera `view` cropped, on its own texel grid, to what it sees of the
 // box [lo, hi] (the tile and its halo within the bounding box). False when
 // it sees none of it.
@@ -103,34 +129,14 @@ static bool crop_view(const wx_view *view, const double lo[3], const double hi[3
     if (i1 <= i0 || j1 <= j0) {
         return false;
     }
-    // The crop's centre on the eye plane; the view direction and up stay.
-    float centre[3] = { (float)((i0 + i1) / (2.0 * W)), (float)(1.0 - (j0 + j1) / (2.0 * H)),
-                        0.0f };
-    float eye[3];
-    wx_camera_map_to_world(&cam, centre, eye);
-    *out = *view;
-    for (int a = 0; a < 3; ++a) {
-        out->eye[a] = eye[a];
-        out->target[a] = eye[a] + (view->target[a] - view->eye[a]);
-    }
-    out->width_px = i1 - i0;
-    out->height_px = j1 - j0;
-    out->width_ws = (float)(view->width_ws * (double)out->width_px / W);
-    out->height_ws = (float)(view->height_ws * (double)out->height_px / H);
+    wx_view_window(view, &cam, i0, i1, j0, j1, out);
     return true;
-}
-
-// Joins `dir` and `name` into path; false when too long.
-static bool join(char path[WX_PATH_MAX], const char *dir, const char *name)
-{
-    int n = snprintf(path, WX_PATH_MAX, "%s/%s", dir, name);
-    return n > 0 && n < WX_PATH_MAX;
 }
 
 static wx_result write_text(const char *dir, const char *name, const char *text, wx_error *err)
 {
     char path[WX_PATH_MAX];
-    if (!join(path, dir, name)) {
+    if (!wx_tiles_join(path, sizeof path, dir, name)) {
         return wx_fail(err, WX_CAUSE_PATH_TOO_LONG, "%s: output folder path too long", dir);
     }
     return wx_write_file_atomic(path, text, strlen(text), err);
@@ -185,7 +191,7 @@ static wx_result write_slurm(const wx_tiles_def *def, const char *dir, const cha
                  dir);
         r = write_text(dir, "submit.sh", text, err);
         char path[WX_PATH_MAX];
-        if (r == WX_OK && join(path, dir, "submit.sh")) {
+        if (r == WX_OK && wx_tiles_join(path, sizeof path, dir, "submit.sh")) {
             chmod(path, 0755);
         }
     }
@@ -257,7 +263,7 @@ static wx_result write_tile(const wx_tiles_def *def, const wx_scene *scene, cons
     }
     // The tile scene must read back as a scene (it names the same files).
     char path[WX_PATH_MAX];
-    if (r == WX_OK && !join(path, dir, file)) {
+    if (r == WX_OK && !wx_tiles_join(path, sizeof path, dir, file)) {
         r = wx_fail(err, WX_CAUSE_PATH_TOO_LONG, "%s: output folder path too long", dir);
     }
     if (r == WX_OK) {

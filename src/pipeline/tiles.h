@@ -7,6 +7,7 @@
 #define WX_TILES_H
 
 #include <stdbool.h>
+#include <stddef.h>
 
 #include "core/error.h"
 #include "model/camera.h"
@@ -26,6 +27,16 @@ void wx_tile_restrict_camera(const wx_scene *scene, const wx_camera *camera, con
 /// Texels without a point keep their values (0). Nothing happens without a <Tile>.
 void wx_tile_restrict_points(const wx_scene *scene, const double *position, const float *seen,
                              wx_image *image);
+
+/// The window of `view` (its matrices `cam`) over its texel columns [i0, i1)
+/// and rows [j0, j1) (row 0 at the top; they may reach beyond its frame): the
+/// same texels, its eye moved sideways by whole texels. A tile's cameras are
+/// such windows, and so is the whole output camera over the tiles' masks.
+void wx_view_window(const wx_view *view, const wx_camera *cam, int i0, int i1, int j0, int j1,
+                    wx_view *out);
+
+/// DIR/NAME into `out` (cap bytes); false when it does not fit.
+bool wx_tiles_join(char *out, size_t cap, const char *dir, const char *name);
 
 /// What `weathering tiles` is asked for.
 typedef struct wx_tiles_def {
