@@ -229,6 +229,51 @@ TEST(a_street_run_as_tiles_merges_into_the_whole_run)
     ENSURE(strstr(text, "--dependency=afterok:") != NULL);
 }
 
+// A shot's tiles (docs/scale-out.md): of 4 x 4 tiles of the street's 40 m
+// box, the output camera (20 m over the centre) sees the middle 2 x 2, tasks
+// 5, 6, 9 and 10; tiles names them, and submit.sh takes them as its array.
+TEST(tiles_name_the_tasks_the_output_camera_sees)
+{
+    const char *dir = ensure_tmpdir();
+    write_street(dir);
+    write_scene(dir);
+    ENSURE(run_in(dir, "tiles street.xml --tiles 4 4 --halo 2 --out shot%s%s", " --slurm", "") ==
+           0);
+    ENSURE(strstr(out, "sees 4 of the 16 tiles (tasks 5,6,9,10") != NULL);
+    char path[PATH_MAX + 64], text[4096];
+    snprintf(path, sizeof path, "%s/shot/submit.sh", dir);
+    FILE *f = fopen(path, "r");
+    size_t n = f != NULL ? fread(text, 1, sizeof text - 1, f) : 0;
+    text[n] = '\0';
+    if (f != NULL) {
+        fclose(f);
+    }
+    ENSURE(strstr(text, "the output camera sees tasks 5,6,9,10") != NULL);
+    ENSURE(strstr(text, "${1:+--array=\"$1\"}") != NULL);
+    // Just those tiles, the others' scenes moved away: merge joins them.
+    if (!ensure_fast()) {
+        char sh[64];
+        ENSURE(ensure_shell(sh, sizeof sh,
+                            "cd '%s/shot' && mkdir skipped && for t in tile_*.xml; do case $t in "
+                            "tile_[12]_[12].xml) ;; *) mv $t skipped/;; esac; done",
+                            dir) == 0);
+        const char *tiles[] = { "1_1", "2_1", "1_2", "2_2" };
+        for (int k = 0; k < 4; ++k) {
+            char args[128];
+            snprintf(args, sizeof args, "run shot/tile_%s.xml --out shot/tile_%s -q", tiles[k],
+                     tiles[k]);
+            ENSURE(weathering_in(dir, args, true) == 0);
+        }
+        ENSURE(run_in(dir, "merge shot%s%s", "", "") == 0);
+        ENSURE(strstr(out, "4 tiles") != NULL);
+        snprintf(path, sizeof path, "%s/shot/merged/mask.exr", dir);
+        ENSURE(access(path, R_OK) == 0);
+    }
+    // Every tile is seen when the camera covers them all: nothing printed.
+    ENSURE(run_in(dir, "tiles street.xml --tiles 2 2 --out all%s%s", "", "") == 0);
+    ENSURE(strstr(out, "sees") == NULL);
+}
+
 TEST(tiles_and_merge_refuse_what_they_cannot_do)
 {
     const char *dir = ensure_tmpdir();
@@ -262,5 +307,6 @@ int main(void)
 {
     RUN(a_street_run_as_tiles_merges_into_the_whole_run);
     RUN(tiles_and_merge_refuse_what_they_cannot_do);
+    RUN(tiles_name_the_tasks_the_output_camera_sees);
     return ensure_summary();
 }

@@ -145,7 +145,7 @@ static wx_result write_text(const char *dir, const char *name, const char *text,
 // tiles.sbatch (the job array), merge.sbatch and submit.sh, which submits both
 // with the merge after the array (afterok).
 static wx_result write_slurm(const wx_tiles_def *def, const char *dir, const char *name,
-                             wx_error *err)
+                             const char *shot, wx_error *err)
 {
     char text[4 * WX_PATH_MAX + 2048];
     snprintf(text, sizeof text,
@@ -182,13 +182,16 @@ static wx_result write_slurm(const wx_tiles_def *def, const char *dir, const cha
         snprintf(text, sizeof text,
                  "#!/bin/sh\n"
                  "# Submits the tiles' job array and the merge that waits for it (afterok).\n"
+                 "# ./submit.sh TASKS submits only those tasks (sbatch --array=TASKS, task\n"
+                 "# IX + %d * IZ): the output camera sees tasks %s. Merge joins the tile\n"
+                 "# scenes in this folder: move the others' tile_IX_IZ.xml away first.\n"
                  "set -eu\n"
                  "cd '%s'\n"
                  "mkdir -p logs\n"
-                 "tiles=$(sbatch --parsable tiles.sbatch)\n"
+                 "tiles=$(sbatch --parsable ${1:+--array=\"$1\"} tiles.sbatch)\n"
                  "merge=$(sbatch --parsable --dependency=afterok:${tiles%%%%;*} merge.sbatch)\n"
                  "echo \"tiles: job ${tiles%%%%;*}; merge: job ${merge%%%%;*}\"\n",
-                 dir);
+                 def->nx, shot[0] != '\0' ? shot : "none", dir);
         r = write_text(dir, "submit.sh", text, err);
         char path[WX_PATH_MAX];
         if (r == WX_OK && wx_tiles_join(path, sizeof path, dir, "submit.sh")) {
@@ -198,8 +201,10 @@ static wx_result write_slurm(const wx_tiles_def *def, const char *dir, const cha
     return r;
 }
 
+// Writes tile IX IZ's scene; *cameras_out: its input cameras; *shot: whether
+// the output camera sees the tile itself (not only its halo).
 static wx_result write_tile(const wx_tiles_def *def, const wx_scene *scene, const char *dir, int ix,
-                            int iz, int *cameras_out, wx_error *err)
+                            int iz, int *cameras_out, bool *shot, wx_error *err)
 {
     const double half = 0.5 * (double)scene->bbox_size;
     double lo[3], hi[3];
@@ -234,10 +239,15 @@ static wx_result write_tile(const wx_tiles_def *def, const wx_scene *scene, cons
     // own pixels, and merge places the crops on the whole camera's pixel grid.
     wx_view output_view;
     bool crop_output = false;
+    *shot = false;
     if (scene->output_index >= 0) {
         const wx_scene_camera *out = &scene->cameras[scene->output_index];
         crop_output = out->has_view && out->depth_path == NULL &&
                       crop_view(&out->view, box_lo, box_hi, &output_view);
+        const double own_lo[3] = { fmax(lo[0], tile.min[0]), lo[1], fmax(lo[2], tile.min[1]) };
+        const double own_hi[3] = { fmin(hi[0], tile.max[0]), hi[1], fmin(hi[2], tile.max[1]) };
+        wx_view unused;
+        *shot = crop_output && crop_view(&out->view, own_lo, own_hi, &unused);
     }
     char name[64], file[80];
     snprintf(name, sizeof name, "tile_%d_%d", ix, iz);
@@ -325,16 +335,30 @@ wx_result wx_tiles_write(const wx_tiles_def *def, wx_error *err)
     if (r == WX_OK && realpath(def->out_dir, dir) == NULL) {
         r = wx_fail(err, WX_CAUSE_IO, "%s: the folder cannot be resolved", def->out_dir);
     }
-    int cameras = 0, most = 0, least = INT32_MAX;
+    // The tiles a shot needs: those the output camera sees, as the job
+    // array's task numbers ("5,6,9,10"; docs/scale-out.md).
+    const size_t shot_cap = (size_t)def->nx * (size_t)def->nz * 8 + 1;
+    char *shot = r == WX_OK ? calloc(shot_cap, 1) : NULL;
+    if (r == WX_OK && shot == NULL) {
+        r = wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "tiles: out of memory");
+    }
+    int cameras = 0, most = 0, least = INT32_MAX, shots = 0;
+    size_t used = 0;
     for (int iz = 0; iz < def->nz && r == WX_OK; ++iz) {
         for (int ix = 0; ix < def->nx && r == WX_OK; ++ix) {
-            r = write_tile(def, &scene, dir, ix, iz, &cameras, err);
+            bool seen = false;
+            r = write_tile(def, &scene, dir, ix, iz, &cameras, &seen, err);
             most = cameras > most ? cameras : most;
             least = cameras < least ? cameras : least;
+            if (seen) {
+                used += (size_t)snprintf(shot + used, shot_cap - used, "%s%d", shots ? "," : "",
+                                         ix + def->nx * iz);
+                ++shots;
+            }
         }
     }
     if (r == WX_OK && def->slurm) {
-        r = write_slurm(def, dir, scene.name, err);
+        r = write_slurm(def, dir, scene.name, shot, err);
     }
     if (r == WX_OK && !def->quiet) {
         fprintf(stderr,
@@ -342,7 +366,16 @@ wx_result wx_tiles_write(const wx_tiles_def *def, wx_error *err)
                 "cameras each%s\n",
                 def->nx, def->nz, scene.path, def->halo, dir, least, most,
                 def->slurm ? "; tiles.sbatch, merge.sbatch and submit.sh for Slurm" : "");
+        if (scene.output_index >= 0 && shots < def->nx * def->nz) {
+            fprintf(stderr,
+                    "tiles: the output camera '%s' sees %d of the %d tiles (tasks %s: tile IX + "
+                    "%d * IZ)%s\n",
+                    scene.cameras[scene.output_index].name, shots, def->nx * def->nz,
+                    shots ? shot : "none", def->nx,
+                    def->slurm && shots ? "; ./submit.sh with that list runs just them" : "");
+        }
     }
+    free(shot);
     wx_scene_free(&scene);
     return r;
 }
