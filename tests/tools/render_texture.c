@@ -12,8 +12,11 @@
 // orthographic projection) and the texture's channel and its `seen` are
 // sampled bilinearly in texel space (x = u*W - 0.5, y = (1-v)*H - 0.5, clamped
 // at the borders; a UV outside [0,1] first taken modulo 1, as the default
-// tiles="repeat" writes it). The mesh is taken as the file gives it (scenes
-// place meshes as they are).
+// tiles="repeat" writes it). A TEXTURE path with the token <UDIM>
+// (city_texture.<UDIM>.exr, as Blender names UDIM sets) reads every tile
+// 1001 ... 1999 that exists: a UV in [k, k+1) x [m, m+1) samples tile
+// 1001 + k + 10 m (all tiles of one size; a UV in a missing tile is unseen).
+// The mesh is taken as the file gives it (scenes place meshes as they are).
 //
 //   make build/tools/render_texture
 //   build/tools/render_texture MESH TEXTURE.exr [--channel NAME] [--uv N]
@@ -34,13 +37,15 @@
 //               (0.55 0.60 0.70) where seen < 0.5, on a dark grey background.
 //               white is --white, else the larger of 1 and the 99th percentile
 //               of the channel's positive values over the texels with seen > 0
-//               (as the previews: wx_preview_white).
+//               (as the previews: wx_preview_white); it prints `white X`.
 // Exit status 2 on bad arguments or unreadable files, 1 on other failures.
+#define _XOPEN_SOURCE 700 // access
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "core/error.h"
 #include "io/exr.h"
@@ -201,16 +206,31 @@ static int parse_args(int argc, char **argv, options *o)
 // ---------------------------------------------------------------------------
 // The texture.
 
+enum { UDIM_TILES = 999 };
+
 typedef struct texture {
     int width, height;
     const float *value;
     const float *seen;
+    int tiles; ///< 0, or UDIM_TILES: tile[k] is UDIM tile 1001 + k (NULL: missing)
+    const float *tile_value[UDIM_TILES], *tile_seen[UDIM_TILES];
 } texture;
 
 // Bilinear in texel space, centres at integers, clamped at the borders; UVs
 // outside [0,1] wrap (REPEAT, docs/texture.md), those inside are read as they are.
-static float sample(const texture *tex, const float *plane, double u, double v)
+static float sample(const texture *tex, bool seen, double u, double v)
 {
+    const float *plane = seen ? tex->seen : tex->value;
+    if (tex->tiles > 0) {
+        double k = floor(u), m = floor(v);
+        int tile = k >= 0.0 && k < 10.0 && m >= 0.0 && m < 100.0 ? (int)k + 10 * (int)m : -1;
+        if (tile < 0 || tile >= tex->tiles || tex->tile_value[tile] == NULL) {
+            return 0.0f;
+        }
+        plane = seen ? tex->tile_seen[tile] : tex->tile_value[tile];
+        u -= k;
+        v -= m;
+    }
     u = u < 0.0 || u > 1.0 ? u - floor(u) : u;
     v = v < 0.0 || v > 1.0 ? v - floor(v) : v;
     double x = u * tex->width - 0.5, y = (1.0 - v) * tex->height - 0.5;
@@ -230,13 +250,18 @@ static float sample(const texture *tex, const float *plane, double u, double v)
 static wx_result white_point(const texture *tex, float *white, wx_error *err)
 {
     size_t texels = (size_t)tex->width * (size_t)tex->height, n = 0;
-    float *values = malloc((texels > 0 ? texels : 1) * sizeof *values);
+    int planes = tex->tiles > 0 ? tex->tiles : 1;
+    float *values = malloc((texels > 0 ? texels : 1) * (size_t)planes * sizeof *values);
     if (values == NULL) {
         return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (white point)");
     }
-    for (size_t t = 0; t < texels; ++t) {
-        if (tex->seen[t] > 0.0f) {
-            values[n++] = tex->value[t];
+    for (int k = 0; k < planes; ++k) {
+        const float *value = tex->tiles > 0 ? tex->tile_value[k] : tex->value;
+        const float *seen = tex->tiles > 0 ? tex->tile_seen[k] : tex->seen;
+        for (size_t t = 0; value != NULL && t < texels; ++t) {
+            if (seen[t] > 0.0f) {
+                values[n++] = value[t];
+            }
         }
     }
     wx_result r = wx_preview_scale(values, n, white, err);
@@ -436,7 +461,7 @@ static surface_sample sample_pixel(const wx_mesh_data *mesh, int uv, const textu
             n[c] += w[k] * mesh->normals[3 * (size_t)idx[k] + c];
         }
     }
-    surface_sample s = { sample(tex, tex->value, tu, tv), sample(tex, tex->seen, tu, tv),
+    surface_sample s = { sample(tex, false, tu, tv), sample(tex, true, tu, tv),
                          { 0.0f, 0.0f, 0.0f } };
     double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
     if (!(len > 1e-12)) {
@@ -549,6 +574,7 @@ static wx_result write_png(const char *path, const wx_mesh_data *mesh, int uv,
 
 // ---------------------------------------------------------------------------
 
+// image: one image, or UDIM_TILES for a <UDIM> path (tile k in image[k]).
 static wx_result load(const options *o, wx_mesh_data *mesh, wx_image *image, texture *tex,
                       wx_error *err)
 {
@@ -559,12 +585,46 @@ static wx_result load(const options *o, wx_mesh_data *mesh, wx_image *image, tex
     char wanted_value[2 * WX_NAME_MAX + 4];
     snprintf(wanted_value, sizeof wanted_value, "%s|%s.Y", o->channel, o->channel);
     const char *const wanted[2] = { wanted_value, "seen" };
-    r = wx_exr_read(o->texture_path, wanted, 2, image, err);
-    if (r != WX_OK) {
+    memset(tex, 0, sizeof *tex);
+    const char *token = strstr(o->texture_path, "<UDIM>");
+    if (token == NULL) {
+        r = wx_exr_read(o->texture_path, wanted, 2, image, err);
+        if (r == WX_OK) {
+            tex->width = image->width;
+            tex->height = image->height;
+            tex->value = image->channels[0];
+            tex->seen = image->channels[1];
+        }
         return r;
     }
-    *tex = (texture){ image->width, image->height, image->channels[0], image->channels[1] };
-    return WX_OK;
+    int found = 0;
+    for (int k = 0; k < UDIM_TILES && r == WX_OK; ++k) {
+        char path[4096];
+        snprintf(path, sizeof path, "%.*s%d%s", (int)(token - o->texture_path), o->texture_path,
+                 1001 + k, token + 6);
+        if (access(path, R_OK) != 0) {
+            continue;
+        }
+        r = wx_exr_read(path, wanted, 2, &image[k], err);
+        if (r == WX_OK && found > 0 &&
+            (image[k].width != tex->width || image[k].height != tex->height)) {
+            r = wx_fail(err, WX_CAUSE_MAP_SIZE, "%s: %d x %d, the other tiles %d x %d", path,
+                        image[k].width, image[k].height, tex->width, tex->height);
+        }
+        if (r == WX_OK) {
+            tex->width = image[k].width;
+            tex->height = image[k].height;
+            tex->tile_value[k] = image[k].channels[0];
+            tex->tile_seen[k] = image[k].channels[1];
+            ++found;
+        }
+    }
+    tex->tiles = UDIM_TILES;
+    if (r == WX_OK && found == 0) {
+        r = wx_fail(err, WX_CAUSE_FILE_MISSING, "%s: no UDIM tile 1001 ... 1999 exists",
+                    o->texture_path);
+    }
+    return r;
 }
 
 static wx_result render(const options *o, const wx_mesh_data *mesh, const texture *tex,
@@ -591,6 +651,9 @@ static wx_result render(const options *o, const wx_mesh_data *mesh, const textur
         if (res == WX_OK) {
             res = write_png(o->png_path, mesh, o->uv, tex, &o->view, white, err);
         }
+        if (res == WX_OK) {
+            printf("white %g\n", white); // for pictures drawn to the same scale
+        }
     }
     return res;
 }
@@ -604,16 +667,22 @@ int main(int argc, char **argv)
     }
     wx_error err = { 0 };
     wx_mesh_data mesh = { 0 };
-    wx_image image = { 0 };
-    texture tex;
-    wx_result r = load(&o, &mesh, &image, &tex, &err);
+    wx_image *images = calloc(UDIM_TILES, sizeof *images);
+    texture *tex = malloc(sizeof *tex);
+    wx_result r = images != NULL && tex != NULL
+                      ? load(&o, &mesh, images, tex, &err)
+                      : wx_fail(&err, WX_CAUSE_OUT_OF_MEMORY, "out of memory");
     if (r == WX_OK) {
-        r = render(&o, &mesh, &tex, &err);
+        r = render(&o, &mesh, tex, &err);
     }
     if (r != WX_OK) {
         fprintf(stderr, "render_texture: %s\n", err.message);
     }
-    wx_image_free(&image);
+    for (int k = 0; images != NULL && k < UDIM_TILES; ++k) {
+        wx_image_free(&images[k]);
+    }
+    free(images);
+    free(tex);
     wx_mesh_data_free(&mesh);
     return (int)r;
 }
