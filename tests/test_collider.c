@@ -1,6 +1,7 @@
 // test_collider.c: the projected-maps collider against analytic scenes whose
 // answers are worked out by hand (tests/sim_fixture.h ray-casts the maps).
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "model/ownership.h"
@@ -63,6 +64,71 @@ TEST(a_camera_framing_the_model_vouches_outside_its_frame)
         ENSURE(swept == !framing);
         ENSURE(!framing || coarse);
     }
+}
+
+// A camera w x h world units around (cx, cy, cz), px texels a unit, looking
+// down -y (down) or along -z.
+static wx_camera window_camera(float cx, float cy, float cz, bool down, float w, float h, int px)
+{
+    wx_view view;
+    memset(&view, 0, sizeof view);
+    view.eye[0] = cx;
+    view.eye[1] = down ? 10.0f : cy;
+    view.eye[2] = down ? cz : 10.0f;
+    view.target[0] = cx;
+    view.target[1] = down ? 0.0f : cy;
+    view.target[2] = cz;
+    view.up[1] = down ? 0.0f : 1.0f;
+    view.up[2] = down ? -1.0f : 0.0f;
+    view.width_ws = w;
+    view.height_ws = h;
+    view.width_px = (int)(w * (float)px);
+    view.height_px = (int)(h * (float)px);
+    wx_camera cam;
+    wx_error err;
+    if (wx_camera_from_view(&view, &cam, &err) != WX_OK) {
+        abort();
+    }
+    return cam;
+}
+
+// A tile's cameras are the whole cameras cut to its box (weathering tiles):
+// the cut ones hold the slab on their cut sides, which alone would make them
+// say "no information" outside their frames, and the top camera would then
+// catch a drop below the slab, outside the front camera's frame, which the
+// whole front camera (framing the slab) calls free space. With the tile's box
+// the cut sides do not count (beyond them lies only space outside the box):
+// free, as in the whole run (docs/tiles.md; the city's slab edges).
+TEST(a_tile_keeps_its_whole_cameras_framing)
+{
+    fx_world world = { 0 };
+    fx_box(&world, -1.0f, -0.2f, -1.0f, 1.0f, 0.0f, 1.0f);
+    // The whole front camera: 4 x 4 around the slab, framing it.
+    wx_camera whole = window_camera(0, 0, 0, false, 4, 4, 16);
+    // The tile x in [-0.5, 0.5] (halo included), y and z unbounded (to 10).
+    wx_camera cams[2] = { window_camera(0, 0, 0, false, 1, 4, 16),
+                          window_camera(0, 0, 0, true, 1, 4, 16) };
+    const double lo[3] = { -0.5, -10.0, -10.0 }, hi[3] = { 0.5, 10.0, 10.0 };
+    float below[3] = { 0.0f, -3.0f, 0.5f };
+    float p0[3] = { 0.0f, -3.0f, 0.6f }, p1[3] = { 0.0f, -3.0f, 0.4f };
+    wx_maps maps[2], whole_maps;
+    wx_collider col, whole_col;
+    ENSURE(build(&whole_col, &whole, &whole_maps, 1, &world, false));
+    ENSURE(whole_col.cameras[0].frames_model);
+    release(&whole_col, &whole_maps, 1);
+    ENSURE(build(&col, cams, maps, 2, &world, false));
+    ENSURE(!col.cameras[0].frames_model && !col.cameras[1].frames_model);
+    ENSURE(wx_collider_point_collides(&col, below)); // caught under the slab
+    wx_collider_frame_box(&col, lo, hi);
+    ENSURE(col.cameras[0].frames_model && col.cameras[1].frames_model);
+    ENSURE(!wx_collider_point_collides(&col, below));
+    wx_hit hit;
+    ENSURE(!wx_collider_sweep(&col, p0, p1, &hit));
+    // A box reaching beyond the slab's cut sides: the surface on them counts.
+    const double wide_lo[3] = { -2.0, -10.0, -10.0 }, wide_hi[3] = { 2.0, 10.0, 10.0 };
+    wx_collider_frame_box(&col, wide_lo, wide_hi);
+    ENSURE(!col.cameras[0].frames_model && !col.cameras[1].frames_model);
+    release(&col, maps, 2);
 }
 
 TEST(drop_hits_the_texel_below)
@@ -876,6 +942,7 @@ TEST(projective_cameras_are_refused)
 
 int main(void)
 {
+    RUN(a_tile_keeps_its_whole_cameras_framing);
     RUN(drop_hits_the_texel_below);
     RUN(box_from_three_sides_point_rule);
     RUN(a_camera_framing_the_model_vouches_outside_its_frame);

@@ -103,6 +103,18 @@ typedef struct wx_collider {
 wx_result wx_collider_init(wx_collider *collider, const wx_camera *cameras, const wx_maps *maps,
                            int count, bool nearest, wx_error *err);
 
+/// A tile's collider (docs/tiles.md): particles live only within the box
+/// [lo, hi] (the tile and its halo), and `weathering tiles` cut each camera's
+/// frame to the box's image. Each camera then frames the model when its map
+/// holds no surface on the border of the sides the box reaches beyond (the
+/// whole camera's own sides); the sides cut to the box have only space
+/// outside the box beyond them, so a surface cut there no longer makes the
+/// camera say "no information" outside its frame. Without this, a point
+/// outside a cut camera's frame lost the whole camera's "free space there",
+/// and another camera (a top camera, solid below its first surface) could
+/// catch it: rain falling past a slab's edge was caught under the slab.
+void wx_collider_frame_box(wx_collider *collider, const double lo[3], const double hi[3]);
+
 /// Frees what the collider owns; the struct is zeroed.
 void wx_collider_free(wx_collider *collider);
 

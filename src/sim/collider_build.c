@@ -134,20 +134,54 @@ static wx_result build_coarse(wx_collider_camera *cam, wx_error *err)
 }
 
 // True when no texel of the map's outermost ring records a surface.
-static bool border_is_empty(const float *depth, int W, int H)
+// Whether the map holds no surface on the outermost ring of texels of the
+// sides asked for (left, right: columns 0 and W-1; top, bottom: rows 0 and H-1).
+static bool sides_are_empty(const float *depth, int W, int H, const bool side[4])
 {
     for (int i = 0; i < W; ++i) {
-        if (isfinite(depth[i]) || isfinite(depth[(size_t)(H - 1) * (size_t)W + (size_t)i])) {
+        if ((side[2] && isfinite(depth[i])) ||
+            (side[3] && isfinite(depth[(size_t)(H - 1) * (size_t)W + (size_t)i]))) {
             return false;
         }
     }
     for (int j = 0; j < H; ++j) {
-        if (isfinite(depth[(size_t)j * (size_t)W]) ||
-            isfinite(depth[(size_t)j * (size_t)W + (size_t)(W - 1)])) {
+        if ((side[0] && isfinite(depth[(size_t)j * (size_t)W])) ||
+            (side[1] && isfinite(depth[(size_t)j * (size_t)W + (size_t)(W - 1)]))) {
             return false;
         }
     }
     return true;
+}
+
+static bool border_is_empty(const float *depth, int W, int H)
+{
+    const bool all[4] = { true, true, true, true };
+    return sides_are_empty(depth, W, H, all);
+}
+
+void wx_collider_frame_box(wx_collider *collider, const double lo[3], const double hi[3])
+{
+    for (int c = 0; c < collider->camera_count; ++c) {
+        wx_collider_camera *cam = &collider->cameras[c];
+        double xlo = INFINITY, xhi = -INFINITY, ylo = INFINITY, yhi = -INFINITY;
+        for (int k = 0; k < 8; ++k) {
+            double p[3] = { (k & 1) ? hi[0] : lo[0], (k & 2) ? hi[1] : lo[1],
+                            (k & 4) ? hi[2] : lo[2] };
+            double X = p[0] * cam->mx[0] + p[1] * cam->mx[1] + p[2] * cam->mx[2] + cam->mx[3];
+            double Y = p[0] * cam->my[0] + p[1] * cam->my[1] + p[2] * cam->my[2] + cam->my[3];
+            xlo = fmin(xlo, X);
+            xhi = fmax(xhi, X);
+            ylo = fmin(ylo, Y);
+            yhi = fmax(yhi, Y);
+        }
+        // A side the box reaches beyond (by more than rounding) is a side of
+        // the whole camera's frame; at the others `weathering tiles` cut the
+        // frame to the box, and what lies beyond them lies outside the box.
+        const double eps = 1e-3; // texels
+        const bool side[4] = { xlo < -eps, xhi > cam->width + eps, ylo < -eps,
+                               yhi > cam->height + eps };
+        cam->frames_model = sides_are_empty(cam->depth, cam->width, cam->height, side);
+    }
 }
 // The roles of every texel's crossings (depth already copied, normals set):
 // each texel's crossings are replaced by their outline (outline above),

@@ -508,6 +508,12 @@ wx_result wx_sim_create(const wx_scene *scene, const wx_sim_def *config, wx_sim 
         r = wx_collider_init(&sim->collider, cameras, sim->maps, sim->input_count,
                              config->nearest_depth, err);
     }
+    if (r == WX_OK && scene->tile.present) {
+        // The tile's cameras are cut to where its particles live.
+        const double lo[3] = { sim->bbox_lo[0], sim->bbox_lo[1], sim->bbox_lo[2] };
+        const double hi[3] = { sim->bbox_hi[0], sim->bbox_hi[1], sim->bbox_hi[2] };
+        wx_collider_frame_box(&sim->collider, lo, hi);
+    }
     free(cameras);
     if (r == WX_OK) {
         uint64_t total = 0;
