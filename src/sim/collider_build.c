@@ -178,8 +178,9 @@ void wx_collider_frame_box(wx_collider *collider, const double lo[3], const doub
         // the whole camera's frame; at the others `weathering tiles` cut the
         // frame to the box, and what lies beyond them lies outside the box.
         const double eps = 1e-3; // texels
-        const bool side[4] = { xlo < -eps, xhi > cam->width + eps, ylo < -eps,
-                               yhi > cam->height + eps };
+        const bool left = xlo < -eps, right = xhi > cam->width + eps;
+        const bool top = ylo < -eps, bottom = yhi > cam->height + eps;
+        const bool side[4] = { left, right, top, bottom };
         cam->frames_model = sides_are_empty(cam->depth, cam->width, cam->height, side);
     }
 }

@@ -461,7 +461,8 @@ static surface_sample sample_pixel(const wx_mesh_data *mesh, int uv, const textu
             n[c] += w[k] * mesh->normals[3 * (size_t)idx[k] + c];
         }
     }
-    surface_sample s = { sample(tex, false, tu, tv), sample(tex, true, tu, tv),
+    surface_sample s = { sample(tex, false, tu, tv),
+                         sample(tex, true, tu, tv),
                          { 0.0f, 0.0f, 0.0f } };
     double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
     if (!(len > 1e-12)) {
