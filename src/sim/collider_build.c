@@ -178,9 +178,8 @@ void wx_collider_frame_box(wx_collider *collider, const double lo[3], const doub
         // the whole camera's frame; at the others `weathering tiles` cut the
         // frame to the box, and what lies beyond them lies outside the box.
         const double eps = 1e-3; // texels
-        const bool left = xlo < -eps, right = xhi > cam->width + eps;
-        const bool top = ylo < -eps, bottom = yhi > cam->height + eps;
-        const bool side[4] = { left, right, top, bottom };
+        const bool side[4] = { xlo + eps < 0.0, xhi - eps > cam->width, ylo + eps < 0.0,
+                               yhi - eps > cam->height };
         cam->frames_model = sides_are_empty(cam->depth, cam->width, cam->height, side);
     }
 }
