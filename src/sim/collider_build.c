@@ -178,8 +178,11 @@ void wx_collider_frame_box(wx_collider *collider, const double lo[3], const doub
         // the whole camera's frame; at the others `weathering tiles` cut the
         // frame to the box, and what lies beyond them lies outside the box.
         const double eps = 1e-3; // texels
-        const bool side[4] = { xlo + eps < 0.0, xhi - eps > cam->width, ylo + eps < 0.0,
-                               yhi - eps > cam->height };
+        bool side[4];
+        side[0] = xlo < -eps;
+        side[1] = xhi > cam->width + eps;
+        side[2] = ylo < -eps;
+        side[3] = yhi > cam->height + eps;
         cam->frames_model = sides_are_empty(cam->depth, cam->width, cam->height, side);
     }
 }
