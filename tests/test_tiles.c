@@ -119,6 +119,19 @@ static long long stats_value(const char *path, const char *key)
     return at != NULL && sscanf(at + strlen(quoted), "%lld", &v) == 1 ? v : -1;
 }
 
+// The text of DIR/NAME (at most cap - 1 bytes; "" when unreadable).
+static void read_text(const char *dir, const char *name, char *text, size_t cap)
+{
+    char path[PATH_MAX + 64];
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    FILE *f = fopen(path, "r");
+    size_t n = f != NULL ? fread(text, 1, cap - 1, f) : 0;
+    text[n] = '\0';
+    if (f != NULL) {
+        fclose(f);
+    }
+}
+
 // RMS of the differences of k x k block means of a and b (block_rms.h),
 // relative to their mean.
 static double block_rms(const float *a, const float *b, const float *seen_a, const float *seen_b,
@@ -210,22 +223,10 @@ TEST(a_street_run_as_tiles_merges_into_the_whole_run)
     ENSURE(access(path, R_OK) == 0);
     // The Slurm scripts: a job array of the 4 tiles and a merge after it.
     char text[4096];
-    snprintf(path, sizeof path, "%s/tiles/tiles.sbatch", dir);
-    FILE *f = fopen(path, "r");
-    size_t n = f != NULL ? fread(text, 1, sizeof text - 1, f) : 0;
-    text[n] = '\0';
-    if (f != NULL) {
-        fclose(f);
-    }
+    read_text(dir, "tiles/tiles.sbatch", text, sizeof text);
     ENSURE(strstr(text, "#SBATCH --array=0-3") != NULL);
     ENSURE(strstr(text, "SLURM_ARRAY_TASK_ID") != NULL);
-    snprintf(path, sizeof path, "%s/tiles/submit.sh", dir);
-    f = fopen(path, "r");
-    n = f != NULL ? fread(text, 1, sizeof text - 1, f) : 0;
-    text[n] = '\0';
-    if (f != NULL) {
-        fclose(f);
-    }
+    read_text(dir, "tiles/submit.sh", text, sizeof text);
     ENSURE(strstr(text, "--dependency=afterok:") != NULL);
 }
 
@@ -241,13 +242,7 @@ TEST(tiles_name_the_tasks_the_output_camera_sees)
            0);
     ENSURE(strstr(out, "sees 4 of the 16 tiles (tasks 5,6,9,10") != NULL);
     char path[PATH_MAX + 64], text[4096];
-    snprintf(path, sizeof path, "%s/shot/submit.sh", dir);
-    FILE *f = fopen(path, "r");
-    size_t n = f != NULL ? fread(text, 1, sizeof text - 1, f) : 0;
-    text[n] = '\0';
-    if (f != NULL) {
-        fclose(f);
-    }
+    read_text(dir, "shot/submit.sh", text, sizeof text);
     ENSURE(strstr(text, "the output camera sees tasks 5,6,9,10") != NULL);
     ENSURE(strstr(text, "${1:+--array=\"$1\"}") != NULL);
     // Just those tiles, the others' scenes moved away: merge joins them.
