@@ -243,7 +243,7 @@ TEST(tiles_name_the_tasks_the_output_camera_sees)
     ENSURE(strstr(out, "sees 4 of the 16 tiles (tasks 5,6,9,10") != NULL);
     char path[PATH_MAX + 64], text[4096];
     read_text(dir, "shot/submit.sh", text, sizeof text);
-    ENSURE(strstr(text, "the output camera sees tasks 5,6,9,10") != NULL);
+    ENSURE(strstr(text, "the output camera sees tasks: 5,6,9,10.") != NULL);
     ENSURE(strstr(text, "${1:+--array=\"$1\"}") != NULL);
     // Just those tiles, the others' scenes moved away: merge joins them.
     if (!ensure_fast()) {

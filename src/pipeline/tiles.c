@@ -183,7 +183,7 @@ static wx_result write_slurm(const wx_tiles_def *def, const char *dir, const cha
                  "#!/bin/sh\n"
                  "# Submits the tiles' job array and the merge that waits for it (afterok).\n"
                  "# ./submit.sh TASKS submits only those tasks (sbatch --array=TASKS, task\n"
-                 "# IX + %d * IZ): the output camera sees tasks %s. Merge joins the tile\n"
+                 "# IX + %d * IZ); the output camera sees tasks: %s. Merge joins the tile\n"
                  "# scenes in this folder: move the others' tile_IX_IZ.xml away first.\n"
                  "set -eu\n"
                  "cd '%s'\n"
@@ -191,7 +191,7 @@ static wx_result write_slurm(const wx_tiles_def *def, const char *dir, const cha
                  "tiles=$(sbatch --parsable ${1:+--array=\"$1\"} tiles.sbatch)\n"
                  "merge=$(sbatch --parsable --dependency=afterok:${tiles%%%%;*} merge.sbatch)\n"
                  "echo \"tiles: job ${tiles%%%%;*}; merge: job ${merge%%%%;*}\"\n",
-                 def->nx, shot[0] != '\0' ? shot : "none", dir);
+                 def->nx, shot, dir);
         r = write_text(dir, "submit.sh", text, err);
         char path[WX_PATH_MAX];
         if (r == WX_OK && wx_tiles_join(path, sizeof path, dir, "submit.sh")) {
@@ -247,7 +247,9 @@ static wx_result write_tile(const wx_tiles_def *def, const wx_scene *scene, cons
         const double own_lo[3] = { fmax(lo[0], tile.min[0]), lo[1], fmax(lo[2], tile.min[1]) };
         const double own_hi[3] = { fmin(hi[0], tile.max[0]), hi[1], fmin(hi[2], tile.max[1]) };
         wx_view unused;
-        *shot = crop_output && crop_view(&out->view, own_lo, own_hi, &unused);
+        // An output camera given by map files is not cropped: it sees them all.
+        *shot = !(out->has_view && out->depth_path == NULL) ||
+                (crop_output && crop_view(&out->view, own_lo, own_hi, &unused));
     }
     char name[64], file[80];
     snprintf(name, sizeof name, "tile_%d_%d", ix, iz);
@@ -358,7 +360,18 @@ wx_result wx_tiles_write(const wx_tiles_def *def, wx_error *err)
         }
     }
     if (r == WX_OK && def->slurm) {
-        r = write_slurm(def, dir, scene.name, shot, err);
+        // The list in submit.sh's comment, unless it is long.
+        const char *listed = shot;
+        if (scene.output_index < 0) {
+            listed = "none (the scene has no output camera)";
+        } else if (shots == def->nx * def->nz) {
+            listed = "all";
+        } else if (shots == 0) {
+            listed = "none";
+        } else if (used > 1024) {
+            listed = "many: `weathering tiles` printed them";
+        }
+        r = write_slurm(def, dir, scene.name, listed, err);
     }
     if (r == WX_OK && !def->quiet) {
         fprintf(stderr,
