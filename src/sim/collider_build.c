@@ -133,7 +133,6 @@ static wx_result build_coarse(wx_collider_camera *cam, wx_error *err)
     return WX_OK;
 }
 
-// True when no texel of the map's outermost ring records a surface.
 // Whether the map holds no surface on the outermost ring of texels of the
 // sides asked for (left, right: columns 0 and W-1; top, bottom: rows 0 and H-1).
 static bool sides_are_empty(const float *depth, int W, int H, const bool side[4])
@@ -153,6 +152,7 @@ static bool sides_are_empty(const float *depth, int W, int H, const bool side[4]
     return true;
 }
 
+// True when no texel of the map's outermost ring records a surface.
 static bool border_is_empty(const float *depth, int W, int H)
 {
     const bool all[4] = { true, true, true, true };
@@ -186,6 +186,7 @@ void wx_collider_frame_box(wx_collider *collider, const double lo[3], const doub
         cam->frames_model = sides_are_empty(cam->depth, cam->width, cam->height, side);
     }
 }
+
 // The roles of every texel's crossings (depth already copied, normals set):
 // each texel's crossings are replaced by their outline (outline above),
 // nearest first, with the layer each came from in `origin`.
