@@ -21,58 +21,14 @@
 static char dir[PATH_MAX];
 static char program[PATH_MAX];
 
-static double steps_seconds(const char *scene)
-{
-    char args[PATH_MAX];
-    snprintf(args, sizeof args, "run '%s' --out out", scene);
-    char *json = bench_run(program, dir, args);
-    double s = json != NULL ? ensure_json_number(json, NULL, "steps") : NAN;
-    free(json);
-    return s;
-}
-
-// `text` with the first `from` of each pair replaced by `to`, written to dir/name.
-static bool write_variant(const char *text, const char *const *pairs, int n, const char *name)
-{
-    char *out = malloc(strlen(text) * 2 + 4096);
-    if (out == NULL) {
-        return false;
-    }
-    strcpy(out, text);
-    for (int k = 0; k < n; ++k) {
-        char *at = strstr(out, pairs[2 * k]);
-        if (at == NULL) {
-            fprintf(stderr, "bench_spread: '%s' not in the scene\n", pairs[2 * k]);
-            free(out);
-            return false;
-        }
-        size_t from = strlen(pairs[2 * k]), to = strlen(pairs[2 * k + 1]);
-        memmove(at + to, at + from, strlen(at + from) + 1);
-        memcpy(at, pairs[2 * k + 1], to);
-    }
-    bool ok = ensure_write_file(dir, name, out) != NULL;
-    free(out);
-    return ok;
-}
-
 int main(void)
 {
     if (!bench_workdir("bench_spread", program, dir)) {
         return 1;
     }
-    char cmd[2 * PATH_MAX];
-    snprintf(cmd, sizeof cmd,
-             "cp xml_scenes/meshes/tank.obj xml_scenes/meshes/tank.mtl '%s/meshes/'", dir);
-    char *scene = ensure_read_file("xml_scenes/rusty_tank.xml");
-    if (system(cmd) != 0 || scene == NULL) {
-        fprintf(stderr, "bench_spread: run from the repository's root\n");
+    char *scene = bench_tank_scene(dir, "bench_spread");
+    if (scene == NULL) {
         return 1;
-    }
-    char *masks = strstr(scene, "<Masks>");
-    char *masks_end = masks != NULL ? strstr(masks, "</Masks>") : NULL;
-    if (masks_end != NULL) {
-        masks_end += strlen("</Masks>");
-        memmove(masks, masks_end, strlen(masks_end) + 1);
     }
     const char *plain[] = {
         "every=\"1\"",
@@ -95,8 +51,8 @@ int main(void)
         "<Spread substance=\"bloom\" radius=\"0.05\" probability=\"0.5\" where=\"water\" "
         "min=\"0.2\"/>",
     };
-    if (!write_variant(scene, plain, 3, "plain.xml") ||
-        !write_variant(scene, spread, 4, "spread.xml")) {
+    if (!bench_write_variant(dir, "bench_spread", scene, plain, 3, "plain.xml") ||
+        !bench_write_variant(dir, "bench_spread", scene, spread, 4, "spread.xml")) {
         return 1;
     }
     free(scene);
@@ -105,8 +61,8 @@ int main(void)
     reps = reps > MAX_REPS ? MAX_REPS : reps;
     double t0[MAX_REPS], t1[MAX_REPS];
     for (int k = 0; k < reps; ++k) {
-        t0[k] = steps_seconds("plain.xml");
-        t1[k] = steps_seconds("spread.xml");
+        t0[k] = bench_steps_seconds(program, dir, "plain.xml");
+        t1[k] = bench_steps_seconds(program, dir, "spread.xml");
     }
     double s0 = bench_median(t0, reps), s1 = bench_median(t1, reps);
     double ratio = s1 / s0;

@@ -18,63 +18,20 @@
 static char dir[PATH_MAX];
 static char program[PATH_MAX];
 
-static double steps_seconds(const char *scene)
-{
-    char args[PATH_MAX];
-    snprintf(args, sizeof args, "run '%s' --out out", scene);
-    char *json = bench_run(program, dir, args);
-    double s = ensure_json_number(json, NULL, "steps");
-    free(json);
-    return s;
-}
-
-// `text` with every `from` replaced by `to`, written to dir/name.
-static bool write_variant(const char *text, const char *const *pairs, int n, const char *name)
-{
-    char *out = malloc(strlen(text) * 2 + 4096);
-    if (out == NULL) {
-        return false;
-    }
-    strcpy(out, text);
-    for (int k = 0; k < n; ++k) {
-        char *at = strstr(out, pairs[2 * k]);
-        if (at == NULL) {
-            fprintf(stderr, "bench_substances: '%s' not in the scene\n", pairs[2 * k]);
-            free(out);
-            return false;
-        }
-        size_t from = strlen(pairs[2 * k]), to = strlen(pairs[2 * k + 1]);
-        memmove(at + to, at + from, strlen(at + from) + 1);
-        memcpy(at, pairs[2 * k + 1], to);
-    }
-    bool ok = ensure_write_file(dir, name, out) != NULL;
-    free(out);
-    return ok;
-}
-
 int main(void)
 {
     if (!bench_workdir("bench_substances", program, dir)) {
         return 1;
     }
-    char cmd[2 * PATH_MAX];
-    snprintf(cmd, sizeof cmd, "cp xml_scenes/meshes/tank.obj xml_scenes/meshes/tank.mtl '%s/meshes/'",
-             dir);
-    char *scene = ensure_read_file("xml_scenes/rusty_tank.xml");
-    if (system(cmd) != 0 || scene == NULL) {
-        fprintf(stderr, "bench_substances: run from the repository's root\n");
-        return 1;
-    }
     // The derived masks are left out of both (they are gathered, not stepped,
     // and the mask `mossy` names the water the one-substance variant drops).
-    char *masks = strstr(scene, "<Masks>");
-    char *masks_end = masks != NULL ? strstr(masks, "</Masks>") : NULL;
-    if (masks_end != NULL) {
-        masks_end += strlen("</Masks>");
-        memmove(masks, masks_end, strlen(masks_end) + 1);
+    char *scene = bench_tank_scene(dir, "bench_substances");
+    if (scene == NULL) {
+        return 1;
     }
     // Four substances, no frames; and one substance (version 1's dirt), the same rain.
     const char *four[] = { "every=\"1\"", "every=\"0\"" };
+    // clang-format off: the pairs (from, to), one a line
     const char *one[] = {
         "every=\"1\"", "every=\"0\"",
         "<Substance name=\"water\"/>\n    <Substance name=\"dirt\"/>\n    <Substance name=\"rust\"/>\n"
@@ -87,14 +44,16 @@ int main(void)
         "<Exchange substance=\"water\" deposit=\"0.8\" erosion=\"0.02\"/>", "",
         "<Transfer from=\"water\" to=\"moss\" rate=\"0.1\"/>", "",
     };
-    if (!write_variant(scene, four, 1, "four.xml") || !write_variant(scene, one, 8, "one.xml")) {
+    // clang-format on
+    if (!bench_write_variant(dir, "bench_substances", scene, four, 1, "four.xml") ||
+        !bench_write_variant(dir, "bench_substances", scene, one, 8, "one.xml")) {
         return 1;
     }
     free(scene);
     double t1[3], t4[3];
     for (int k = 0; k < 3; ++k) {
-        t1[k] = steps_seconds("one.xml");
-        t4[k] = steps_seconds("four.xml");
+        t1[k] = bench_steps_seconds(program, dir, "one.xml");
+        t4[k] = bench_steps_seconds(program, dir, "four.xml");
     }
     double s1 = bench_median(t1, 3), s4 = bench_median(t4, 3);
     double share = s1 / s4;
