@@ -63,6 +63,22 @@ static const char PLANE_RULES[] =
     "    <Spread substance=\"rust\" radius=\"0.05\" probability=\"1\"/>\n"
     "    <Seed substance=\"spot\" density=\"500\"/>\n";
 
+// Runs DIR/scene.xml into DIR/out with its statistics in DIR/stats.json and
+// the extra command-line words; false (with the run's output on stderr) when
+// it fails.
+static bool run_scene(const char *dir, const char *extra)
+{
+    char log[8192];
+    int status = ensure_shell(log, sizeof log,
+                              "'%s/weathering' run '%s/scene.xml' --out '%s/out' -q --stats "
+                              "'%s/stats.json' %s",
+                              ensure_build_dir(), dir, dir, dir, extra);
+    if (status != 0) {
+        fprintf(stderr, "        weathering run: status %d\n%s\n", status, log);
+    }
+    return status == 0;
+}
+
 // Runs the plane scene in tmp/NAME with `rules` and extra command-line words;
 // returns the folder (static) or NULL.
 static const char *run_plane(const char *name, const char *rules, const char *extra)
@@ -75,16 +91,7 @@ static const char *run_plane(const char *name, const char *rules, const char *ex
     char xml[8192];
     snprintf(xml, sizeof xml, PLANE_XML, rules);
     ensure_write_file(dir, "scene.xml", xml);
-    char log[8192];
-    int status = ensure_shell(log, sizeof log,
-                              "'%s/weathering' run '%s/scene.xml' --out '%s/out' -q --stats "
-                              "'%s/stats.json' %s",
-                              ensure_build_dir(), dir, dir, dir, extra);
-    if (status != 0) {
-        fprintf(stderr, "        weathering run: status %d\n%s\n", status, log);
-        return NULL;
-    }
-    return dir;
+    return run_scene(dir, extra) ? dir : NULL;
 }
 
 static const char *plane_dir(void)
@@ -307,15 +314,7 @@ TEST(spread_crosses_the_texture_seam_around_a_cylinder)
     ENSURE(write_cylinder(dir));
     ensure_write_file(dir, "cylinder.mtl", PLANE_MTL);
     ensure_write_file(dir, "scene.xml", CYLINDER_XML);
-    char log[8192];
-    int status = ensure_shell(log, sizeof log,
-                              "'%s/weathering' run '%s/scene.xml' --out '%s/out' -q --stats "
-                              "'%s/stats.json'",
-                              ensure_build_dir(), dir, dir, dir);
-    if (status != 0) {
-        fprintf(stderr, "        weathering run: status %d\n%s\n", status, log);
-    }
-    ENSURE(status == 0);
+    ENSURE(run_scene(dir, ""));
     char path[4400];
     snprintf(path, sizeof path, "%s/out/cylinder.exr", dir);
     int w = 0, h = 0;
