@@ -102,20 +102,26 @@ static bool rules_automata(const wx_rule *rules, int count)
     return false;
 }
 
-bool wx_scene_has_surface_automata(const wx_scene *scene)
+// Whether `test` holds for the scene's global rules or for some surface's own.
+static bool any_rules(const wx_scene *scene, bool (*test)(const wx_rule *, int))
 {
-    if (rules_automata(scene->rules, scene->rule_count)) {
+    if (test(scene->rules, scene->rule_count)) {
         return true;
     }
     for (int m = 0; m < scene->mesh_count; ++m) {
         for (int k = 0; k < scene->meshes[m].surface_count; ++k) {
             const wx_surface *sf = &scene->meshes[m].surfaces[k];
-            if (rules_automata(sf->rules, sf->rule_count)) {
+            if (test(sf->rules, sf->rule_count)) {
                 return true;
             }
         }
     }
     return false;
+}
+
+bool wx_scene_has_surface_automata(const wx_scene *scene)
+{
+    return any_rules(scene, rules_automata);
 }
 
 bool wx_scene_has_layers(const wx_scene *scene)
@@ -130,18 +136,7 @@ bool wx_scene_has_layers(const wx_scene *scene)
 
 bool wx_scene_has_grow(const wx_scene *scene)
 {
-    if (rules_grow(scene->rules, scene->rule_count)) {
-        return true;
-    }
-    for (int m = 0; m < scene->mesh_count; ++m) {
-        for (int k = 0; k < scene->meshes[m].surface_count; ++k) {
-            const wx_surface *sf = &scene->meshes[m].surfaces[k];
-            if (rules_grow(sf->rules, sf->rule_count)) {
-                return true;
-            }
-        }
-    }
-    return false;
+    return any_rules(scene, rules_grow);
 }
 
 int wx_scene_surface_base(const wx_scene *scene, int mesh)
