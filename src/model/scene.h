@@ -389,25 +389,21 @@ typedef struct wx_scene {
     wx_tile_def tile;
 } wx_scene;
 
-/// Where a tile's particles live: its region and halo within the bounding box
-/// (x and z; y: the bounding box's). The bounding box itself without a tile.
-/// A tile's particles escape where they leave it (docs/tiles.md).
-static inline void wx_scene_particle_box(const wx_scene *scene, double lo[3], double hi[3])
+/// Where the scene's particles live, the box where they escape: the bounding
+/// box, within a tile's region and halo for a tile (x and z; docs/tiles.md).
+static inline void wx_scene_particle_box(const wx_scene *scene, float lo[3], float hi[3])
 {
-    const double half = 0.5 * (double)scene->bbox_size;
     for (int k = 0; k < 3; ++k) {
-        lo[k] = (double)scene->bbox_center[k] - half;
-        hi[k] = (double)scene->bbox_center[k] + half;
+        lo[k] = scene->bbox_center[k] - 0.5f * scene->bbox_size;
+        hi[k] = scene->bbox_center[k] + 0.5f * scene->bbox_size;
     }
     if (scene->tile.present) {
         for (int a = 0; a < 2; ++a) {
             int k = 2 * a; // x, then z
-            lo[k] = lo[k] > scene->tile.min[a] - scene->tile.halo
-                        ? lo[k]
-                        : scene->tile.min[a] - scene->tile.halo;
-            hi[k] = hi[k] < scene->tile.max[a] + scene->tile.halo
-                        ? hi[k]
-                        : scene->tile.max[a] + scene->tile.halo;
+            double tlo = scene->tile.min[a] - scene->tile.halo;
+            double thi = scene->tile.max[a] + scene->tile.halo;
+            lo[k] = (float)((double)lo[k] > tlo ? (double)lo[k] : tlo);
+            hi[k] = (float)((double)hi[k] < thi ? (double)hi[k] : thi);
         }
     }
 }

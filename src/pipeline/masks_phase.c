@@ -198,9 +198,10 @@ wx_result wx_mask_context_init(const wx_scene *scene, const wx_maps *in_maps, bo
         r = wx_collider_init(&ctx->collider, cams, maps, n, false, err);
     }
     if (r == WX_OK && scene->tile.present) {
-        double lo[3], hi[3];
+        float lo[3], hi[3];
         wx_scene_particle_box(scene, lo, hi);
-        wx_collider_frame_box(&ctx->collider, lo, hi);
+        const double dlo[3] = { lo[0], lo[1], lo[2] }, dhi[3] = { hi[0], hi[1], hi[2] };
+        wx_collider_frame_box(&ctx->collider, dlo, dhi);
     }
     if (r == WX_OK) {
         r = noise_tables_init(scene, in_maps, ctx, err);

@@ -412,20 +412,10 @@ wx_result wx_sim_create(const wx_scene *scene, const wx_sim_def *config, wx_sim 
     sim->seed = config->seed;
     sim->dt = scene->time_step;
     sim->params = scene->collider;
-    for (int k = 0; k < 3; ++k) {
-        sim->bbox_lo[k] = scene->bbox_center[k] - 0.5f * scene->bbox_size;
-        sim->bbox_hi[k] = scene->bbox_center[k] + 0.5f * scene->bbox_size;
-    }
     // A tile's particles escape where they leave its halo: beyond it the tile's
     // cropped cameras know less than the whole scene's, and what flies there
     // lands in another tile (docs/tiles.md).
-    if (scene->tile.present) {
-        for (int a = 0; a < 2; ++a) {
-            int k = 2 * a; // x, then z
-            sim->bbox_lo[k] = (float)fmax(sim->bbox_lo[k], scene->tile.min[a] - scene->tile.halo);
-            sim->bbox_hi[k] = (float)fmin(sim->bbox_hi[k], scene->tile.max[a] + scene->tile.halo);
-        }
-    }
+    wx_scene_particle_box(scene, sim->bbox_lo, sim->bbox_hi);
     sim->emitter_count = scene->emitter_count;
     sim->emitters = scene->emitters;
     sim->substances = scene->substance_count > 1 ? scene->substance_count : 1;
