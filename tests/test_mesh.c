@@ -860,6 +860,109 @@ TEST(flat_shading_is_not_cut)
     wx_mesh_data_free(&m);
 }
 
+// A coarse cylinder (8 sides, radius 1, height 2) with a flat bottom cap and
+// a steep cone on top (apex 1.8 above the rim), as an OBJ without normals: the
+// import smooths within 60 degrees, so the rim between the flat cap and the
+// smooth side is a crease, and at the apex each face keeps a normal of its
+// own (its opposite faces lie 64 degrees apart, as at the pole of a lumpy UV
+// sphere whose fan goes beyond the smoothing).
+static const char *write_capped_cylinder(const char *dir)
+{
+    const char *path = join(dir, "capped_cylinder.obj");
+    FILE *f = fopen(path, "w");
+    if (f == NULL) {
+        return NULL;
+    }
+    const double pi = 3.14159265358979323846;
+    for (int i = 0; i < 8; ++i) { // 1..8 bottom ring, 9..16 top ring
+        fprintf(f, "v %.6f 0 %.6f\n", cos(2 * pi * i / 8), sin(2 * pi * i / 8));
+    }
+    for (int i = 0; i < 8; ++i) {
+        fprintf(f, "v %.6f 2 %.6f\n", cos(2 * pi * i / 8), sin(2 * pi * i / 8));
+    }
+    fprintf(f, "v 0 0 0\nv 0 3.8 0\n"); // 17 bottom centre, 18 apex
+    for (int i = 0; i < 8; ++i) {
+        int a = 1 + i, b = 1 + (i + 1) % 8;
+        fprintf(f, "f %d %d %d\nf %d %d %d\n", a, a + 8, b + 8, a, b + 8, b); // side
+        fprintf(f, "f 17 %d %d\n", a, b);                                  // bottom
+        fprintf(f, "f 18 %d %d\n", b + 8, a + 8);                          // cone
+    }
+    return fclose(f) == 0 ? path : NULL;
+}
+
+// Whether triangles s and t share the edge from corner k of s to corner k + 1
+// (by position); *l gets the corner of t at s's corner k.
+static bool shared_edge(const wx_mesh_data *m, int64_t s, int k, int64_t t, int *l, int *l2)
+{
+    const float *a = &m->positions[3 * m->indices[3 * s + k]];
+    const float *b = &m->positions[3 * m->indices[3 * s + (k + 1) % 3]];
+    *l = *l2 = -1;
+    for (int j = 0; j < 3; ++j) {
+        const float *c = &m->positions[3 * m->indices[3 * t + j]];
+        if (memcmp(a, c, 3 * sizeof *a) == 0) {
+            *l = j;
+        }
+        if (memcmp(b, c, 3 * sizeof *b) == 0) {
+            *l2 = j;
+        }
+    }
+    return *l >= 0 && *l2 >= 0;
+}
+
+// The smooth surface is closed: every edge two triangles share has its points
+// at the same place, bit for bit, from both, also where their normals differ
+// at an end (a crease: the cylinder's rim, the cone's apex). Before the
+// creases were kept straight, each side curved such an edge its own way and
+// the cameras saw the inside through the crack (the south pole of a lumpy
+// sphere took the rain of its top, seen through its north pole's fan).
+TEST(smooth_surface_is_closed_along_creases)
+{
+    const char *path = write_capped_cylinder(make_dir("creases"));
+    ENSURE(path != NULL);
+    wx_mesh_data m;
+    wx_error err;
+    ENSURE(wx_mesh_import(path, &m, &err) == WX_OK);
+    ENSURE(m.triangle_count == 32);
+    ENSURE(m.creases != NULL);
+    int creases = 0, shared = 0, curved = 0;
+    for (int64_t s = 0; s < m.triangle_count; ++s) {
+        for (int k = 0; k < 3; ++k) {
+            creases += (m.creases[s] >> k) & 1;
+            for (int64_t t = 0; t < m.triangle_count; ++t) {
+                int l, l2;
+                if (t == s || !shared_edge(&m, s, k, t, &l, &l2)) {
+                    continue;
+                }
+                shared++;
+                double bent = 0.0;
+                for (int i = 0; i <= 8; ++i) {
+                    double ws[3] = { 0, 0, 0 }, wt[3] = { 0, 0, 0 }, ps[3], pt[3];
+                    ws[k] = wt[l] = (8 - i) / 8.0;
+                    ws[(k + 1) % 3] = wt[l2] = i / 8.0;
+                    wx_mesh_phong_point(&m, s, ws, ps);
+                    wx_mesh_phong_point(&m, t, wt, pt);
+                    ENSURE(memcmp(ps, pt, sizeof ps) == 0);
+                    const float *a = &m.positions[3 * m.indices[3 * s + k]];
+                    const float *b = &m.positions[3 * m.indices[3 * s + (k + 1) % 3]];
+                    for (int c = 0; c < 3; ++c) {
+                        bent = fmax(bent, fabs(ps[c] - (ws[k] * a[c] + ws[(k + 1) % 3] * b[c])));
+                    }
+                }
+                curved += bent > 1e-3;
+            }
+        }
+    }
+    printf("        %d crease edges of 96, %d shared edges, %d of them curved\n", creases, shared,
+           curved);
+    // The bottom rim's 8 edges and the cone's 8 edges at the apex, each on
+    // both sides (the top rim is smooth: the side and the cone lie within 60
+    // degrees); the side's vertical edges and the top rim stay curved.
+    ENSURE(creases == 32);
+    ENSURE(shared == 96);
+    ENSURE(curved >= 16);
+    wx_mesh_data_free(&m);
+}
+
 // --- import time (issue 24 item 8) ------------------------------------------------------
 
 // Seconds of a time bound: ten times longer under AddressSanitizer, whose
@@ -1218,6 +1321,7 @@ int main(void)
     RUN(smooth_surface_of_a_coarse_sphere_is_rounder);
     RUN(smooth_subdivision_leaves_no_crack);
     RUN(flat_shading_is_not_cut);
+    RUN(smooth_surface_is_closed_along_creases);
     RUN(two_materials_keep_their_names);
     RUN(box_gets_flat_generated_normals);
     RUN(ply_vertex_colours);

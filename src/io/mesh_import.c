@@ -817,6 +817,9 @@ wx_result wx_mesh_import_uvs(const char *path, unsigned uv_channels, wx_mesh_dat
     if (r == WX_OK) {
         r = wx_mesh_orient_outwards(out, &out->parts_turned, err);
     }
+    if (r == WX_OK) {
+        r = wx_mesh_find_creases(out, err); // after the turn: it compares normals
+    }
     free(st.material_slot);
     io_free(&io);
     if (r != WX_OK) {

@@ -15,9 +15,11 @@ void wx_mesh_data_release_arrays(wx_mesh_data *mesh)
     free(mesh->colors);
     free(mesh->indices);
     free(mesh->materials);
+    free(mesh->creases);
     mesh->positions = mesh->normals = mesh->colors = NULL;
     mesh->indices = NULL;
     mesh->materials = NULL;
+    mesh->creases = NULL;
     for (int c = 0; c < WX_MESH_MAX_UV_CHANNELS; ++c) {
         free(mesh->uvs[c]);
         mesh->uvs[c] = NULL;
@@ -47,6 +49,40 @@ static bool corner_after(const wx_mesh_data *mesh, uint32_t a, uint32_t b)
     return false;
 }
 
+// Corner v's position and unit normal (0 when it has none), in double.
+static void unit_corner(const wx_mesh_data *mesh, uint32_t v, double p[3], double n[3])
+{
+    const float *pv = &mesh->positions[3 * (size_t)v];
+    const float *nv = &mesh->normals[3 * (size_t)v];
+    double len = sqrt((double)nv[0] * nv[0] + (double)nv[1] * nv[1] + (double)nv[2] * nv[2]);
+    for (int a = 0; a < 3; ++a) {
+        p[a] = pv[a];
+        n[a] = len > 1e-6 ? nv[a] / len : 0.0;
+    }
+}
+
+// The crease bit of the edge between corners j and l of a triangle: bit k
+// is the edge from corner k to corner k + 1 (mod 3).
+static inline uint8_t edge_bit(int j, int l)
+{
+    return (uint8_t)(1u << (l == (j + 1) % 3 ? j : l));
+}
+
+// The Phong displacement of edge kl: E = (e . n_k) n_k - (e . n_l) n_l with
+// e = p_l - p_k, so that the point of weights w moves by -sum w_k w_l E_kl
+// (the flat point minus p_k is the sum over l of w_l (p_l - p_k)). 0 when the
+// two normals are equal.
+static void phong_edge(const double pk[3], const double nk[3], const double pl[3],
+                       const double nl[3], double out[3])
+{
+    double e[3] = { pl[0] - pk[0], pl[1] - pk[1], pl[2] - pk[2] };
+    double ek = e[0] * nk[0] + e[1] * nk[1] + e[2] * nk[2];
+    double el = e[0] * nl[0] + e[1] * nl[1] + e[2] * nl[2];
+    for (int a = 0; a < 3; ++a) {
+        out[a] = ek * nk[a] - el * nl[a];
+    }
+}
+
 void wx_mesh_phong_point(const wx_mesh_data *mesh, int64_t tri, const double w[3],
                          double out[3])
 {
@@ -64,77 +100,71 @@ void wx_mesh_phong_point(const wx_mesh_data *mesh, int64_t tri, const double w[3
             order[b - 1] = swap;
         }
     }
-    double flat[3] = { 0.0, 0.0, 0.0 };
+    double flat[3] = { 0.0, 0.0, 0.0 }, p[3][3], n[3][3];
     for (int j = 0; j < 3; ++j) {
-        const float *pk = &mesh->positions[3 * (size_t)tri_idx[order[j]]];
+        unit_corner(mesh, tri_idx[order[j]], p[j], n[j]);
         for (int a = 0; a < 3; ++a) {
-            flat[a] += w[order[j]] * pk[a];
+            flat[a] += w[order[j]] * p[j][a];
         }
     }
+    // Projected onto each corner's tangent plane and blended, the flat point
+    // moves by -sum over the edges kl of w_k w_l E_kl (phong_edge): on an
+    // edge only its own term is left, so its curve depends on the edge alone,
+    // and a crease's is left out on both sides.
+    uint8_t creases = mesh->creases != NULL ? mesh->creases[tri] : 0;
     double q[3] = { 0.0, 0.0, 0.0 };
-    for (int j = 0; j < 3; ++j) {
-        int k = order[j];
-        const float *pk = &mesh->positions[3 * (size_t)tri_idx[k]];
-        const float *nk = &mesh->normals[3 * (size_t)tri_idx[k]];
-        double len = sqrt((double)nk[0] * nk[0] + (double)nk[1] * nk[1] + (double)nk[2] * nk[2]);
-        double n[3] = { 0.0, 0.0, 0.0 }, along = 0.0;
-        if (len > 1e-6) {
-            for (int a = 0; a < 3; ++a) {
-                n[a] = nk[a] / len;
-                along += (flat[a] - pk[a]) * n[a];
+    for (int j = 0; j < 2; ++j) {
+        for (int l = j + 1; l < 3; ++l) {
+            if (creases & edge_bit(order[j], order[l])) {
+                continue;
             }
-        }
-        for (int a = 0; a < 3; ++a) {
-            q[a] += w[k] * (flat[a] - along * n[a]);
+            double e[3];
+            phong_edge(p[j], n[j], p[l], n[l], e);
+            double wjl = w[order[j]] * w[order[l]];
+            for (int a = 0; a < 3; ++a) {
+                q[a] -= wjl * e[a];
+            }
         }
     }
     for (int a = 0; a < 3; ++a) {
-        q[a] = flat[a] + WX_PHONG_SHAPE * (q[a] - flat[a]);
+        out[a] = flat[a] + WX_PHONG_SHAPE * q[a];
     }
-    memcpy(out, q, sizeof q);
 }
 
 void wx_mesh_phong_normal(const wx_mesh_data *mesh, int64_t tri, const double w[3],
                           float out[3])
 {
-    // p(w) = flat(w) - s sum_k w_k ((flat(w) - p_k) . n_k) n_k, flat(w) = sum w_k p_k
-    // (s = WX_PHONG_SHAPE); its derivatives along w1 - w0 and w2 - w0 span the
-    // tangent plane.
+    // p(w) = flat(w) - s sum over the edges kl (not creases) of w_k w_l E_kl,
+    // flat(w) = sum w_k p_k (s = WX_PHONG_SHAPE, wx_mesh_phong_point); its
+    // derivatives along w1 - w0 and w2 - w0 span the tangent plane.
     const uint32_t *idx = &mesh->indices[3 * (size_t)tri];
-    double p[3][3], n[3][3], flat[3] = { 0, 0, 0 }, interpolated[3] = { 0, 0, 0 };
+    double p[3][3], n[3][3], interpolated[3] = { 0, 0, 0 };
     for (int k = 0; k < 3; ++k) {
-        const float *pk = &mesh->positions[3 * (size_t)idx[k]];
-        const float *nk = &mesh->normals[3 * (size_t)idx[k]];
-        double len = sqrt((double)nk[0] * nk[0] + (double)nk[1] * nk[1] + (double)nk[2] * nk[2]);
+        unit_corner(mesh, idx[k], p[k], n[k]);
         for (int a = 0; a < 3; ++a) {
-            p[k][a] = pk[a];
-            n[k][a] = len > 1e-6 ? nk[a] / len : 0.0;
-            flat[a] += w[k] * pk[a];
-            interpolated[a] += w[k] * nk[a];
+            interpolated[a] += w[k] * mesh->normals[3 * (size_t)idx[k] + (size_t)a];
         }
     }
-    double along[3];
-    for (int k = 0; k < 3; ++k) {
-        along[k] = 0.0;
-        for (int a = 0; a < 3; ++a) {
-            along[k] += (flat[a] - p[k][a]) * n[k][a];
-        }
-    }
+    uint8_t creases = mesh->creases != NULL ? mesh->creases[tri] : 0;
     double tangent[2][3];
     for (int d = 0; d < 2; ++d) {
         int to = d + 1; // the derivative along w_to - w0
-        double edge[3];
+        double dw[3] = { -1.0, to == 1 ? 1.0 : 0.0, to == 2 ? 1.0 : 0.0 };
         for (int a = 0; a < 3; ++a) {
-            edge[a] = p[to][a] - p[0][a];
+            tangent[d][a] = p[to][a] - p[0][a];
         }
-        for (int a = 0; a < 3; ++a) {
-            double t = edge[a];
-            for (int k = 0; k < 3; ++k) {
-                double dw = k == to ? 1.0 : k == 0 ? -1.0 : 0.0;
-                double dalong = edge[0] * n[k][0] + edge[1] * n[k][1] + edge[2] * n[k][2];
-                t -= WX_PHONG_SHAPE * (dw * along[k] + w[k] * dalong) * n[k][a];
+        for (int k = 0; k < 2; ++k) {
+            for (int l = k + 1; l < 3; ++l) {
+                if (creases & edge_bit(k, l)) {
+                    continue;
+                }
+                double e[3];
+                phong_edge(p[k], n[k], p[l], n[l], e);
+                double dkl = dw[k] * w[l] + w[k] * dw[l];
+                for (int a = 0; a < 3; ++a) {
+                    tangent[d][a] -= WX_PHONG_SHAPE * dkl * e[a];
+                }
             }
-            tangent[d][a] = t;
         }
     }
     double c[3] = { tangent[0][1] * tangent[1][2] - tangent[0][2] * tangent[1][1],
@@ -149,19 +179,22 @@ void wx_mesh_phong_normal(const wx_mesh_data *mesh, int64_t tri, const double w[
     }
 }
 
-// Whether the normals at the two ends of an edge differ: only then does the
-// smooth surface leave the flat triangle along it.
-static bool edge_curves(const wx_mesh_data *mesh, uint32_t a, uint32_t b)
+// Whether edge k of triangle t (corner k to corner k + 1) bends the smooth
+// surface: its two normals differ and it is not a crease.
+static bool edge_curves(const wx_mesh_data *mesh, int64_t t, int k)
 {
-    const float *na = &mesh->normals[3 * (size_t)a], *nb = &mesh->normals[3 * (size_t)b];
+    if (mesh->creases != NULL && (mesh->creases[t] >> k & 1u)) {
+        return false;
+    }
+    const uint32_t *idx = &mesh->indices[3 * t];
+    const float *na = &mesh->normals[3 * (size_t)idx[k]];
+    const float *nb = &mesh->normals[3 * (size_t)idx[(k + 1) % 3]];
     return na[0] != nb[0] || na[1] != nb[1] || na[2] != nb[2];
 }
 
 bool wx_mesh_triangle_curves(const wx_mesh_data *mesh, int64_t t)
 {
-    const uint32_t *idx = &mesh->indices[3 * t];
-    return edge_curves(mesh, idx[0], idx[1]) || edge_curves(mesh, idx[1], idx[2]) ||
-           edge_curves(mesh, idx[2], idx[0]);
+    return edge_curves(mesh, t, 0) || edge_curves(mesh, t, 1) || edge_curves(mesh, t, 2);
 }
 
 static int compare_doubles(const void *a, const void *b)
@@ -180,7 +213,7 @@ double wx_mesh_curved_edge_length(const wx_mesh_data *mesh, double quantile)
         const uint32_t *idx = &mesh->indices[3 * t];
         for (int k = 0; k < 3; ++k) {
             uint32_t a = idx[k], b = idx[(k + 1) % 3];
-            if (!edge_curves(mesh, a, b)) {
+            if (!edge_curves(mesh, t, k)) {
                 continue;
             }
             const float *pa = &mesh->positions[3 * (size_t)a];
@@ -303,13 +336,141 @@ wx_result wx_mesh_smooth_subdivide(wx_mesh_data *mesh, int level, wx_error *err)
     free(mesh->colors);
     free(mesh->indices);
     free(mesh->materials);
+    free(mesh->creases); // the pieces are drawn, not cut again
     mesh->positions = positions;
     mesh->normals = normals;
     mesh->colors = colors;
     mesh->indices = indices;
     mesh->materials = materials;
+    mesh->creases = NULL;
     mesh->vertex_count = (int64_t)v;
     mesh->triangle_count = (int64_t)t_out;
+    return WX_OK;
+}
+
+// --- creases ---------------------------------------------------------------------
+
+// One edge of a triangle, found by a hash of its ends' positions (in the order
+// corner_after gives them, -0 as +0).
+typedef struct edge_record {
+    uint64_t hash;
+    uint32_t tri;
+    uint8_t k; ///< the edge from corner k to corner k + 1
+} edge_record;
+
+static uint64_t mix64(uint64_t h, float v)
+{
+    uint32_t bits;
+    float f = v == 0.0f ? 0.0f : v; // -0 as +0
+    memcpy(&bits, &f, sizeof bits);
+    h ^= bits;
+    h *= 0x9E3779B97F4A7C15ull;
+    return h ^ (h >> 29);
+}
+
+// The ends of edge k of triangle t, the one corner_after puts first as *lo.
+static void edge_ends(const wx_mesh_data *mesh, uint32_t t, int k, uint32_t *lo, uint32_t *hi)
+{
+    uint32_t a = mesh->indices[3 * (size_t)t + (size_t)k];
+    uint32_t b = mesh->indices[3 * (size_t)t + (size_t)((k + 1) % 3)];
+    const float *pa = &mesh->positions[3 * (size_t)a], *pb = &mesh->positions[3 * (size_t)b];
+    bool swap = false;
+    for (int i = 0; i < 3; ++i) {
+        if (pa[i] != pb[i]) {
+            swap = pa[i] > pb[i];
+            break;
+        }
+    }
+    *lo = swap ? b : a;
+    *hi = swap ? a : b;
+}
+
+static bool same3(const float *a, const float *b)
+{
+    return a[0] == b[0] && a[1] == b[1] && a[2] == b[2];
+}
+
+static int compare_records(const void *a, const void *b)
+{
+    const edge_record *x = a, *y = b;
+    if (x->hash != y->hash) {
+        return x->hash < y->hash ? -1 : 1;
+    }
+    return x->tri != y->tri ? (x->tri < y->tri ? -1 : 1) : (int)x->k - (int)y->k;
+}
+
+wx_result wx_mesh_find_creases(wx_mesh_data *mesh, wx_error *err)
+{
+    free(mesh->creases);
+    mesh->creases = NULL;
+    size_t T = (size_t)mesh->triangle_count;
+    if (T == 0 || mesh->normals == NULL) {
+        return WX_OK;
+    }
+    edge_record *rec = malloc(3 * T * sizeof *rec);
+    uint8_t *creases = calloc(T, 1);
+    if (rec == NULL || creases == NULL) {
+        free(rec);
+        free(creases);
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory finding the mesh's creases");
+    }
+    size_t n = 0;
+    for (size_t t = 0; t < T; ++t) {
+        for (int k = 0; k < 3; ++k) {
+            uint32_t lo, hi;
+            edge_ends(mesh, (uint32_t)t, k, &lo, &hi);
+            const float *pl = &mesh->positions[3 * (size_t)lo];
+            const float *ph = &mesh->positions[3 * (size_t)hi];
+            if (same3(pl, ph)) {
+                continue; // no length: nothing to bend
+            }
+            uint64_t h = 0x243F6A8885A308D3ull;
+            for (int a = 0; a < 3; ++a) {
+                h = mix64(h, pl[a]);
+            }
+            for (int a = 0; a < 3; ++a) {
+                h = mix64(h, ph[a]);
+            }
+            rec[n++] = (edge_record){ h, (uint32_t)t, (uint8_t)k };
+        }
+    }
+    qsort(rec, n, sizeof *rec, compare_records);
+    // In each run of one hash (an edge's triangles, and rarely another edge of
+    // the same hash), an edge is a crease when another triangle holds the same
+    // ends with another normal at either.
+    bool any = false;
+    for (size_t a = 0; a < n;) {
+        size_t b = a + 1;
+        while (b < n && rec[b].hash == rec[a].hash) {
+            b++;
+        }
+        for (size_t i = a; i < b; ++i) {
+            uint32_t li, hi_i;
+            edge_ends(mesh, rec[i].tri, rec[i].k, &li, &hi_i);
+            for (size_t j = a; j < b; ++j) {
+                uint32_t lj, hj;
+                edge_ends(mesh, rec[j].tri, rec[j].k, &lj, &hj);
+                const float *P = mesh->positions, *N = mesh->normals;
+                if (j == i || !same3(&P[3 * (size_t)li], &P[3 * (size_t)lj]) ||
+                    !same3(&P[3 * (size_t)hi_i], &P[3 * (size_t)hj])) {
+                    continue;
+                }
+                if (!same3(&N[3 * (size_t)li], &N[3 * (size_t)lj]) ||
+                    !same3(&N[3 * (size_t)hi_i], &N[3 * (size_t)hj])) {
+                    creases[rec[i].tri] |= (uint8_t)(1u << rec[i].k);
+                    any = true;
+                    break;
+                }
+            }
+        }
+        a = b;
+    }
+    free(rec);
+    if (any) {
+        mesh->creases = creases;
+    } else {
+        free(creases);
+    }
     return WX_OK;
 }
 

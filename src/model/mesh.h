@@ -30,6 +30,11 @@ typedef struct wx_mesh_data {
     float *uvs[WX_MESH_MAX_UV_CHANNELS];
     uint32_t *indices;     ///< 3 per triangle
     uint16_t *materials;   ///< 1 per triangle: index into material_names
+    /// 1 per triangle, NULL when the mesh has none: bit k set when the edge
+    /// from corner k to corner k + 1 (mod 3) is a crease, an edge whose other
+    /// triangle has other normals at its ends (wx_mesh_find_creases). The
+    /// smooth surface keeps it straight.
+    uint8_t *creases;
     int material_count;    ///< distinct material names used by triangles, in file order
     char (*material_names)[WX_MATERIAL_NAME_MAX];
     bool *material_colored; ///< per material: all its vertices carry a colour
@@ -83,11 +88,22 @@ void wx_mesh_phong_normal(const wx_mesh_data *mesh, int64_t tri, const double w[
 /// (0.9: nine in ten are shorter; 1: the longest); 0 for a flat-shaded mesh.
 double wx_mesh_curved_edge_length(const wx_mesh_data *mesh, double quantile);
 
-/// Whether triangle t has an edge whose vertex normals differ (the bake draws
-/// it on its smooth surface, with wx_mesh_phong_normal's normals).
+/// Finds the mesh's creases (mesh->creases; left NULL when it has none): the
+/// edges, by their ends' positions, that two triangles share with other
+/// normals at an end (a hard edge where the normals are split: a cylinder's
+/// rim between its flat cap and its smooth side, or the pole of a sphere whose
+/// fan exceeds the 60 degree smoothing). Each side would curve the edge its
+/// own way and the smooth surface would open a crack along it, through which
+/// the cameras would see the inside; straight on both sides, it stays closed.
+/// WX_FAIL when out of memory.
+wx_result wx_mesh_find_creases(wx_mesh_data *mesh, wx_error *err);
+
+/// Whether triangle t has an edge, not a crease, whose vertex normals differ
+/// (the bake draws it on its smooth surface, with wx_mesh_phong_normal's
+/// normals).
 bool wx_mesh_triangle_curves(const wx_mesh_data *mesh, int64_t t);
 
-/// How many triangles have an edge whose vertex normals differ.
+/// How many triangles have an edge, not a crease, whose vertex normals differ.
 int64_t wx_mesh_curved_triangles(const wx_mesh_data *mesh);
 
 /// The most triangles the bake cuts a mesh's smooth surface into

@@ -38,6 +38,14 @@ static wx_result copy_mesh(const wx_mesh_data *from, int uv, wx_mesh_data *to, w
     memcpy(to->normals, from->normals, 3 * nv * sizeof *to->normals);
     memcpy(to->indices, from->indices, 3 * nt * sizeof *to->indices);
     memcpy(to->uvs[uv], from->uvs[uv], 2 * nv * sizeof *to->uvs[uv]);
+    if (from->creases != NULL) {
+        to->creases = malloc(nt + 1);
+        if (to->creases == NULL) {
+            wx_mesh_data_free(to);
+            return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "texture: out of memory for the mesh");
+        }
+        memcpy(to->creases, from->creases, nt);
+    }
     return WX_OK;
 }
 
