@@ -884,8 +884,8 @@ static const char *write_capped_cylinder(const char *dir)
     for (int i = 0; i < 8; ++i) {
         int a = 1 + i, b = 1 + (i + 1) % 8;
         fprintf(f, "f %d %d %d\nf %d %d %d\n", a, a + 8, b + 8, a, b + 8, b); // side
-        fprintf(f, "f 17 %d %d\n", a, b);                                  // bottom
-        fprintf(f, "f 18 %d %d\n", b + 8, a + 8);                          // cone
+        fprintf(f, "f 17 %d %d\n", a, b);                                     // bottom
+        fprintf(f, "f 18 %d %d\n", b + 8, a + 8);                             // cone
     }
     return fclose(f) == 0 ? path : NULL;
 }

@@ -350,51 +350,35 @@ wx_result wx_mesh_smooth_subdivide(wx_mesh_data *mesh, int level, wx_error *err)
 
 // --- creases ---------------------------------------------------------------------
 
-// One edge of a triangle, found by a hash of its ends' positions (in the order
-// corner_after gives them, -0 as +0).
+// One edge of a triangle: hashes of its ends' positions and of the normals the
+// triangle gives them, both in the order corner_after puts the ends (-0 as +0).
 typedef struct edge_record {
-    uint64_t hash;
+    uint64_t where, normals;
     uint32_t tri;
     uint8_t k; ///< the edge from corner k to corner k + 1
 } edge_record;
 
-static uint64_t mix64(uint64_t h, float v)
+static uint64_t mix64(uint64_t h, const float *v)
 {
-    uint32_t bits;
-    float f = v == 0.0f ? 0.0f : v; // -0 as +0
-    memcpy(&bits, &f, sizeof bits);
-    h ^= bits;
-    h *= 0x9E3779B97F4A7C15ull;
-    return h ^ (h >> 29);
-}
-
-// The ends of edge k of triangle t, the one corner_after puts first as *lo.
-static void edge_ends(const wx_mesh_data *mesh, uint32_t t, int k, uint32_t *lo, uint32_t *hi)
-{
-    uint32_t a = mesh->indices[3 * (size_t)t + (size_t)k];
-    uint32_t b = mesh->indices[3 * (size_t)t + (size_t)((k + 1) % 3)];
-    const float *pa = &mesh->positions[3 * (size_t)a], *pb = &mesh->positions[3 * (size_t)b];
-    bool swap = false;
-    for (int i = 0; i < 3; ++i) {
-        if (pa[i] != pb[i]) {
-            swap = pa[i] > pb[i];
-            break;
-        }
+    for (int a = 0; a < 3; ++a) {
+        uint32_t bits;
+        float f = v[a] == 0.0f ? 0.0f : v[a]; // -0 as +0
+        memcpy(&bits, &f, sizeof bits);
+        h ^= bits;
+        h *= 0x9E3779B97F4A7C15ull;
+        h ^= h >> 29;
     }
-    *lo = swap ? b : a;
-    *hi = swap ? a : b;
-}
-
-static bool same3(const float *a, const float *b)
-{
-    return a[0] == b[0] && a[1] == b[1] && a[2] == b[2];
+    return h;
 }
 
 static int compare_records(const void *a, const void *b)
 {
     const edge_record *x = a, *y = b;
-    if (x->hash != y->hash) {
-        return x->hash < y->hash ? -1 : 1;
+    if (x->where != y->where) {
+        return x->where < y->where ? -1 : 1;
+    }
+    if (x->normals != y->normals) {
+        return x->normals < y->normals ? -1 : 1;
     }
     return x->tri != y->tri ? (x->tri < y->tri ? -1 : 1) : (int)x->k - (int)y->k;
 }
@@ -416,52 +400,44 @@ wx_result wx_mesh_find_creases(wx_mesh_data *mesh, wx_error *err)
     }
     size_t n = 0;
     for (size_t t = 0; t < T; ++t) {
+        const uint32_t *idx = &mesh->indices[3 * t];
         for (int k = 0; k < 3; ++k) {
-            uint32_t lo, hi;
-            edge_ends(mesh, (uint32_t)t, k, &lo, &hi);
+            uint32_t lo = idx[k], hi = idx[(k + 1) % 3];
             const float *pl = &mesh->positions[3 * (size_t)lo];
             const float *ph = &mesh->positions[3 * (size_t)hi];
-            if (same3(pl, ph)) {
+            if (pl[0] == ph[0] && pl[1] == ph[1] && pl[2] == ph[2]) {
                 continue; // no length: nothing to bend
             }
-            uint64_t h = 0x243F6A8885A308D3ull;
-            for (int a = 0; a < 3; ++a) {
-                h = mix64(h, pl[a]);
+            if (pl[0] > ph[0] || (pl[0] == ph[0] && (pl[1] > ph[1] ||
+                                                     (pl[1] == ph[1] && pl[2] > ph[2])))) {
+                uint32_t swap = lo;
+                lo = hi;
+                hi = swap;
             }
-            for (int a = 0; a < 3; ++a) {
-                h = mix64(h, ph[a]);
-            }
-            rec[n++] = (edge_record){ h, (uint32_t)t, (uint8_t)k };
+            const uint64_t seed = 0x243F6A8885A308D3ull;
+            uint64_t where = mix64(mix64(seed, &mesh->positions[3 * (size_t)lo]),
+                                   &mesh->positions[3 * (size_t)hi]);
+            uint64_t normals = mix64(mix64(seed, &mesh->normals[3 * (size_t)lo]),
+                                     &mesh->normals[3 * (size_t)hi]);
+            rec[n++] = (edge_record){ where, normals, (uint32_t)t, (uint8_t)k };
         }
     }
+    // Sorted, an edge's triangles lie together (the ones that give it the same
+    // normals together too): it is a crease when its first and last differ.
+    // Two edges whose positions share a hash would only both be kept
+    // straight, on both sides alike: no crack either way.
     qsort(rec, n, sizeof *rec, compare_records);
-    // In each run of one hash (an edge's triangles, and rarely another edge of
-    // the same hash), an edge is a crease when another triangle holds the same
-    // ends with another normal at either.
     bool any = false;
     for (size_t a = 0; a < n;) {
         size_t b = a + 1;
-        while (b < n && rec[b].hash == rec[a].hash) {
+        while (b < n && rec[b].where == rec[a].where) {
             b++;
         }
-        for (size_t i = a; i < b; ++i) {
-            uint32_t li, hi_i;
-            edge_ends(mesh, rec[i].tri, rec[i].k, &li, &hi_i);
-            for (size_t j = a; j < b; ++j) {
-                uint32_t lj, hj;
-                edge_ends(mesh, rec[j].tri, rec[j].k, &lj, &hj);
-                const float *P = mesh->positions, *N = mesh->normals;
-                if (j == i || !same3(&P[3 * (size_t)li], &P[3 * (size_t)lj]) ||
-                    !same3(&P[3 * (size_t)hi_i], &P[3 * (size_t)hj])) {
-                    continue;
-                }
-                if (!same3(&N[3 * (size_t)li], &N[3 * (size_t)lj]) ||
-                    !same3(&N[3 * (size_t)hi_i], &N[3 * (size_t)hj])) {
-                    creases[rec[i].tri] |= (uint8_t)(1u << rec[i].k);
-                    any = true;
-                    break;
-                }
+        if (rec[b - 1].normals != rec[a].normals) {
+            for (size_t i = a; i < b; ++i) {
+                creases[rec[i].tri] |= (uint8_t)(1u << rec[i].k);
             }
+            any = true;
         }
         a = b;
     }
