@@ -408,8 +408,8 @@ wx_result wx_mesh_find_creases(wx_mesh_data *mesh, wx_error *err)
             if (pl[0] == ph[0] && pl[1] == ph[1] && pl[2] == ph[2]) {
                 continue; // no length: nothing to bend
             }
-            if (pl[0] > ph[0] || (pl[0] == ph[0] && (pl[1] > ph[1] ||
-                                                     (pl[1] == ph[1] && pl[2] > ph[2])))) {
+            if (pl[0] > ph[0] ||
+                (pl[0] == ph[0] && (pl[1] > ph[1] || (pl[1] == ph[1] && pl[2] > ph[2])))) {
                 uint32_t swap = lo;
                 lo = hi;
                 hi = swap;
@@ -417,8 +417,8 @@ wx_result wx_mesh_find_creases(wx_mesh_data *mesh, wx_error *err)
             const uint64_t seed = 0x243F6A8885A308D3ull;
             uint64_t where = mix64(mix64(seed, &mesh->positions[3 * (size_t)lo]),
                                    &mesh->positions[3 * (size_t)hi]);
-            uint64_t normals = mix64(mix64(seed, &mesh->normals[3 * (size_t)lo]),
-                                     &mesh->normals[3 * (size_t)hi]);
+            uint64_t normals =
+                mix64(mix64(seed, &mesh->normals[3 * (size_t)lo]), &mesh->normals[3 * (size_t)hi]);
             rec[n++] = (edge_record){ where, normals, (uint32_t)t, (uint8_t)k };
         }
     }
