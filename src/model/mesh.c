@@ -358,13 +358,19 @@ typedef struct edge_record {
     uint8_t k; ///< the edge from corner k to corner k + 1
 } edge_record;
 
+// The bits of a coordinate, -0 as +0 (the same position or normal).
+static uint32_t coordinate_bits(float f)
+{
+    f = f == 0.0f ? 0.0f : f;
+    uint32_t u;
+    memcpy(&u, &f, sizeof u);
+    return u;
+}
+
 static uint64_t mix64(uint64_t h, const float *v)
 {
     for (int a = 0; a < 3; ++a) {
-        uint32_t bits;
-        float f = v[a] == 0.0f ? 0.0f : v[a]; // -0 as +0
-        memcpy(&bits, &f, sizeof bits);
-        h ^= bits;
+        h ^= coordinate_bits(v[a]);
         h *= 0x9E3779B97F4A7C15ull;
         h ^= h >> 29;
     }
@@ -462,14 +468,6 @@ typedef struct edge_key {
     uint32_t forward; // 1 when the triangle runs from the smaller id to the larger
     uint32_t part;
 } edge_key;
-
-static uint32_t coordinate_bits(float f)
-{
-    f = f == 0.0f ? 0.0f : f;
-    uint32_t u;
-    memcpy(&u, &f, sizeof u);
-    return u;
-}
 
 static int compare_positions(const void *a, const void *b)
 {
