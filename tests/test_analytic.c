@@ -452,7 +452,7 @@ static const char *lumpy_scene =
     "    <BoxEmitter minX=\"-1.5\" minY=\"3\" minZ=\"-1.5\" maxX=\"1.5\" maxY=\"3\" maxZ=\"1.5\"\n"
     "                dirX=\"0\" dirY=\"-1\" dirZ=\"0\" rate=\"400000\" end=\"1\" speed=\"10\"/>\n"
     "  </Emitters>\n"
-    "  <Collider>\n"
+    "  <Collider%s>\n"
     "    <ProjectedMaps>\n"
     "      <Ortho cameraName=\"top\"%s><View eye=\"0 5 0\" target=\"0 1.2 0\" up=\"0 0 -1\"\n"
     "        width=\"3\" height=\"3\" resolution=\"384\"/></Ortho>\n"
@@ -468,26 +468,58 @@ static const char *lumpy_scene =
     "  </Collider>\n"
     "  <Geometry>\n"
     "    <Mesh file=\"%s\">\n"
-    "      <Surface material=\"*\" absorption=\"1\"/>\n"
+    "      <Surface material=\"*\" %s/>\n"
     "      <TextureMap file=\"t.exr\" resolution=\"512\" padding=\"4\"/>\n"
     "    </Mesh>\n"
     "  </Geometry>\n"
     "  <Masks><Exposure name=\"sun\" elevation=\"90\" azimuth=\"0\"/></Masks>\n"
     "</Weathering>\n";
 
-// Runs the lumpy sphere (turned or not, seed) and reads its texture's dirt,
-// the exact shape (sun) and seen; false on failure.
-static bool run_lumpy(const char *dir, const char *model, int seed, int layers, float **dirt,
-                      float **sun, float **seen)
+// Replaces every `from` in text (of capacity cap) with `to`.
+static void replace_all(char *text, size_t cap, const char *from, const char *to)
+{
+    size_t lf = strlen(from), lt = strlen(to);
+    for (char *at = strstr(text, from); at != NULL; at = strstr(at + lt, from)) {
+        size_t tail = strlen(at + lf);
+        if ((size_t)(at - text) + lt + tail + 1 > cap) {
+            return;
+        }
+        memmove(at + lt, at + lf, tail + 1);
+        memcpy(at, to, lt);
+    }
+}
+
+// Every drop absorbed where it lands (the exact density is known).
+static const char *ABSORB = "absorption=\"1\"";
+// The rain preset's collider and surfaces: drops that slide.
+static const char *RAIN_COLLIDER =
+    " resilience=\"0.2\" friction=\"0.9\" adherence=\"1\" deposit=\"1\" erosion=\"1\"";
+static const char *RAIN_SURFACE =
+    "absorption=\"0.05\" bounce=\"0.15\" deposit=\"0.3\" erosion=\"0.4\"";
+
+// Runs the lumpy sphere (turned or not, seed) with the given collider
+// attributes and surface, and reads its texture's dirt, the exact shape (sun)
+// and seen; false on failure.
+static bool run_lumpy_with(const char *dir, const char *model, int seed, int layers,
+                           const char *collider, const char *surface, float **dirt, float **sun,
+                           float **seen)
 {
     char name[64], scene[8192], path[4300], mesh[80];
     snprintf(mesh, sizeof mesh, "%s.obj", model);
-    snprintf(name, sizeof name, "%s%d_%d", model, seed, layers);
+    snprintf(name, sizeof name, "%s%d_%d%s", model, seed, layers, surface == ABSORB ? "" : "_s");
     char file[80];
     snprintf(file, sizeof file, "%s.xml", name);
     char attr[32];
     snprintf(attr, sizeof attr, " layers=\"%d\"", layers);
-    snprintf(scene, sizeof scene, lumpy_scene, seed, attr, attr, attr, attr, attr, mesh);
+    snprintf(scene, sizeof scene, lumpy_scene, seed, collider, attr, attr, attr, attr, attr, mesh,
+             surface);
+    if (surface != ABSORB) {
+        // Sliding drops: finer maps and steps, as init makes them for a model
+        // of this size (texels of 4 mm, a step of 7 ms).
+        replace_all(scene, sizeof scene, "resolution=\"384\"", "resolution=\"768\"");
+        replace_all(scene, sizeof scene, "timeStep=\"0.02\" steps=\"100\"",
+                    "timeStep=\"0.007\" steps=\"430\"");
+    }
     ensure_write_file(dir, file, scene);
     if (!run_scene(dir, file, name)) {
         return false;
@@ -503,6 +535,81 @@ static bool run_lumpy(const char *dir, const char *model, int seed, int layers, 
         }
     }
     return *dirt != NULL && *sun != NULL && *seen != NULL;
+}
+
+static bool run_lumpy(const char *dir, const char *model, int seed, int layers, float **dirt,
+                      float **sun, float **seen)
+{
+    return run_lumpy_with(dir, model, seed, layers, "", ABSORB, dirt, sun, seen);
+}
+
+// The lumpy sphere under the rain preset's sliding drops, five cameras of four
+// layers, seeds 1 and 2, as it is and turned 30 degrees: over 16 x 16-texel
+// blocks of the upper sphere the two orientations may differ at most
+// MAX_TURN_RATIO times as much as the two seeds do. Measured (4 December
+// 2026): seeds 0.0231 of the mean apart, orientations 0.0277, ratio 1.198;
+// before each camera's crossings were widened by their margin
+// (docs/physics.md, "Which camera's surface a particle meets") the sliding
+// followed whichever camera's surface lay innermost: 0.0235, 0.0300, 1.277.
+// The run is deterministic, so the bound between the two tells them apart;
+// issue 25's 1.05 is not met (docs/performance.md).
+#define MAX_TURN_RATIO 1.24
+TEST(lumpy_sphere_turned_slides_as_a_new_seed_does)
+{
+    SLOW();
+    const char *dir = ensure_tmpdir();
+    lumpy_sphere(dir, "lumpy.obj", 0.0, false);
+    lumpy_sphere(dir, "turned.obj", 30.0, false);
+    enum { RUNS = 4, W = 512, B = 16 };
+    const char *model[RUNS] = { "lumpy", "lumpy", "turned", "turned" };
+    const int seed[RUNS] = { 1, 2, 1, 2 };
+    float *dirt[RUNS] = { NULL }, *sun[RUNS] = { NULL }, *seen[RUNS] = { NULL };
+    for (int r = 0; r < RUNS; ++r) {
+        ENSURE(run_lumpy_with(dir, model[r], seed[r], 4, RAIN_COLLIDER, RAIN_SURFACE, &dirt[r],
+                              &sun[r], &seen[r]));
+    }
+    double seeds = 0.0, turn = 0.0, mean = 0.0;
+    int blocks = 0;
+    for (int by = 48 / B; by < 192 / B; ++by) {
+        for (int bx = 0; bx < W / B; ++bx) {
+            double d[RUNS] = { 0 };
+            bool ok = true;
+            for (int y = by * B; y < (by + 1) * B && ok; ++y) {
+                for (int x = bx * B; x < (bx + 1) * B; ++x) {
+                    size_t i = (size_t)y * W + (size_t)x;
+                    for (int r = 0; r < RUNS && ok; ++r) {
+                        ok = seen[r][i] > 0.5f && sun[r][i] > 0.3f;
+                    }
+                    if (!ok) {
+                        break;
+                    }
+                    for (int r = 0; r < RUNS; ++r) {
+                        d[r] += dirt[r][i];
+                    }
+                }
+            }
+            if (!ok) {
+                continue;
+            }
+            seeds += pow(d[1] - d[0], 2.0) + pow(d[3] - d[2], 2.0);
+            turn += pow(d[2] - d[0], 2.0) + pow(d[3] - d[1], 2.0);
+            mean += 0.25 * (d[0] + d[1] + d[2] + d[3]);
+            blocks++;
+        }
+    }
+    for (int r = 0; r < RUNS; ++r) {
+        free(dirt[r]);
+        free(sun[r]);
+        free(seen[r]);
+    }
+    ENSURE(blocks >= 200);
+    mean /= blocks;
+    seeds = sqrt(seeds / (2.0 * blocks)) / mean;
+    turn = sqrt(turn / (2.0 * blocks)) / mean;
+    printf("        %d blocks of 16 x 16: seeds differ %.4f, orientations %.4f of the mean: "
+           "ratio %.3f\n",
+           blocks, seeds, turn, turn / seeds);
+    ENSURE(turn <= MAX_TURN_RATIO * seeds);
 }
 
 // Measured (3 December 2026): each run within 1.6% RMS of the exact density
@@ -707,6 +814,7 @@ int main(void)
     RUN(wall_under_an_overhang_in_slanting_rain);
     RUN(shelter_edge_at_30_degrees_to_the_cameras_is_straight);
     RUN(lumpy_sphere_turned_in_the_camera_grid_keeps_its_exact_rain);
+    RUN(lumpy_sphere_turned_slides_as_a_new_seed_does);
     RUN(lumpy_sphere_bottom_stays_dry_under_a_layered_top_camera);
     RUN(lumpy_sphere_wound_inwards_weathers_as_wound_outwards);
     return ensure_summary();

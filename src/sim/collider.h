@@ -68,6 +68,13 @@ typedef struct wx_collider_camera {
     /// layer of the maps (normal, impact, the hit's layer) it came from.
     uint8_t *origin;
     double sheet;
+    /// With layers: the unit direction towards the camera (back / |back|),
+    /// |back|, and the widest `margin` any crossing gets (collider.c,
+    /// crossing_margin; in d), which the coarse pyramid and the cells' near
+    /// bound leave room for.
+    float unit_back[3];
+    double back_length;
+    double margin_max;
     /// Coarse pyramid: level l has blocks of 4 << 2l texels; its value at block
     /// (bx, by) is the least depth over the 3x3 blocks around it, lowered by a
     /// rounding margin. Levels are stored one after the other in `coarse`.

@@ -107,7 +107,7 @@ static wx_result build_coarse(wx_collider_camera *cam, wx_error *err)
             }
         }
     }
-    double margin_base = 1e-4 * cam->texel_ws;
+    double margin_base = 1e-4 * cam->texel_ws + cam->margin_max;
     for (int l = 0; l < WX_COARSE_LEVELS; ++l) {
         const float *src = blockmin + cam->level_offset[l];
         float *dst = cam->coarse + cam->level_offset[l];
@@ -290,15 +290,23 @@ wx_result wx_collider_init(wx_collider *collider, const wx_camera *cameras, cons
         cam->frames_model = border_is_empty(cam->depth, m->width, m->height);
         cam->normal = m->normal;
         cam->impact = m->impact;
+        // Every camera's axis counts when a layered camera's margin is measured.
+        cam->back_length =
+            sqrt((double)cam->back[0] * cam->back[0] + (double)cam->back[1] * cam->back[1] +
+                 (double)cam->back[2] * cam->back[2]);
+        for (int k = 0; k < 3; ++k) {
+            cam->unit_back[k] =
+                cam->back_length > 0.0 ? (float)(cam->back[k] / cam->back_length) : 0.0f;
+        }
         if (layers > 1) {
             // A quarter texel (docs/physics.md, "Layered maps"): thick enough for
             // float rounding and to bridge the steps the silhouette rule leaves
             // along a sheet's edge, thin enough that a hit from behind lies
             // within half the collider's precision (half a texel) of the sheet.
-            double bl =
-                sqrt((double)cam->back[0] * cam->back[0] + (double)cam->back[1] * cam->back[1] +
-                     (double)cam->back[2] * cam->back[2]);
+            double bl = cam->back_length;
             cam->sheet = 0.25 * cam->texel_ws / bl;
+            // collider.c's crossing_margin: at most 4 half texels (MARGIN_MAX_TAN).
+            cam->margin_max = bl > 0.0 ? 2.0 * cam->texel_ws / bl : 0.0;
             classify_layers(cam);
         }
         r = build_coarse(cam, err);
