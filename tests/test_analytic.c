@@ -547,7 +547,7 @@ static bool run_lumpy(const char *dir, const char *model, int seed, int layers, 
 // layers, seeds 1 and 2, as it is and turned 30 degrees: over 16 x 16-texel
 // blocks of the upper sphere the two orientations may differ at most
 // MAX_TURN_RATIO times as much as the two seeds do. Measured (4 December
-// 2026): seeds 0.0231 of the mean apart, orientations 0.0277, ratio 1.198;
+// 2026): seeds 0.0230 of the mean apart, orientations 0.0274, ratio 1.190;
 // before each camera's crossings were widened by their margin
 // (docs/physics.md, "Which camera's surface a particle meets") the sliding
 // followed whichever camera's surface lay innermost: 0.0235, 0.0300, 1.277.

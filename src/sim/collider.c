@@ -23,65 +23,6 @@ static inline size_t maps_index(const wx_collider_camera *cam, int k, size_t t)
     return layer * texels + t;
 }
 
-// How far a camera with layers widens crossing k of texel t, in d: a camera's
-// map records a surface seen at angle theta to about half a texel times
-// tan(theta) along its axis (the depth changes by texel * tan(theta) across a
-// texel), so its "not behind" is sure only that far in front of the crossing.
-// Each crossing is widened by the part of that which exceeds what the most
-// head-on camera's map records there (its normal against every camera's axis):
-// the most head-on camera keeps its surface as it is, the others' solids reach
-// out past it, and the collision surface (where every camera agrees) is the
-// head-on camera's. Without this it was whichever camera's surface lay
-// innermost, and a particle sliding over the top of a model met the side
-// cameras' grazing surfaces, which turn with the model in the grid
-// (docs/physics.md, "Which camera's surface a particle meets"). At most
-// MARGIN_MAX_TAN half texels' worth.
-#define MARGIN_MAX_TAN 4.0
-
-static inline double tan_of_cos(double c)
-{
-    return sqrt(1.0 - c * c) / (c > 1e-3 ? c : 1e-3);
-}
-
-static double crossing_margin(const wx_collider *collider, const wx_collider_camera *cam, int k,
-                              size_t t)
-{
-    const float *n = cam->normal + 3 * maps_index(cam, k, t);
-    double nl = sqrt((double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2]);
-    if (!(nl > 1e-6) || !isfinite(nl)) {
-        return 0.0;
-    }
-    double own =
-        fabs(n[0] * cam->unit_back[0] + n[1] * cam->unit_back[1] + n[2] * cam->unit_back[2]) / nl;
-    double best = own;
-    for (int c = 0; c < collider->camera_count; ++c) {
-        const float *b = collider->cameras[c].unit_back;
-        double along = fabs(n[0] * b[0] + n[1] * b[1] + n[2] * b[2]) / nl;
-        best = along > best ? along : best;
-    }
-    own = own < 1.0 ? own : 1.0;
-    best = best < 1.0 ? best : 1.0;
-    double excess = tan_of_cos(own) - tan_of_cos(best);
-    excess = excess < MARGIN_MAX_TAN ? excess : MARGIN_MAX_TAN;
-    return excess > 0.0 ? 0.5 * cam->texel_ws * excess / cam->back_length : 0.0;
-}
-
-// Crossing k's depth moved outwards by its margin: an entering face (or the
-// last one of a full texel) towards the camera, a leaving face away from it;
-// a sheet's slab is left as it is.
-static inline double widen(const wx_collider *collider, const wx_collider_camera *cam, int k,
-                           size_t t, uint8_t role, double depth)
-{
-    int kind = role & WX_ROLE_KIND;
-    if (kind == WX_ROLE_ENTER || kind == WX_ROLE_TAIL) {
-        return depth - crossing_margin(collider, cam, k, t);
-    }
-    if (kind == WX_ROLE_LEAVE) {
-        return depth + crossing_margin(collider, cam, k, t);
-    }
-    return depth;
-}
-
 // fmin and fmax are library calls unless NaN semantics are relaxed; these are
 // plain compares (no NaN reaches them).
 static inline double dmin(double a, double b)
@@ -260,12 +201,6 @@ static bool layers_may_collide(const wx_collider *collider, const wx_collider_ca
     double depth[WX_MAX_LAYERS];
     uint8_t role[WX_MAX_LAYERS];
     int n = layer_depths(collider, cam, X, Y, depth, role);
-    int hx = clampi((int)(2.0 * X), 0, 2 * cam->width - 1);
-    int hy = clampi((int)(2.0 * Y), 0, 2 * cam->height - 1);
-    size_t t = (size_t)(hy >> 1) * (size_t)cam->width + (size_t)(hx >> 1);
-    for (int k = 0; k < n; ++k) {
-        depth[k] = widen(collider, cam, k, t, role[k], depth[k]);
-    }
     for (int k = 0; k < n; ++k) {
         switch (role[k] & WX_ROLE_KIND) {
         case WX_ROLE_ENTER:
@@ -488,7 +423,7 @@ static void make_layers(march *m)
         double c1 = cd.k1 * m->dX + cd.k2 * m->dY + cd.k3 * (fx0 * m->dY + fy0 * m->dX);
         double c2 = cd.k3 * m->dX * m->dY;
         m->role[n] = role;
-        m->LA[n] = m->D0 - widen(collider, cam, n, t, role, c0);
+        m->LA[n] = m->D0 - c0;
         m->LB[n] = m->dD - c1;
         m->LC[n] = -c2;
     }
@@ -628,7 +563,7 @@ static double layers_first(march *m, double lo, double hi)
         // In front of every crossing of the cell over [lo, hi] (d is linear
         // in s): nothing to meet here.
         double d_far = fmax(m->D0 + lo * m->dD, m->D0 + hi * m->dD);
-        if (d_far < m->near - 2.0 * sheet - m->cam->margin_max) {
+        if (d_far < m->near - 2.0 * sheet) {
             return INFINITY;
         }
         make_layers(m);

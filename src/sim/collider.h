@@ -51,7 +51,8 @@ typedef struct wx_collider_camera {
     float back[3];  ///< world displacement that lowers d by 1 and keeps u, v
     float texel_ws; ///< world size of the smaller side of a texel
     /// layers*W*H (layer k at k*W*H; layer 0 is today's map), +inf where there
-    /// is no surface (owned copy)
+    /// is no surface (owned copy; with layers, each crossing moved out by its
+    /// margin: collider_build.c, widen_crossings)
     float *depth;
     const float *normal; ///< 3*layers*W*H world normals (borrowed)
     const float *impact; ///< 2*layers*W*H absorption, bounce (borrowed)
@@ -68,13 +69,6 @@ typedef struct wx_collider_camera {
     /// layer of the maps (normal, impact, the hit's layer) it came from.
     uint8_t *origin;
     double sheet;
-    /// With layers: the unit direction towards the camera (back / |back|),
-    /// |back|, and the widest `margin` any crossing gets (collider.c,
-    /// crossing_margin; in d), which the coarse pyramid and the cells' near
-    /// bound leave room for.
-    float unit_back[3];
-    double back_length;
-    double margin_max;
     /// Coarse pyramid: level l has blocks of 4 << 2l texels; its value at block
     /// (bx, by) is the least depth over the 3x3 blocks around it, lowered by a
     /// rounding margin. Levels are stored one after the other in `coarse`.

@@ -107,7 +107,7 @@ static wx_result build_coarse(wx_collider_camera *cam, wx_error *err)
             }
         }
     }
-    double margin_base = 1e-4 * cam->texel_ws + cam->margin_max;
+    double margin_base = 1e-4 * cam->texel_ws;
     for (int l = 0; l < WX_COARSE_LEVELS; ++l) {
         const float *src = blockmin + cam->level_offset[l];
         float *dst = cam->coarse + cam->level_offset[l];
@@ -227,6 +227,75 @@ static void classify_layers(wx_collider_camera *cam)
         }
     }
 }
+// Widening a camera's crossings by their margins (docs/physics.md, "Which
+// camera's surface a particle meets"). A camera's map records a surface seen
+// at angle theta to its axis to about half a texel times tan(theta) along that
+// axis (the depth changes by texel * tan(theta) across a texel), so its "not
+// behind" is sure only that far in front of a crossing. The point rule takes
+// the intersection of every camera's solid, so without a margin the
+// collision surface was whichever camera's surface lay innermost: on the top
+// of a lumpy model the side cameras' grazing ones, in a pattern that turns
+// with the model in the camera grid, which a sliding particle, meeting the
+// collision surface at every step, followed. Each crossing moves by the part
+// of its camera's precision that exceeds the most head-on camera's at that
+// surface (its normal against every camera's axis): an entering face (or a
+// full texel's last one) towards the camera, a leaving face away from it; a
+// sheet's slab stays. The most head-on camera keeps its surface, which is
+// then the collision surface, and the others' solids reach past it. At most
+// MARGIN_MAX_TAN half texels.
+#define MARGIN_MAX_TAN 4.0
+
+static double tan_of_cos(double c)
+{
+    c = c < 1.0 ? c : 1.0;
+    return sqrt(1.0 - c * c) / (c > 1e-3 ? c : 1e-3);
+}
+
+static void widen_crossings(const wx_collider *collider, wx_collider_camera *cam)
+{
+    double axes[WX_MAX_INPUT_CAMERAS][3];
+    for (int c = 0; c < collider->camera_count; ++c) {
+        const float *b = collider->cameras[c].back;
+        double l = sqrt((double)b[0] * b[0] + (double)b[1] * b[1] + (double)b[2] * b[2]);
+        for (int k = 0; k < 3; ++k) {
+            axes[c][k] = l > 0.0 ? b[k] / l : 0.0;
+        }
+    }
+    double bl = sqrt((double)cam->back[0] * cam->back[0] + (double)cam->back[1] * cam->back[1] +
+                     (double)cam->back[2] * cam->back[2]);
+    if (!(bl > 0.0)) {
+        return;
+    }
+    const double *own_axis = axes[cam - collider->cameras];
+    size_t texels = (size_t)cam->width * (size_t)cam->height;
+    for (size_t at = 0; at < (size_t)cam->layers * texels; ++at) {
+        int kind = cam->role[at] & WX_ROLE_KIND;
+        double sign = kind == WX_ROLE_ENTER || kind == WX_ROLE_TAIL ? -1.0
+                      : kind == WX_ROLE_LEAVE                       ? 1.0
+                                                                    : 0.0;
+        if (sign == 0.0 || !isfinite(cam->depth[at])) {
+            continue;
+        }
+        size_t t = at % texels;
+        const float *n = cam->normal + 3 * ((size_t)cam->origin[at] * texels + t);
+        double nl = sqrt((double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2]);
+        if (!(nl > 1e-6) || !isfinite(nl)) {
+            continue;
+        }
+        double own = fabs(n[0] * own_axis[0] + n[1] * own_axis[1] + n[2] * own_axis[2]) / nl;
+        double best = own;
+        for (int c = 0; c < collider->camera_count; ++c) {
+            const double *a = axes[c];
+            double along = fabs(n[0] * a[0] + n[1] * a[1] + n[2] * a[2]) / nl;
+            best = along > best ? along : best;
+        }
+        double excess = fmin(tan_of_cos(own) - tan_of_cos(best), MARGIN_MAX_TAN);
+        if (excess > 0.0) {
+            cam->depth[at] = (float)(cam->depth[at] + sign * 0.5 * cam->texel_ws * excess / bl);
+        }
+    }
+}
+
 wx_result wx_collider_init(wx_collider *collider, const wx_camera *cameras, const wx_maps *maps,
                            int count, bool nearest, wx_error *err)
 {
@@ -290,26 +359,27 @@ wx_result wx_collider_init(wx_collider *collider, const wx_camera *cameras, cons
         cam->frames_model = border_is_empty(cam->depth, m->width, m->height);
         cam->normal = m->normal;
         cam->impact = m->impact;
-        // Every camera's axis counts when a layered camera's margin is measured.
-        cam->back_length =
-            sqrt((double)cam->back[0] * cam->back[0] + (double)cam->back[1] * cam->back[1] +
-                 (double)cam->back[2] * cam->back[2]);
-        for (int k = 0; k < 3; ++k) {
-            cam->unit_back[k] =
-                cam->back_length > 0.0 ? (float)(cam->back[k] / cam->back_length) : 0.0f;
-        }
         if (layers > 1) {
             // A quarter texel (docs/physics.md, "Layered maps"): thick enough for
             // float rounding and to bridge the steps the silhouette rule leaves
             // along a sheet's edge, thin enough that a hit from behind lies
             // within half the collider's precision (half a texel) of the sheet.
-            double bl = cam->back_length;
+            double bl =
+                sqrt((double)cam->back[0] * cam->back[0] + (double)cam->back[1] * cam->back[1] +
+                     (double)cam->back[2] * cam->back[2]);
             cam->sheet = 0.25 * cam->texel_ws / bl;
-            // collider.c's crossing_margin: at most 4 half texels (MARGIN_MAX_TAN).
-            cam->margin_max = bl > 0.0 ? 2.0 * cam->texel_ws / bl : 0.0;
             classify_layers(cam);
         }
-        r = build_coarse(cam, err);
+    }
+    // Every camera's axis is known now: widen the layered cameras' crossings
+    // by their margins, then build each pyramid from the depths as widened.
+    for (int c = 0; c < count; ++c) {
+        if (collider->cameras[c].layers > 1) {
+            widen_crossings(collider, &collider->cameras[c]);
+        }
+    }
+    for (int c = 0; c < count; ++c) {
+        wx_result r = build_coarse(&collider->cameras[c], err);
         if (r != WX_OK) {
             wx_collider_free(collider);
             return r;
