@@ -537,6 +537,15 @@ static bool run_lumpy_with(const char *dir, const char *model, int seed, int lay
     return *dirt != NULL && *sun != NULL && *seen != NULL;
 }
 
+static void free_runs(float **dirt, float **sun, float **seen, int runs)
+{
+    for (int r = 0; r < runs; ++r) {
+        free(dirt[r]);
+        free(sun[r]);
+        free(seen[r]);
+    }
+}
+
 static bool run_lumpy(const char *dir, const char *model, int seed, int layers, float **dirt,
                       float **sun, float **seen)
 {
@@ -597,11 +606,7 @@ TEST(lumpy_sphere_turned_slides_as_a_new_seed_does)
             blocks++;
         }
     }
-    for (int r = 0; r < RUNS; ++r) {
-        free(dirt[r]);
-        free(sun[r]);
-        free(seen[r]);
-    }
+    free_runs(dirt, sun, seen, RUNS);
     ENSURE(blocks >= 200);
     mean /= blocks;
     seeds = sqrt(seeds / (2.0 * blocks)) / mean;
@@ -664,11 +669,7 @@ TEST(lumpy_sphere_turned_in_the_camera_grid_keeps_its_exact_rain)
             blocks++;
         }
     }
-    for (int r = 0; r < RUNS; ++r) {
-        free(dirt[r]);
-        free(sun[r]);
-        free(seen[r]);
-    }
+    free_runs(dirt, sun, seen, RUNS);
     ENSURE(blocks >= 200);
     for (int r = 0; r < RUNS; ++r) {
         err[r] = sqrt(err[r] / blocks);
