@@ -446,7 +446,7 @@ static const char *lumpy_scene =
     "<Weathering>\n"
     "  <Solver>\n"
     "    <BoundingBox size=\"8\" centerX=\"0\" centerY=\"1.2\" centerZ=\"0\"/>\n"
-    "    <Simulation timeStep=\"0.02\" steps=\"100\" seed=\"%d\"/>\n"
+    "    <Simulation timeStep=\"%g\" steps=\"%d\" seed=\"%d\"/>\n"
     "  </Solver>\n"
     "  <Emitters>\n"
     "    <BoxEmitter minX=\"-1.5\" minY=\"3\" minZ=\"-1.5\" maxX=\"1.5\" maxY=\"3\" maxZ=\"1.5\"\n"
@@ -455,15 +455,15 @@ static const char *lumpy_scene =
     "  <Collider%s>\n"
     "    <ProjectedMaps>\n"
     "      <Ortho cameraName=\"top\"%s><View eye=\"0 5 0\" target=\"0 1.2 0\" up=\"0 0 -1\"\n"
-    "        width=\"3\" height=\"3\" resolution=\"384\"/></Ortho>\n"
+    "        width=\"3\" height=\"3\" resolution=\"%d\"/></Ortho>\n"
     "      <Ortho cameraName=\"front\"%s><View eye=\"0 1.2 5\" target=\"0 1.2 0\" up=\"0 1 0\"\n"
-    "        width=\"3\" height=\"3\" resolution=\"384\"/></Ortho>\n"
+    "        width=\"3\" height=\"3\" resolution=\"%d\"/></Ortho>\n"
     "      <Ortho cameraName=\"back\"%s><View eye=\"0 1.2 -5\" target=\"0 1.2 0\" up=\"0 1 0\"\n"
-    "        width=\"3\" height=\"3\" resolution=\"384\"/></Ortho>\n"
+    "        width=\"3\" height=\"3\" resolution=\"%d\"/></Ortho>\n"
     "      <Ortho cameraName=\"left\"%s><View eye=\"-5 1.2 0\" target=\"0 1.2 0\" up=\"0 1 0\"\n"
-    "        width=\"3\" height=\"3\" resolution=\"384\"/></Ortho>\n"
+    "        width=\"3\" height=\"3\" resolution=\"%d\"/></Ortho>\n"
     "      <Ortho cameraName=\"right\"%s><View eye=\"5 1.2 0\" target=\"0 1.2 0\" up=\"0 1 0\"\n"
-    "        width=\"3\" height=\"3\" resolution=\"384\"/></Ortho>\n"
+    "        width=\"3\" height=\"3\" resolution=\"%d\"/></Ortho>\n"
     "    </ProjectedMaps>\n"
     "  </Collider>\n"
     "  <Geometry>\n"
@@ -475,51 +475,41 @@ static const char *lumpy_scene =
     "  <Masks><Exposure name=\"sun\" elevation=\"90\" azimuth=\"0\"/></Masks>\n"
     "</Weathering>\n";
 
-// Replaces every `from` in text (of capacity cap) with `to`.
-static void replace_all(char *text, size_t cap, const char *from, const char *to)
-{
-    size_t lf = strlen(from), lt = strlen(to);
-    for (char *at = strstr(text, from); at != NULL; at = strstr(at + lt, from)) {
-        size_t tail = strlen(at + lf);
-        if ((size_t)(at - text) + lt + tail + 1 > cap) {
-            return;
-        }
-        memmove(at + lt, at + lf, tail + 1);
-        memcpy(at, to, lt);
-    }
-}
+// Every drop absorbed where it lands (the exact density is known); or, with
+// `sliding`, the rain preset's collider and surfaces on finer maps and steps,
+// as init makes them for a model of this size (texels of 4 mm, a step of 7 ms).
+typedef struct lumpy_setup {
+    const char *collider, *surface, *suffix;
+    double time_step;
+    int steps, resolution;
+} lumpy_setup;
 
-// Every drop absorbed where it lands (the exact density is known).
-static const char *ABSORB = "absorption=\"1\"";
-// The rain preset's collider and surfaces: drops that slide.
-static const char *RAIN_COLLIDER =
-    " resilience=\"0.2\" friction=\"0.9\" adherence=\"1\" deposit=\"1\" erosion=\"1\"";
-static const char *RAIN_SURFACE =
-    "absorption=\"0.05\" bounce=\"0.15\" deposit=\"0.3\" erosion=\"0.4\"";
+static const lumpy_setup ABSORB = { "", "absorption=\"1\"", "", 0.02, 100, 384 };
+static const lumpy_setup SLIDE = {
+    " resilience=\"0.2\" friction=\"0.9\" adherence=\"1\" deposit=\"1\" erosion=\"1\"",
+    "absorption=\"0.05\" bounce=\"0.15\" deposit=\"0.3\" erosion=\"0.4\"",
+    "_s",
+    0.007,
+    430,
+    768,
+};
 
-// Runs the lumpy sphere (turned or not, seed) with the given collider
-// attributes and surface, and reads its texture's dirt, the exact shape (sun)
-// and seen; false on failure.
+// Runs the lumpy sphere (turned or not, seed) under a setup, and reads its
+// texture's dirt, the exact shape (sun) and seen; false on failure.
 static bool run_lumpy_with(const char *dir, const char *model, int seed, int layers,
-                           const char *collider, const char *surface, float **dirt, float **sun,
-                           float **seen)
+                           const lumpy_setup *setup, float **dirt, float **sun, float **seen)
 {
     char name[64], scene[8192], path[4300], mesh[80];
     snprintf(mesh, sizeof mesh, "%s.obj", model);
-    snprintf(name, sizeof name, "%s%d_%d%s", model, seed, layers, surface == ABSORB ? "" : "_s");
+    snprintf(name, sizeof name, "%s%d_%d%s", model, seed, layers, setup->suffix);
     char file[80];
     snprintf(file, sizeof file, "%s.xml", name);
     char attr[32];
     snprintf(attr, sizeof attr, " layers=\"%d\"", layers);
-    snprintf(scene, sizeof scene, lumpy_scene, seed, collider, attr, attr, attr, attr, attr, mesh,
-             surface);
-    if (surface != ABSORB) {
-        // Sliding drops: finer maps and steps, as init makes them for a model
-        // of this size (texels of 4 mm, a step of 7 ms).
-        replace_all(scene, sizeof scene, "resolution=\"384\"", "resolution=\"768\"");
-        replace_all(scene, sizeof scene, "timeStep=\"0.02\" steps=\"100\"",
-                    "timeStep=\"0.007\" steps=\"430\"");
-    }
+    int px = setup->resolution;
+    snprintf(scene, sizeof scene, lumpy_scene, setup->time_step, setup->steps, seed,
+             setup->collider, attr, px, attr, px, attr, px, attr, px, attr, px, mesh,
+             setup->surface);
     ensure_write_file(dir, file, scene);
     if (!run_scene(dir, file, name)) {
         return false;
@@ -549,7 +539,7 @@ static void free_runs(float **dirt, float **sun, float **seen, int runs)
 static bool run_lumpy(const char *dir, const char *model, int seed, int layers, float **dirt,
                       float **sun, float **seen)
 {
-    return run_lumpy_with(dir, model, seed, layers, "", ABSORB, dirt, sun, seen);
+    return run_lumpy_with(dir, model, seed, layers, &ABSORB, dirt, sun, seen);
 }
 
 // The lumpy sphere under the rain preset's sliding drops, five cameras of four
@@ -574,8 +564,7 @@ TEST(lumpy_sphere_turned_slides_as_a_new_seed_does)
     const int seed[RUNS] = { 1, 2, 1, 2 };
     float *dirt[RUNS] = { NULL }, *sun[RUNS] = { NULL }, *seen[RUNS] = { NULL };
     for (int r = 0; r < RUNS; ++r) {
-        ENSURE(run_lumpy_with(dir, model[r], seed[r], 4, RAIN_COLLIDER, RAIN_SURFACE, &dirt[r],
-                              &sun[r], &seen[r]));
+        ENSURE(run_lumpy_with(dir, model[r], seed[r], 4, &SLIDE, &dirt[r], &sun[r], &seen[r]));
     }
     double seeds = 0.0, turn = 0.0, mean = 0.0;
     int blocks = 0;
