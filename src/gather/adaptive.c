@@ -82,12 +82,14 @@ typedef struct job {
     float *delta;         // change per unit area
     float *radius;        // h (world units) of a sample, 0 elsewhere
     unsigned char *clean; // step 2's verdict: TEXEL_CLEAN, TEXEL_SPARSE bits
-    double *sat;          // (width + 1) * (height + 1) summed impacts
+    double *sat;          // (width + 1) * (height + 1) summed impacts; in step 4,
+                          // the samples with a change (pcoef != 0)
     double *sat_surface;  // the same for the texels with a surface
     float *tile_bound;
     int tiles_x, tiles_y;
     const offset *offsets;
     int offset_count;
+    int *reach_i, *reach_j; // the largest |di|, |dj| of offsets[0 .. o]
     double target_hits;
     float texel_i, texel_j; // |step_i|, |step_j| across the view
     float z2;               // |step_d|^2
@@ -258,6 +260,26 @@ static void gather_chunk(const job *jb, int j, int x0)
         return;
     }
     const float bound = chunk_bound(jb, j, x0, x1);
+    // A chunk no sample with a change can reach keeps its initial dirt: the
+    // sum below would add w * 0 over every offset (the sheltered walls and the
+    // deeper layers, where every radius is the largest: most of the work).
+    int reach = 0;
+    for (int lo = 0, hi = jb->offset_count; lo < hi;) {
+        int mid = lo + (hi - lo) / 2; // reach: the offsets with r < bound
+        if (jb->offsets[mid].r < bound) {
+            lo = reach = mid + 1;
+        } else {
+            hi = mid;
+        }
+    }
+    if (reach == 0 || rect_sum(jb, jb->sat, x0 - jb->reach_i[reach - 1], j - jb->reach_j[reach - 1],
+                               x1 - 1 + jb->reach_i[reach - 1], j + jb->reach_j[reach - 1]) < 0.5) {
+        for (int x = x0; x < x1; ++x) {
+            size_t t = (size_t)j * (size_t)jb->width + (size_t)x;
+            jb->out[t] = wx_depth_is_empty(row_depth[x]) ? 0.0f : jb->def->initial[t] + 0.0f;
+        }
+        return;
+    }
     const size_t q = jb->base + (size_t)j * jb->stride + (size_t)x0;
     float num[CHUNK], den[CHUNK];
     for (int x = 0; x < CHUNK; ++x) {
@@ -267,7 +289,7 @@ static void gather_chunk(const job *jb, int j, int x0)
     const float z2 = jb->z2;
     const float *restrict dq = jb->pd + q, *restrict nxq = jb->pnx + q;
     const float *restrict nyq = jb->pny + q, *restrict nzq = jb->pnz + q;
-    for (int o = 0; o < jb->offset_count && jb->offsets[o].r < bound; ++o) {
+    for (int o = 0; o < reach; ++o) {
         const offset off = jb->offsets[o];
         // The sample is p = q - (di, dj); the offset from p to q is (di, dj).
         const size_t p = (size_t)((ptrdiff_t)q - (ptrdiff_t)off.dj * (ptrdiff_t)jb->stride - off.di);
@@ -445,6 +467,8 @@ wx_result wx_adaptive_smooth(const wx_adaptive_def *def, float *out, wx_adaptive
 
     size_t cap = (size_t)(2 * pad_x - 1) * (size_t)(2 * pad_y - 1);
     offset *offsets = malloc(cap * sizeof *offsets);
+    jb.reach_i = malloc(2 * cap * sizeof *jb.reach_i);
+    jb.reach_j = jb.reach_i + cap;
     float *scratch = calloc(8 * plane, sizeof *scratch);
     jb.delta = malloc(texels * sizeof *jb.delta);
     jb.radius = calloc(texels, sizeof *jb.radius);
@@ -454,14 +478,20 @@ wx_result wx_adaptive_smooth(const wx_adaptive_def *def, float *out, wx_adaptive
     float *tile_max = calloc(tiles, sizeof *tile_max);
     float *sorted = NULL;
     wx_result r = WX_OK;
-    if (offsets == NULL || scratch == NULL || jb.delta == NULL || jb.radius == NULL ||
-        jb.clean == NULL || jb.sat == NULL || jb.tile_bound == NULL || tile_max == NULL) {
+    if (offsets == NULL || jb.reach_i == NULL || scratch == NULL || jb.delta == NULL ||
+        jb.radius == NULL || jb.clean == NULL || jb.sat == NULL || jb.tile_bound == NULL ||
+        tile_max == NULL) {
         r = wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "gather: out of memory (adaptive smoothing)");
         goto done;
     }
     jb.sat_surface = jb.sat + sat_size;
     jb.offset_count = build_offsets(def, px, py, z, pad_x - 1, pad_y - 1, max_r, texel, offsets);
     jb.offsets = offsets;
+    for (int o = 0; o < jb.offset_count; ++o) {
+        int di = abs(offsets[o].di), dj = abs(offsets[o].dj);
+        jb.reach_i[o] = o > 0 && jb.reach_i[o - 1] > di ? jb.reach_i[o - 1] : di;
+        jb.reach_j[o] = o > 0 && jb.reach_j[o - 1] > dj ? jb.reach_j[o - 1] : dj;
+    }
     jb.pd = scratch;
     jb.pnx = scratch + plane;
     jb.pny = scratch + 2 * plane;
@@ -530,6 +560,16 @@ wx_result wx_adaptive_smooth(const wx_adaptive_def *def, float *out, wx_adaptive
         }
     }
     bound_tiles(&jb, tile_max);
+    // Step 4's table: the samples with a change (the impacts' table is done with).
+    for (int j = 0; j < H; ++j) {
+        double row = 0.0;
+        for (int i = 0; i < W; ++i) {
+            size_t p = jb.base + (size_t)j * jb.stride + (size_t)i;
+            row += jb.pcoef[p] != 0.0f ? 1.0 : 0.0;
+            size_t s = (size_t)(j + 1) * sw + (size_t)(i + 1);
+            jb.sat[s] = jb.sat[s - sw] + row;
+        }
+    }
 
     // Step 4: the mask.
     jb.pass = 4;
@@ -560,6 +600,7 @@ done:
     free(jb.radius);
     free(jb.delta);
     free(scratch);
+    free(jb.reach_i);
     free(offsets);
     return r;
 }
