@@ -5,9 +5,11 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/limits.h"
 #include "core/parallel.h"
 #include "core/progress.h"
 #include "sim/noise.h"
+#include "sim/particles.h"
 
 #define PI 3.14159265358979323846
 
@@ -176,6 +178,96 @@ static bool ray_free(const wx_collider *collider, const double p[3], const doubl
     return true;
 }
 
+// ray_free for up to RAY_BLOCK rays at once (lanes `active`; ray k from
+// start[k] along dir[k] for length[k]): their segments of doubling length go
+// side by side through the collider's vectorised coarse test, and a segment it
+// cannot clear is cut and swept as segment_free does. The segments, and so the
+// answers, are ray_free's ray by ray. Returns the lanes whose rays are free.
+enum { RAY_BLOCK = WX_PARTICLE_BLOCK };
+static uint32_t rays_free_one_by_one(const wx_collider *collider, uint32_t active,
+                                     double start[RAY_BLOCK][3], double dir[RAY_BLOCK][3],
+                                     const double length[RAY_BLOCK], double first)
+{
+    uint32_t free_lanes = 0;
+    for (int k = 0; k < RAY_BLOCK; ++k) {
+        if (((active >> k) & 1u) && ray_free(collider, start[k], dir[k], length[k], first)) {
+            free_lanes |= 1u << k;
+        }
+    }
+    return free_lanes;
+}
+
+static uint32_t rays_free(const wx_collider *collider, uint32_t active,
+                          double start[RAY_BLOCK][3], double dir[RAY_BLOCK][3],
+                          const double length[RAY_BLOCK], double first)
+{
+    if (collider == NULL || collider->camera_count == 0 ||
+        collider->camera_count > WX_MAX_INPUT_CAMERAS) {
+        return collider == NULL || collider->camera_count == 0
+                   ? active
+                   : rays_free_one_by_one(collider, active, start, dir, length, first);
+    }
+    int cams[WX_MAX_INPUT_CAMERAS];
+    for (int c = 0; c < collider->camera_count; ++c) {
+        cams[c] = c;
+    }
+    double len[RAY_BLOCK];
+    for (int k = 0; k < RAY_BLOCK; ++k) {
+        len[k] = (active >> k) & 1u ? frames_exit(collider, start[k], dir[k], length[k]) : 0.0;
+    }
+    uint32_t free_lanes = active;
+    double t0 = 0.0, step = first;
+    for (;;) {
+        uint32_t pending = 0;
+        float x0[RAY_BLOCK], y0[RAY_BLOCK], z0[RAY_BLOCK], x1[RAY_BLOCK], y1[RAY_BLOCK],
+            z1[RAY_BLOCK];
+        double t1[RAY_BLOCK];
+        for (int k = 0; k < RAY_BLOCK; ++k) {
+            bool on = ((free_lanes >> k) & 1u) && t0 < len[k];
+            pending |= (uint32_t)on << k;
+            t1[k] = on ? fmin(len[k], t0 + step) : t0;
+            const double *p = start[k], *d = dir[k];
+            x0[k] = (float)(p[0] + d[0] * t0);
+            y0[k] = (float)(p[1] + d[1] * t0);
+            z0[k] = (float)(p[2] + d[2] * t0);
+            x1[k] = (float)(p[0] + d[0] * t1[k]);
+            y1[k] = (float)(p[1] + d[1] * t1[k]);
+            z1[k] = (float)(p[2] + d[2] * t1[k]);
+        }
+        if (pending == 0) {
+            return free_lanes;
+        }
+        uint32_t outside = 0;
+        uint32_t clear = wx_collider_coarse_block(collider, cams, collider->camera_count, NULL, x0,
+                                                  y0, z0, x1, y1, z1, &outside);
+        // (outside is whole when some lane is not cleared: then no camera was skipped)
+        for (uint32_t left = pending & ~(clear | outside); left != 0; left &= left - 1) {
+            int k = __builtin_ctz(left);
+            double a[3], b[3];
+            for (int c = 0; c < 3; ++c) {
+                a[c] = start[k][c] + dir[k][c] * t0;
+                b[c] = start[k][c] + dir[k][c] * t1[k];
+            }
+            double m[3] = { 0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1]), 0.5 * (a[2] + b[2]) };
+            double half = 0.5 * (t1[k] - t0);
+            bool ok;
+            if (t1[k] - t0 <= first) {
+                float fa[3] = { x0[k], y0[k], z0[k] }, fb[3] = { x1[k], y1[k], z1[k] };
+                wx_hit hit;
+                ok = !wx_collider_sweep(collider, fa, fb, &hit);
+            } else {
+                ok = segment_free(collider, a, m, half, first) &&
+                     segment_free(collider, m, b, half, first);
+            }
+            if (!ok) {
+                free_lanes &= ~(1u << k);
+            }
+        }
+        t0 += step;
+        step *= 2.0;
+    }
+}
+
 // Where a ray from surface point p along unit dir starts: on the ray itself
 // (so that a shadow's edge does not move), within one of the collider's finest
 // texels of p: at a height of 1/8, then 1/4, then 1/2 of that texel above the
@@ -292,25 +384,31 @@ static double box_exit(const wx_scene *scene, const double p[3], const double di
 static float accessibility(const job *jb, const wx_mask_def *m, size_t t, const double p[3],
                            const float n[3])
 {
-    double start[3], tx[3], bx[3];
+    double tx[3], bx[3];
     frame_of(n, tx, bx);
     uint64_t h = splitmix(jb->def->seed ^ splitmix((uint64_t)jb->mask * 0x632be59bd9b4e019ull ^
                                                    (uint64_t)t));
     double r1 = unit_of(h), r2 = unit_of(splitmix(h));
     int open = 0;
-    for (int i = 0; i < m->rays; ++i) {
-        // A stratified point of the unit square, rotated per point, mapped to
-        // cosine-weighted directions (Malley's method).
-        double u = fmod((i + 0.5) / m->rays + r1, 1.0), v = fmod(radical_inverse((uint32_t)i) + r2, 1.0);
-        double r = sqrt(u), phi = 2.0 * PI * v, z = sqrt(fmax(0.0, 1.0 - u));
-        double dir[3];
-        for (int k = 0; k < 3; ++k) {
-            dir[k] = r * cos(phi) * tx[k] + r * sin(phi) * bx[k] + z * n[k];
+    for (int i0 = 0; i0 < m->rays; i0 += RAY_BLOCK) {
+        double start[RAY_BLOCK][3], dir[RAY_BLOCK][3], length[RAY_BLOCK];
+        uint32_t active = 0;
+        for (int k = 0; k < RAY_BLOCK && i0 + k < m->rays; ++k) {
+            int i = i0 + k;
+            // A stratified point of the unit square, rotated per point, mapped to
+            // cosine-weighted directions (Malley's method).
+            double u = fmod((i + 0.5) / m->rays + r1, 1.0),
+                   v = fmod(radical_inverse((uint32_t)i) + r2, 1.0);
+            double r = sqrt(u), phi = 2.0 * PI * v, z = sqrt(fmax(0.0, 1.0 - u));
+            for (int c = 0; c < 3; ++c) {
+                dir[k][c] = r * cos(phi) * tx[c] + r * sin(phi) * bx[c] + z * n[c];
+            }
+            double skipped = ray_start(jb, p, n, dir[k], start[k]);
+            length[k] = m->distance - skipped;
+            open += skipped >= m->distance; // past the distance already: open
+            active |= (uint32_t)(skipped >= 0.0 && skipped < m->distance) << k;
         }
-        double skipped = ray_start(jb, p, n, dir, start);
-        open += skipped >= 0.0 &&
-                (skipped >= m->distance ||
-                 ray_free(jb->def->collider, start, dir, m->distance - skipped, jb->first));
+        open += __builtin_popcount(rays_free(jb->def->collider, active, start, dir, length, jb->first));
     }
     return (float)open / (float)m->rays;
 }
