@@ -98,6 +98,18 @@ static void frame_of(const float n[3], double t[3], double b[3])
     b[2] = -n[1];
 }
 
+// fmin and fmax for the rays' finite values, inline (the library calls took 4%
+// of an accessibility mask's time).
+static inline double min_of(double a, double b)
+{
+    return b < a ? b : a;
+}
+
+static inline double max_of(double a, double b)
+{
+    return b > a ? b : a;
+}
+
 // The part of a ray that some camera sees: beyond the last camera's frame
 // nothing can stop it (docs/design.md section 4: a point no camera sees does
 // not collide). The distance from p along dir where the last frame is left.
@@ -121,11 +133,11 @@ static double frames_exit(const wx_collider *collider, const double p[3], const 
                 continue;
             }
             double t0 = (0.0 - x0) / dx, t1 = (size[a] - x0) / dx;
-            lo = fmax(lo, fmin(t0, t1));
-            hi = fmin(hi, fmax(t0, t1));
+            lo = max_of(lo, min_of(t0, t1));
+            hi = min_of(hi, max_of(t0, t1));
         }
         if (lo <= hi) {
-            last = fmax(last, hi);
+            last = max_of(last, hi);
         }
     }
     return last;
@@ -163,7 +175,7 @@ static bool ray_free(const wx_collider *collider, const double p[3], const doubl
     length = frames_exit(collider, p, dir, length);
     double t0 = 0.0, step = first;
     while (t0 < length) {
-        double t1 = fmin(length, t0 + step);
+        double t1 = min_of(length, t0 + step);
         double a[3], b[3];
         for (int k = 0; k < 3; ++k) {
             a[k] = p[k] + dir[k] * t0;
@@ -225,7 +237,7 @@ static uint32_t rays_free(const wx_collider *collider, uint32_t active,
         for (int k = 0; k < RAY_BLOCK; ++k) {
             bool on = ((free_lanes >> k) & 1u) && t0 < len[k];
             pending |= (uint32_t)on << k;
-            t1[k] = on ? fmin(len[k], t0 + step) : t0;
+            t1[k] = on ? min_of(len[k], t0 + step) : t0;
             const double *p = start[k], *d = dir[k];
             x0[k] = (float)(p[0] + d[0] * t0);
             y0[k] = (float)(p[1] + d[1] * t0);
@@ -285,7 +297,7 @@ static double ray_start(const job *jb, const double p[3], const float n[3], cons
     double c = n[0] * dir[0] + n[1] * dir[1] + n[2] * dir[2];
     double texel = 8.0 * jb->offset;
     for (int tries = 0; tries < 4; ++tries) {
-        double skip = fmin(texel, jb->offset * (double)(1 << tries) / fmax(c, 0.5));
+        double skip = min_of(texel, jb->offset * (double)(1 << tries) / max_of(c, 0.5));
         float f[3];
         for (int k = 0; k < 3; ++k) {
             out[k] = p[k] + dir[k] * skip;
@@ -399,7 +411,7 @@ static float accessibility(const job *jb, const wx_mask_def *m, size_t t, const 
             // cosine-weighted directions (Malley's method).
             double u = fmod((i + 0.5) / m->rays + r1, 1.0),
                    v = fmod(radical_inverse((uint32_t)i) + r2, 1.0);
-            double r = sqrt(u), phi = 2.0 * PI * v, z = sqrt(fmax(0.0, 1.0 - u));
+            double r = sqrt(u), phi = 2.0 * PI * v, z = sqrt(max_of(0.0, 1.0 - u));
             for (int c = 0; c < 3; ++c) {
                 dir[k][c] = r * cos(phi) * tx[c] + r * sin(phi) * bx[c] + z * n[c];
             }
