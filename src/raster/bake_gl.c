@@ -191,6 +191,27 @@ static wx_result ensure_framebuffer(baker *b, int width, int height, wx_error *e
     return WX_OK;
 }
 
+void bake_set_region(baker *b, int x0, int y0, int x1, int y1)
+{
+    b->region_x0 = x0;
+    b->region_y0 = y0;
+    b->region_x1 = x1;
+    b->region_y1 = y1;
+}
+
+// The region in GL's window coordinates (rows bottom-up) for a frame of
+// width x height: x, y, w, h.
+static void region_gl(const baker *b, int width, int height, int rect[4])
+{
+    bool whole = b->region_x1 <= 0;
+    int x0 = whole ? 0 : b->region_x0, x1 = whole ? width : b->region_x1;
+    int y0 = whole ? 0 : b->region_y0, y1 = whole ? height : b->region_y1;
+    rect[0] = x0;
+    rect[1] = height - y1;
+    rect[2] = x1 - x0;
+    rect[3] = y1 - y0;
+}
+
 // Copies attachment 0 (d, normal) of the layer just drawn into the `previous`
 // texture the next peeling pass reads (made, or remade, at the framebuffer's
 // size: 16 bytes a texel more while a layered camera bakes).
@@ -215,8 +236,10 @@ wx_result bake_keep_previous_layer(baker *b, wx_error *err)
             return r;
         }
     }
-    glCopyImageSubData(b->renderbuffers[TARGET_DEPTH_NORMAL], GL_RENDERBUFFER, 0, 0, 0, 0,
-                       b->previous, GL_TEXTURE_2D, 0, 0, 0, 0, width, height, 1);
+    int rect[4];
+    region_gl(b, width, height, rect);
+    glCopyImageSubData(b->renderbuffers[TARGET_DEPTH_NORMAL], GL_RENDERBUFFER, 0, rect[0], rect[1],
+                       0, b->previous, GL_TEXTURE_2D, 0, rect[0], rect[1], 0, rect[2], rect[3], 1);
     return gl_check("keeping a layer for depth peeling", err);
 }
 
@@ -330,8 +353,8 @@ static void local_matrix(const float wtc[16], const double origin[3], float out[
 // Rendering and readback.
 
 // Draws layer `layer` of camera c into the framebuffer (the first `targets`
-// colour targets). A layer after the first keeps the crossings behind the
-// layer in the `previous` texture (bake_keep_previous_layer).
+// colour targets), within the region (bake_set_region). A layer after the first keeps the crossings
+// behind the layer in the `previous` texture (bake_keep_previous_layer).
 wx_result bake_draw_camera(baker *b, int c, int targets, int layer, wx_error *err)
 {
     const wx_scene_camera *sc = &b->scene->cameras[c];
@@ -355,6 +378,11 @@ wx_result bake_draw_camera(baker *b, int c, int targets, int layer, wx_error *er
                                               GL_COLOR_ATTACHMENT2 };
     glDrawBuffers(TARGET_COUNT, all);
     glViewport(0, 0, width, height);
+    // The region: the clears and the fragments outside it are scissored away.
+    int rect[4];
+    region_gl(b, width, height, rect);
+    glEnable(GL_SCISSOR_TEST);
+    glScissor(rect[0], rect[1], rect[2], rect[3]);
     const float background[4] = { INFINITY, 0.0f, 0.0f, 0.0f };
     const float zero[4] = { 0.0f, 0.0f, 0.0f, 0.0f };
     glClearBufferfv(GL_COLOR, 0, background);
@@ -388,13 +416,18 @@ wx_result bake_draw_camera(baker *b, int c, int targets, int layer, wx_error *er
     return gl_check("drawing", err);
 }
 
-// Reads colour target `target` (`channels` floats per texel) in strips and
-// scatters its channels into planes, flipping rows: GL row y is EXR row H-1-y.
+// Reads colour target `target` (`channels` floats per texel) of the region
+// (bake_set_region) in strips and scatters its channels into planes, flipping
+// rows: GL row y is EXR row H-1-y. The planes' texels outside the region are
+// left as they are.
 wx_result bake_read_target(baker *b, int target, int channels, const plane_out *out, wx_error *err)
 {
     int width = b->fb_width, height = b->fb_height;
-    size_t row_floats = (size_t)width * (size_t)channels;
-    int rows = (int)((size_t)(1 << 20) / row_floats);
+    int rect[4];
+    region_gl(b, width, height, rect);
+    const int x0 = rect[0], w = rect[2], y_end = rect[1] + rect[3];
+    size_t row_floats = (size_t)w * (size_t)channels;
+    int rows = (int)((size_t)(1 << 20) / (row_floats > 0 ? row_floats : 1));
     rows = rows < 1 ? 1 : rows > height ? height : rows;
     size_t need = row_floats * (size_t)rows;
     if (b->strip_floats < need) {
@@ -407,12 +440,12 @@ wx_result bake_read_target(baker *b, int target, int channels, const plane_out *
     }
     glReadBuffer((GLenum)(GL_COLOR_ATTACHMENT0 + target));
     GLenum format = channels == 4 ? GL_RGBA : channels == 2 ? GL_RG : GL_RED;
-    for (int y0 = 0; y0 < height; y0 += rows) {
-        int n = height - y0 < rows ? height - y0 : rows;
-        glReadPixels(0, y0, width, n, format, GL_FLOAT, b->strip);
+    for (int y0 = rect[1]; y0 < y_end; y0 += rows) {
+        int n = y_end - y0 < rows ? y_end - y0 : rows;
+        glReadPixels(x0, y0, w, n, format, GL_FLOAT, b->strip);
         for (int k = 0; k < n; ++k) {
             const float *src = b->strip + (size_t)k * row_floats;
-            size_t row = (size_t)(height - 1 - (y0 + k)) * (size_t)width;
+            size_t row = (size_t)(height - 1 - (y0 + k)) * (size_t)width + (size_t)x0;
             for (int c = 0; c < channels; ++c) {
                 float *dst = out[c].plane;
                 size_t stride = out[c].stride > 0 ? out[c].stride : 1;
@@ -421,12 +454,12 @@ wx_result bake_read_target(baker *b, int target, int channels, const plane_out *
                 }
                 dst += row * stride;
                 if (stride == 1) {
-                    for (int i = 0; i < width; ++i) {
+                    for (int i = 0; i < w; ++i) {
                         dst[i] = src[(size_t)i * (size_t)channels + (size_t)c];
                     }
                     continue;
                 }
-                for (int i = 0; i < width; ++i) {
+                for (int i = 0; i < w; ++i) {
                     dst[(size_t)i * stride] = src[(size_t)i * (size_t)channels + (size_t)c];
                 }
             }

@@ -80,6 +80,9 @@ typedef struct baker {
     bool has_dirt;   // some surface starts with dirt
     float *strip;    // readback buffer
     size_t strip_floats;
+    // The texels drawn, read back and kept for the next peeling pass: columns
+    // [x0, x1), rows [y0, y1) in EXR row order; x1 = 0: the whole frame.
+    int region_x0, region_y0, region_x1, region_y1;
     map_set set;
 } baker;
 
@@ -131,6 +134,11 @@ wx_result bake_create_context(baker *b, wx_error *err);
 // bake_gl.c: uploads one mesh (its CPU arrays freed on the way).
 wx_result bake_upload_mesh(baker *b, wx_mesh_data *mesh, const float *props, gpu_mesh *g,
                            wx_error *err);
+
+// bake_gl.c: the region later draws, readbacks and kept layers cover: columns
+// [x0, x1), rows [y0, y1) in EXR row order (x1 = 0: the whole frame). The
+// texels outside it keep what the framebuffer held.
+void bake_set_region(baker *b, int x0, int y0, int x1, int y1);
 
 // bake_gl.c: draws layer `layer` of camera c (the first `targets` colour targets).
 wx_result bake_draw_camera(baker *b, int c, int targets, int layer, wx_error *err);
