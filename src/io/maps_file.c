@@ -91,19 +91,33 @@ static int decoded_channel(const wx_image *image, const char *alternatives)
     return -1;
 }
 
+// The decoded file at `path` when it has every wanted channel (their indices
+// in index[]), else NULL.
+static const wx_image *decoded_channels(size_check *check, const char *path,
+                                        const char *const *wanted, int count,
+                                        int index[WX_IMAGE_MAX_CHANNELS])
+{
+    const wx_image *image = decoded(check, path);
+    if (image == NULL || count > WX_IMAGE_MAX_CHANNELS) {
+        return NULL;
+    }
+    for (int c = 0; c < count; ++c) {
+        index[c] = decoded_channel(image, wanted[c]);
+        if (index[c] < 0) {
+            return NULL;
+        }
+    }
+    return image;
+}
+
 // wx_exr_read_parallel from the decoded file when it has every wanted channel
 // (the same planes, names and attributes), else from the file.
 static wx_result read_planar(size_check *check, const char *path, const char *const *wanted,
                              int count, wx_image *out, wx_error *err)
 {
-    const wx_image *image = decoded(check, path);
     int index[WX_IMAGE_MAX_CHANNELS];
-    bool all = image != NULL && count <= WX_IMAGE_MAX_CHANNELS;
-    for (int c = 0; all && c < count; ++c) {
-        index[c] = decoded_channel(image, wanted[c]);
-        all = index[c] >= 0;
-    }
-    if (!all) {
+    const wx_image *image = decoded_channels(check, path, wanted, count, index);
+    if (image == NULL) {
         return wx_exr_read_parallel(path, wanted, count, check->threads, out, err);
     }
     memset(out, 0, sizeof *out);
@@ -148,14 +162,9 @@ static wx_result read_header(size_check *check, const char *path, wx_image *out,
 static wx_result read_interleaved(size_check *check, const char *path, const char *const *wanted,
                                   int count, float **out, int *width, int *height, wx_error *err)
 {
-    const wx_image *image = decoded(check, path);
     int index[WX_IMAGE_MAX_CHANNELS];
-    bool all = image != NULL && count <= WX_IMAGE_MAX_CHANNELS;
-    for (int c = 0; all && c < count; ++c) {
-        index[c] = decoded_channel(image, wanted[c]);
-        all = index[c] >= 0;
-    }
-    if (!all) {
+    const wx_image *image = decoded_channels(check, path, wanted, count, index);
+    if (image == NULL) {
         return wx_exr_read_interleaved(path, wanted, count, check->threads, out, width, height,
                                        err);
     }
