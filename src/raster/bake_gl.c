@@ -212,8 +212,8 @@ static void region_gl(const baker *b, int width, int height, int rect[4])
     rect[3] = y1 - y0;
 }
 
-// Copies attachment 0 (d, normal) of the layer just drawn into the `previous`
-// texture the next peeling pass reads (made, or remade, at the framebuffer's
+// Copies attachment 0 (d, normal) of the layer just drawn (within the region)
+// into the `previous` texture the next peeling pass reads (made, or remade, at the framebuffer's
 // size: 16 bytes a texel more while a layered camera bakes).
 wx_result bake_keep_previous_layer(baker *b, wx_error *err)
 {
@@ -353,8 +353,9 @@ static void local_matrix(const float wtc[16], const double origin[3], float out[
 // Rendering and readback.
 
 // Draws layer `layer` of camera c into the framebuffer (the first `targets`
-// colour targets), within the region (bake_set_region). A layer after the first keeps the crossings
-// behind the layer in the `previous` texture (bake_keep_previous_layer).
+// colour targets), within the region (bake_set_region). A layer after the
+// first keeps the crossings behind the layer in the `previous` texture
+// (bake_keep_previous_layer).
 wx_result bake_draw_camera(baker *b, int c, int targets, int layer, wx_error *err)
 {
     const wx_scene_camera *sc = &b->scene->cameras[c];

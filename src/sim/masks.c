@@ -209,9 +209,8 @@ static uint32_t rays_free_one_by_one(const wx_collider *collider, uint32_t activ
     return free_lanes;
 }
 
-static uint32_t rays_free(const wx_collider *collider, uint32_t active,
-                          double start[RAY_BLOCK][3], double dir[RAY_BLOCK][3],
-                          const double length[RAY_BLOCK], double first)
+static uint32_t rays_free(const wx_collider *collider, uint32_t active, double start[RAY_BLOCK][3],
+                          double dir[RAY_BLOCK][3], const double length[RAY_BLOCK], double first)
 {
     if (collider == NULL || collider->camera_count == 0 ||
         collider->camera_count > WX_MAX_INPUT_CAMERAS) {
@@ -238,7 +237,10 @@ static uint32_t rays_free(const wx_collider *collider, uint32_t active,
             bool on = ((free_lanes >> k) & 1u) && t0 < len[k];
             pending |= (uint32_t)on << k;
             t1[k] = on ? min_of(len[k], t0 + step) : t0;
-            const double *p = start[k], *d = dir[k];
+            // A lane without a ray (fewer rays than lanes, or one already
+            // decided) tests a point at the origin: its answer is not read.
+            const double none[3] = { 0.0, 0.0, 0.0 };
+            const double *p = on ? start[k] : none, *d = on ? dir[k] : none;
             x0[k] = (float)(p[0] + d[0] * t0);
             y0[k] = (float)(p[1] + d[1] * t0);
             z0[k] = (float)(p[2] + d[2] * t0);
@@ -420,7 +422,8 @@ static float accessibility(const job *jb, const wx_mask_def *m, size_t t, const 
             open += skipped >= m->distance; // past the distance already: open
             active |= (uint32_t)(skipped >= 0.0 && skipped < m->distance) << k;
         }
-        open += __builtin_popcount(rays_free(jb->def->collider, active, start, dir, length, jb->first));
+        open +=
+            __builtin_popcount(rays_free(jb->def->collider, active, start, dir, length, jb->first));
     }
     return (float)open / (float)m->rays;
 }
