@@ -91,8 +91,9 @@ static int decoded_channel(const wx_image *image, const char *alternatives)
     return -1;
 }
 
-// The decoded file at `path` when it has every wanted channel (their indices
-// in index[]), else NULL.
+// The decoded file at `path` when it has every wanted channel, each once
+// (their indices in index[]), else NULL: the file reader then says what is
+// missing or asked for twice.
 static const wx_image *decoded_channels(size_check *check, const char *path,
                                         const char *const *wanted, int count,
                                         int index[WX_IMAGE_MAX_CHANNELS])
@@ -103,11 +104,23 @@ static const wx_image *decoded_channels(size_check *check, const char *path,
     }
     for (int c = 0; c < count; ++c) {
         index[c] = decoded_channel(image, wanted[c]);
+        for (int k = 0; k < c && index[c] >= 0; ++k) {
+            index[c] = index[k] == index[c] ? -1 : index[c];
+        }
         if (index[c] < 0) {
             return NULL;
         }
     }
     return image;
+}
+
+// The size and attributes of a decoded file, as a read of it gives them.
+static void copy_frame(wx_image *out, const wx_image *image)
+{
+    out->width = image->width;
+    out->height = image->height;
+    out->attr_count = image->attr_count;
+    memcpy(out->attrs, image->attrs, (size_t)image->attr_count * sizeof *out->attrs);
 }
 
 // wx_exr_read_parallel from the decoded file when it has every wanted channel
@@ -132,11 +145,8 @@ static wx_result read_planar(size_check *check, const char *path, const char *co
         memcpy(out->channels[c], image->channels[index[c]], texels * sizeof(float));
         memcpy(out->channel_names[c], image->channel_names[index[c]], sizeof out->channel_names[c]);
     }
-    out->width = image->width;
-    out->height = image->height;
     out->channel_count = count;
-    out->attr_count = image->attr_count;
-    memcpy(out->attrs, image->attrs, (size_t)image->attr_count * sizeof *out->attrs);
+    copy_frame(out, image);
     return WX_OK;
 }
 
@@ -148,12 +158,9 @@ static wx_result read_header(size_check *check, const char *path, wx_image *out,
         return wx_exr_read_header(path, out, err);
     }
     memset(out, 0, sizeof *out);
-    out->width = image->width;
-    out->height = image->height;
     out->channel_count = image->channel_count;
     memcpy(out->channel_names, image->channel_names, sizeof out->channel_names);
-    out->attr_count = image->attr_count;
-    memcpy(out->attrs, image->attrs, (size_t)image->attr_count * sizeof *out->attrs);
+    copy_frame(out, image);
     return WX_OK;
 }
 

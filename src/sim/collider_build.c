@@ -251,16 +251,10 @@ static double tan_of_cos(double c)
     return sqrt(1.0 - c * c) / (c > 1e-3 ? c : 1e-3);
 }
 
-static void widen_crossings(const wx_collider *collider, wx_collider_camera *cam)
+// Widens camera `cam`'s crossings; axes[c]: camera c's unit axis (towards it).
+static void widen_crossings(const wx_collider *collider, const double (*axes)[3],
+                            wx_collider_camera *cam)
 {
-    double axes[WX_MAX_INPUT_CAMERAS][3];
-    for (int c = 0; c < collider->camera_count; ++c) {
-        const float *b = collider->cameras[c].back;
-        double l = sqrt((double)b[0] * b[0] + (double)b[1] * b[1] + (double)b[2] * b[2]);
-        for (int k = 0; k < 3; ++k) {
-            axes[c][k] = l > 0.0 ? b[k] / l : 0.0;
-        }
-    }
     double bl = sqrt((double)cam->back[0] * cam->back[0] + (double)cam->back[1] * cam->back[1] +
                      (double)cam->back[2] * cam->back[2]);
     if (!(bl > 0.0)) {
@@ -373,9 +367,17 @@ wx_result wx_collider_init(wx_collider *collider, const wx_camera *cameras, cons
     }
     // Every camera's axis is known now: widen the layered cameras' crossings
     // by their margins, then build each pyramid from the depths as widened.
+    double axes[WX_MAX_INPUT_CAMERAS][3];
+    for (int c = 0; c < count; ++c) {
+        const float *b = collider->cameras[c].back;
+        double l = sqrt((double)b[0] * b[0] + (double)b[1] * b[1] + (double)b[2] * b[2]);
+        for (int k = 0; k < 3; ++k) {
+            axes[c][k] = l > 0.0 ? b[k] / l : 0.0;
+        }
+    }
     for (int c = 0; c < count; ++c) {
         if (collider->cameras[c].layers > 1) {
-            widen_crossings(collider, &collider->cameras[c]);
+            widen_crossings(collider, (const double(*)[3])axes, &collider->cameras[c]);
         }
     }
     for (int c = 0; c < count; ++c) {

@@ -143,6 +143,25 @@ static double frames_exit(const wx_collider *collider, const double p[3], const 
     return last;
 }
 
+static bool segment_free(const wx_collider *collider, const double a[3], const double b[3],
+                         double length, double finest);
+
+// segment_free past the coarse pyramid: swept when no longer than `finest`,
+// else cut in two halves, each tested again.
+static bool segment_past_coarse(const wx_collider *collider, const double a[3], const double b[3],
+                                double length, double finest)
+{
+    if (length <= finest) {
+        float fa[3] = { (float)a[0], (float)a[1], (float)a[2] };
+        float fb[3] = { (float)b[0], (float)b[1], (float)b[2] };
+        wx_hit hit;
+        return !wx_collider_sweep(collider, fa, fb, &hit);
+    }
+    double m[3] = { 0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1]), 0.5 * (a[2] + b[2]) };
+    return segment_free(collider, a, m, 0.5 * length, finest) &&
+           segment_free(collider, m, b, 0.5 * length, finest);
+}
+
 // Whether segment a -> b of a ray is free: cleared by the coarse pyramid, or
 // cut in two halves (the finer levels bound it tighter) down to `finest`, then
 // swept.
@@ -151,16 +170,8 @@ static bool segment_free(const wx_collider *collider, const double a[3], const d
 {
     float fa[3] = { (float)a[0], (float)a[1], (float)a[2] };
     float fb[3] = { (float)b[0], (float)b[1], (float)b[2] };
-    if (wx_collider_coarse_clear(collider, fa, fb)) {
-        return true;
-    }
-    if (length <= finest) {
-        wx_hit hit;
-        return !wx_collider_sweep(collider, fa, fb, &hit);
-    }
-    double m[3] = { 0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1]), 0.5 * (a[2] + b[2]) };
-    return segment_free(collider, a, m, 0.5 * length, finest) &&
-           segment_free(collider, m, b, 0.5 * length, finest);
+    return wx_collider_coarse_clear(collider, fa, fb) ||
+           segment_past_coarse(collider, a, b, length, finest);
 }
 
 // True when the ray from p along unit dir travels `length` without entering a
@@ -196,29 +207,13 @@ static bool ray_free(const wx_collider *collider, const double p[3], const doubl
 // cannot clear is cut and swept as segment_free does. The segments, and so the
 // answers, are ray_free's ray by ray. Returns the lanes whose rays are free.
 enum { RAY_BLOCK = WX_PARTICLE_BLOCK };
-static uint32_t rays_free_one_by_one(const wx_collider *collider, uint32_t active,
-                                     double start[RAY_BLOCK][3], double dir[RAY_BLOCK][3],
-                                     const double length[RAY_BLOCK], double first)
-{
-    uint32_t free_lanes = 0;
-    for (int k = 0; k < RAY_BLOCK; ++k) {
-        if (((active >> k) & 1u) && ray_free(collider, start[k], dir[k], length[k], first)) {
-            free_lanes |= 1u << k;
-        }
-    }
-    return free_lanes;
-}
-
 static uint32_t rays_free(const wx_collider *collider, uint32_t active, double start[RAY_BLOCK][3],
                           double dir[RAY_BLOCK][3], const double length[RAY_BLOCK], double first)
 {
-    if (collider == NULL || collider->camera_count == 0 ||
-        collider->camera_count > WX_MAX_INPUT_CAMERAS) {
-        return collider == NULL || collider->camera_count == 0
-                   ? active
-                   : rays_free_one_by_one(collider, active, start, dir, length, first);
+    if (collider == NULL || collider->camera_count == 0) {
+        return active; // nothing can stop them
     }
-    int cams[WX_MAX_INPUT_CAMERAS];
+    int cams[WX_MAX_INPUT_CAMERAS]; // (a collider holds at most that many)
     for (int c = 0; c < collider->camera_count; ++c) {
         cams[c] = c;
     }
@@ -262,18 +257,7 @@ static uint32_t rays_free(const wx_collider *collider, uint32_t active, double s
                 a[c] = start[k][c] + dir[k][c] * t0;
                 b[c] = start[k][c] + dir[k][c] * t1[k];
             }
-            double m[3] = { 0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1]), 0.5 * (a[2] + b[2]) };
-            double half = 0.5 * (t1[k] - t0);
-            bool ok;
-            if (t1[k] - t0 <= first) {
-                float fa[3] = { x0[k], y0[k], z0[k] }, fb[3] = { x1[k], y1[k], z1[k] };
-                wx_hit hit;
-                ok = !wx_collider_sweep(collider, fa, fb, &hit);
-            } else {
-                ok = segment_free(collider, a, m, half, first) &&
-                     segment_free(collider, m, b, half, first);
-            }
-            if (!ok) {
+            if (!segment_past_coarse(collider, a, b, t1[k] - t0, first)) {
                 free_lanes &= ~(1u << k);
             }
         }
