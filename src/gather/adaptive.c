@@ -16,6 +16,7 @@
 // stopping at the largest radius that can reach the chunk), in a loop the
 // compiler vectorises.
 #include "gather/adaptive.h"
+#include "core/big_alloc.h"
 
 #include <math.h>
 #include <stdbool.h>
@@ -469,11 +470,11 @@ wx_result wx_adaptive_smooth(const wx_adaptive_def *def, float *out, wx_adaptive
     offset *offsets = malloc(cap * sizeof *offsets);
     jb.reach_i = malloc(2 * cap * sizeof *jb.reach_i);
     jb.reach_j = jb.reach_i + cap;
-    float *scratch = calloc(8 * plane, sizeof *scratch);
-    jb.delta = malloc(texels * sizeof *jb.delta);
-    jb.radius = calloc(texels, sizeof *jb.radius);
-    jb.clean = calloc(texels, 1);
-    jb.sat = calloc(2 * sat_size, sizeof *jb.sat);
+    float *scratch = wx_big_calloc(8 * plane, sizeof *scratch);
+    jb.delta = wx_big_malloc(texels * sizeof *jb.delta);
+    jb.radius = wx_big_calloc(texels, sizeof *jb.radius);
+    jb.clean = wx_big_calloc(texels, 1);
+    jb.sat = wx_big_calloc(2 * sat_size, sizeof *jb.sat);
     jb.tile_bound = calloc(tiles, sizeof *jb.tile_bound);
     float *tile_max = calloc(tiles, sizeof *tile_max);
     float *sorted = NULL;

@@ -14,6 +14,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/big_alloc.h"
 #include "core/limits.h"
 #include "gather/adaptive.h"
 #include "model/ownership.h"
@@ -702,7 +703,7 @@ wx_result wx_gather_owned(const wx_gather_view *views, int count, int threads, f
         return WX_OK;
     }
     wx_owner_view *owners = malloc((size_t)count * sizeof *owners);
-    float *planes = malloc(total * sizeof *planes);
+    float *planes = wx_big_malloc(total * sizeof *planes);
     if (owners == NULL || planes == NULL) {
         free(owners);
         free(planes);
@@ -766,7 +767,7 @@ wx_result wx_gather_compute(const wx_gather_def *def, float *mask_out, wx_gather
     }
     float *adaptive_planes = NULL;
     if (adaptive) {
-        adaptive_planes = malloc(3 * texels * sizeof *adaptive_planes);
+        adaptive_planes = wx_big_malloc(3 * texels * sizeof *adaptive_planes);
         if (adaptive_planes == NULL) {
             return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "gather: out of memory (%zu texels)",
                            texels);
@@ -809,7 +810,7 @@ wx_result wx_gather_compute(const wx_gather_def *def, float *mask_out, wx_gather
         plane = stride * ((size_t)out->height + 2 * (size_t)pad_y);
         if (result == WX_OK) {
             // Zeroed: margins have normal 0 (weight 0) and value 0.
-            scratch = calloc(5 * plane, sizeof *scratch);
+            scratch = wx_big_calloc(5 * plane, sizeof *scratch);
             if (scratch == NULL) {
                 result = wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "gather: out of memory (%zu texels)",
                                  texels);

@@ -1,5 +1,6 @@
 // texture.c: the UV raster of a mesh and the sampling of its texture (texture.h).
 #include "gather/texture.h"
+#include "core/big_alloc.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -262,7 +263,7 @@ static wx_result pad(wx_uv_raster *r, int padding, wx_error *err)
 {
     const int W = r->width, H = r->height;
     const size_t texels = (size_t)W * (size_t)H;
-    int32_t *row_of = malloc(texels * sizeof *row_of); // nearest covered row in the column
+    int32_t *row_of = wx_big_malloc(texels * sizeof *row_of); // nearest covered row in the column
     int *v = malloc((size_t)W * sizeof *v);
     double *z = malloc(((size_t)W + 1) * sizeof *z);
     if (row_of == NULL || v == NULL || z == NULL) {
@@ -355,9 +356,9 @@ wx_result wx_uv_raster_build(const wx_uv_raster_def *def, wx_uv_raster *out, wx_
     out->height = height;
     out->tiles = def->tiles;
     out->udim = def->tiles == WX_TILES_UDIM ? def->udim : 0;
-    out->triangle = malloc(texels * sizeof *out->triangle);
-    out->source = malloc(texels * sizeof *out->source);
-    unsigned char *count = calloc(texels, 1);
+    out->triangle = wx_big_malloc(texels * sizeof *out->triangle);
+    out->source = wx_big_malloc(texels * sizeof *out->source);
+    unsigned char *count = wx_big_calloc(texels, 1);
     if (out->triangle == NULL || out->source == NULL || count == NULL) {
         free(count);
         wx_uv_raster_free(out);

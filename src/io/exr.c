@@ -14,6 +14,7 @@
 // This file reads, and holds the stream both directions use; exr_write.c
 // writes (exr_internal.h).
 #include "io/exr.h"
+#include "core/big_alloc.h"
 
 #include "core/atomic_file.h"
 #include "core/input_file.h"
@@ -647,7 +648,7 @@ static wx_result read_channels(const char *path, const char *const *wanted, int 
     size_t texels = (size_t)r.width * (size_t)r.height;
     if (planar) {
         for (int i = 0; i < wanted_count; i++) {
-            out->channels[i] = malloc(texels * sizeof(float));
+            out->channels[i] = wx_big_malloc(texels * sizeof(float));
             if (out->channels[i] == NULL) {
                 result = wx_fail(err, WX_CAUSE_OUT_OF_MEMORY,
                                  "%s: out of memory for %d x %d texels", path, r.width, r.height);
@@ -656,7 +657,7 @@ static wx_result read_channels(const char *path, const char *const *wanted, int 
             targets[i].base = out->channels[i];
         }
     } else {
-        *interleaved = malloc(texels * (size_t)wanted_count * sizeof(float));
+        *interleaved = wx_big_malloc(texels * (size_t)wanted_count * sizeof(float));
         if (*interleaved == NULL) {
             result = wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "%s: out of memory for %d x %d texels",
                              path, r.width, r.height);

@@ -2,6 +2,7 @@
 // from their EXR files into the in-memory layout of model/maps.h
 // (docs/design.md section 2).
 #include "io/maps_file.h"
+#include "core/big_alloc.h"
 
 #include <math.h>
 #include <stdbool.h>
@@ -136,7 +137,7 @@ static wx_result read_planar(size_check *check, const char *path, const char *co
     memset(out, 0, sizeof *out);
     size_t texels = (size_t)image->width * (size_t)image->height;
     for (int c = 0; c < count; ++c) {
-        out->channels[c] = malloc(texels * sizeof(float));
+        out->channels[c] = wx_big_malloc(texels * sizeof(float));
         if (out->channels[c] == NULL) {
             wx_image_free(out);
             return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "%s: out of memory for %d x %d texels",
@@ -176,7 +177,7 @@ static wx_result read_interleaved(size_check *check, const char *path, const cha
                                        err);
     }
     size_t texels = (size_t)image->width * (size_t)image->height;
-    *out = malloc(texels * (size_t)count * sizeof(float));
+    *out = wx_big_malloc(texels * (size_t)count * sizeof(float));
     if (*out == NULL) {
         return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "%s: out of memory for %d x %d texels", path,
                        image->width, image->height);
@@ -406,7 +407,7 @@ static wx_result load_scene_dirt(wx_maps *maps, unsigned which, const wx_scene *
                            ? (size_t)S
                            : 1;
         if (*p->dest == NULL) {
-            *p->dest = calloc(n * block + 1, sizeof(float));
+            *p->dest = wx_big_calloc(n * block + 1, sizeof(float));
             if (*p->dest == NULL) {
                 result = wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "%s: out of memory", dirt_path);
                 break;
@@ -565,10 +566,13 @@ static bool append_block(float **plane, int layers, float *block, size_t block_f
         return *plane == NULL;
     }
     if (layer == 0) {
-        float *all = realloc(block, (size_t)layers * block_floats * sizeof(float) + sizeof(float));
+        // A new block (not realloc's: its growth would be mapped in small pages).
+        float *all = wx_big_malloc((size_t)layers * block_floats * sizeof(float) + sizeof(float));
         if (all == NULL) {
             return false;
         }
+        memcpy(all, block, block_floats * sizeof(float));
+        free(block);
         *plane = all;
         return true;
     }

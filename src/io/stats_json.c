@@ -2,8 +2,35 @@
 #include "io/stats_json.h"
 
 #include <stdio.h>
+#include <string.h>
 
 #include "core/atomic_file.h"
+
+// The most memory this process has held resident, in MiB: the kernel's high
+// water mark of its address space (VmHWM in /proc/self/status), which starts
+// anew at exec, unlike getrusage's ru_maxrss, which keeps the parent's when a
+// large process forks the run (a benchmark that ran a simulation itself
+// measured its own memory as the run's). -1 where /proc does not say.
+static double peak_memory_mib(void)
+{
+    FILE *f = fopen("/proc/self/status", "r");
+    if (f == NULL) {
+        return -1.0;
+    }
+    char line[256];
+    double kib = -1.0;
+    while (fgets(line, sizeof line, f) != NULL) {
+        if (strncmp(line, "VmHWM:", 6) == 0) {
+            long long v = 0;
+            if (sscanf(line + 6, "%lld", &v) == 1) {
+                kib = (double)v;
+            }
+            break;
+        }
+    }
+    fclose(f);
+    return kib >= 0.0 ? kib / 1024.0 : -1.0;
+}
 
 wx_result wx_write_stats(const char *path, const wx_sim_stats *stats, const wx_phase_times *times,
                          int threads, uint64_t seed, wx_error *err)
@@ -70,18 +97,17 @@ wx_result wx_write_stats(const char *path, const wx_sim_stats *stats, const wx_p
         "\"write\": %.6f },\n"
         "  \"gather_seconds\": { \"read\": %.6f, \"compute\": %.6f, \"write\": %.6f },\n"
         "  \"threads\": %d,\n"
+        "  \"peak_memory_mib\": %.1f,\n"
         "  \"seed\": %llu\n"
         "}\n",
         (long long)stats->particles_emitted, tile, (long long)stats->particle_steps,
         (long long)stats->collisions, (long long)stats->absorbed, (long long)stats->settled,
-        (long long)stats->escaped, (long long)stats->escaped_without_hit,
-        (long long)stats->alive, (long long)stats->alive_without_hit, dirt,
-        (long long)stats->iterations, substances, times->load, times->bake, times->simulate,
-        times->gather,
-        times->total, times->simulate_detail.read, times->simulate_detail.setup,
-        times->simulate_detail.compute, times->simulate_detail.write, times->gather_detail.read,
-        times->gather_detail.compute, times->gather_detail.write, threads,
-        (unsigned long long)seed);
+        (long long)stats->escaped, (long long)stats->escaped_without_hit, (long long)stats->alive,
+        (long long)stats->alive_without_hit, dirt, (long long)stats->iterations, substances,
+        times->load, times->bake, times->simulate, times->gather, times->total,
+        times->simulate_detail.read, times->simulate_detail.setup, times->simulate_detail.compute,
+        times->simulate_detail.write, times->gather_detail.read, times->gather_detail.compute,
+        times->gather_detail.write, threads, peak_memory_mib(), (unsigned long long)seed);
     if (n < 0 || n >= (int)sizeof json) {
         return wx_fail(err, WX_CAUSE_INTERNAL, "%s: statistics too long", path);
     }

@@ -1,5 +1,6 @@
 // image.c: float images in memory: planes, names and header attributes (image.h).
 #include "model/image.h"
+#include "core/big_alloc.h"
 
 #include <assert.h>
 #include <math.h>
@@ -29,7 +30,7 @@ wx_result wx_image_alloc(wx_image *image, int width, int height, int channel_cou
     }
     size_t texels = (size_t)width * (size_t)height;
     for (int c = 0; c < channel_count; c++) {
-        image->channels[c] = calloc(texels, sizeof(float));
+        image->channels[c] = wx_big_calloc(texels, sizeof(float));
         if (image->channels[c] == NULL) {
             wx_image_free(image);
             return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory for %d x %d x %d floats",

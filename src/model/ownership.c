@@ -1,5 +1,6 @@
 // ownership.c: which input camera a surface point belongs to (ownership.h).
 #include "model/ownership.h"
+#include "core/big_alloc.h"
 
 #include <math.h>
 #include <stdint.h>
@@ -320,7 +321,7 @@ wx_result wx_owned_fraction(const wx_owner_view *views, int count, int c, const 
     owned_job job = { .views = views, .count = count, .c = c, .nx = nx, .ny = ny, .nz = nz,
                       .stride = stride, .out = out };
     size_t n = (size_t)v->width * (size_t)v->height;
-    float *centre = malloc((n > 0 ? n : 1) * sizeof *centre);
+    float *centre = wx_big_malloc((n > 0 ? n : 1) * sizeof *centre);
     if (centre == NULL) {
         return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (%d x %d ownership)",
                        v->width, v->height);

@@ -2,6 +2,7 @@
 // visibility test needs read, the cameras rendered in memory (raster/bake.c),
 // each camera's maps written as they come.
 #include "pipeline/bake_phase.h"
+#include "core/big_alloc.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -58,8 +59,8 @@ static wx_result keep_output_maps(const wx_image *depth, const wx_image *normal,
     int w = depth->width, h = depth->height;
     size_t texels = (size_t)w * (size_t)h;
     memset(out, 0, sizeof *out);
-    out->depth = malloc(texels * sizeof *out->depth);
-    out->normal = malloc(3 * texels * sizeof *out->normal);
+    out->depth = wx_big_malloc(texels * sizeof *out->depth);
+    out->normal = wx_big_malloc(3 * texels * sizeof *out->normal);
     if (out->depth == NULL || out->normal == NULL) {
         wx_maps_free(out);
         return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "bake: out of memory");

@@ -1,6 +1,7 @@
 // load.c: what the simulation and the gather read before they compute (load.h):
 // the input cameras' maps.
 #include "pipeline/load.h"
+#include "core/big_alloc.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -157,7 +158,7 @@ wx_result wx_layer_scene_init(const wx_scene *scene, const wx_maps *maps, int th
         int K = wx_maps_layers(&maps[k]);
         size_t texels = (size_t)maps[k].width * (size_t)maps[k].height;
         if (K > 1 && out->buried_count < WX_MAX_INPUT_CAMERAS) {
-            buried = malloc((size_t)K * texels * sizeof *buried + 1);
+            buried = wx_big_malloc((size_t)K * texels * sizeof *buried + 1);
             if (buried == NULL) {
                 free(gather);
                 wx_layer_scene_free(out);

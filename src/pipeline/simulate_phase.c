@@ -1,6 +1,7 @@
 // simulate_phase.c: the `simulate` phase on files (simulate_phase.h): the maps
 // in, the simulation (sim/simulate.c) on them, the dirt maps out.
 #include "pipeline/simulate_phase.h"
+#include "core/big_alloc.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -75,9 +76,9 @@ static wx_result gather_plane_blocks(const wx_sim *sim, const wx_maps *m, int c,
     size_t n = (size_t)map->width * (size_t)map->height;
     int S = map->substances;
     size_t L = (size_t)layers;
-    *dirt = malloc(L * n * (size_t)S * sizeof **dirt + 1);
-    *initial = malloc(L * n * (size_t)S * sizeof **initial + 1);
-    *hits = malloc(L * n * sizeof **hits + 1);
+    *dirt = wx_big_malloc(L * n * (size_t)S * sizeof **dirt + 1);
+    *initial = wx_big_malloc(L * n * (size_t)S * sizeof **initial + 1);
+    *hits = wx_big_malloc(L * n * sizeof **hits + 1);
     if (*dirt == NULL || *initial == NULL || *hits == NULL) {
         free(*dirt);
         free(*initial);

@@ -28,6 +28,7 @@
 // framebuffer, drawing, readback) and bake_peel.c the merge of peeling passes
 // into layers, through baker_internal.h.
 #include "raster/bake.h"
+#include "core/big_alloc.h"
 
 #include <math.h>
 #include <stdarg.h>
@@ -234,12 +235,12 @@ static wx_result take_given_depth(baker *b, int c, wx_error *err)
     cam_state *cs = &b->cams[c];
     int layers = wx_maps_layers(given) > 1 && given->normal != NULL ? wx_maps_layers(given) : 1;
     size_t n = (size_t)given->width * (size_t)given->height * (size_t)layers;
-    cs->depth = malloc((n > 0 ? n : 1) * sizeof *cs->depth);
+    cs->depth = wx_big_malloc((n > 0 ? n : 1) * sizeof *cs->depth);
     if (cs->depth == NULL) {
         return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "bake: out of memory");
     }
     if (layers > 1) {
-        cs->normal = malloc(3 * n * sizeof *cs->normal);
+        cs->normal = wx_big_malloc(3 * n * sizeof *cs->normal);
         if (cs->normal == NULL) {
             return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "bake: out of memory");
         }
@@ -322,7 +323,7 @@ static wx_result compute_initial_dirt(baker *b, int c, const wx_owner_view *view
     float texel_area = (frame_w / (float)width) * (frame_h / (float)height);
 
     size_t texels = (size_t)width * (size_t)height;
-    float *share = malloc((texels > 0 ? texels : 1) * sizeof *share);
+    float *share = wx_big_malloc((texels > 0 ? texels : 1) * sizeof *share);
     if (share == NULL) {
         return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "bake: out of memory");
     }
@@ -473,12 +474,12 @@ static wx_result render_depth_only(baker *b, int c, wx_error *err)
     cam_state *cs = &b->cams[c];
     int layers = bake_cam_layers(sc);
     size_t n = (size_t)sc->camera.width * (size_t)sc->camera.height;
-    cs->depth = malloc(n * (size_t)layers * sizeof(float));
+    cs->depth = wx_big_malloc(n * (size_t)layers * sizeof(float));
     if (cs->depth == NULL) {
         return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "bake: out of memory");
     }
     if (layers > 1) {
-        cs->normal = malloc(3 * n * (size_t)layers * sizeof(float));
+        cs->normal = wx_big_malloc(3 * n * (size_t)layers * sizeof(float));
         if (cs->normal == NULL) {
             return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "bake: out of memory");
         }
@@ -534,7 +535,7 @@ static void clear_layer(map_set *set, int layers, int layer, size_t texels)
 // layer after the other), as the ownership views of a layered camera read them.
 static float *interleaved_normals(const wx_image *normal, int layers, size_t texels)
 {
-    float *out = malloc(3 * texels * (size_t)layers * sizeof *out);
+    float *out = wx_big_malloc(3 * texels * (size_t)layers * sizeof *out);
     for (int l = 0; out != NULL && l < layers; ++l) {
         float *dst = out + 3 * texels * (size_t)l;
         for (size_t t = 0; t < texels; ++t) {
@@ -575,7 +576,7 @@ static wx_result bake_camera(baker *b, int c, wx_error *err)
     float *surface[WX_MAX_LAYERS] = { NULL };
     if (r == WX_OK && input && (S > 1 || surface_channel >= 0)) {
         if (surface_channel < 0) {
-            scratch = malloc(texels * (size_t)layers * sizeof *scratch);
+            scratch = wx_big_malloc(texels * (size_t)layers * sizeof *scratch);
             if (scratch == NULL) {
                 r = wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "bake: out of memory");
             }

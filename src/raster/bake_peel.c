@@ -8,6 +8,7 @@
 #include <stdbool.h>
 #include <stdlib.h>
 
+#include "core/big_alloc.h"
 #include "core/error.h"
 #include "model/camera.h"
 #include "raster/baker_internal.h"
@@ -190,8 +191,8 @@ wx_result bake_peel_camera(baker *b, int c, int layers, int planes, plane_out (*
     size_t texels = (size_t)sc->camera.width * (size_t)sc->camera.height;
     float view[3];
     wx_camera_view_dir(&sc->camera, view);
-    float *pass = malloc((size_t)planes * texels * sizeof *pass);
-    unsigned char *kept = calloc(texels, 1), *pairs = calloc(texels, 1);
+    float *pass = wx_big_malloc((size_t)planes * texels * sizeof *pass);
+    unsigned char *kept = wx_big_calloc(texels, 1), *pairs = wx_big_calloc(texels, 1);
     wx_result r = pass != NULL && kept != NULL && pairs != NULL
                       ? WX_OK
                       : wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "bake: out of memory (peeling)");

@@ -3,6 +3,7 @@
 // the coarse test reads, and a layered camera's crossings reduced to the
 // outline of its solids.
 #include "sim/collider.h"
+#include "core/big_alloc.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -70,8 +71,8 @@ static wx_result build_coarse(wx_collider_camera *cam, wx_error *err)
         total += cam->level_width[l] * cam->level_height[l];
     }
     cam->levels = WX_COARSE_LEVELS;
-    cam->coarse = malloc((size_t)total * sizeof *cam->coarse);
-    float *blockmin = malloc((size_t)total * sizeof *blockmin);
+    cam->coarse = wx_big_malloc((size_t)total * sizeof *cam->coarse);
+    float *blockmin = wx_big_malloc((size_t)total * sizeof *blockmin);
     if (cam->coarse == NULL || blockmin == NULL) {
         free(blockmin);
         return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (collider pyramid)");
@@ -338,10 +339,10 @@ wx_result wx_collider_init(wx_collider *collider, const wx_camera *cameras, cons
         }
         size_t texels = (size_t)m->width * (size_t)m->height;
         cam->layers = layers;
-        cam->depth = malloc((size_t)layers * texels * sizeof *cam->depth);
+        cam->depth = wx_big_malloc((size_t)layers * texels * sizeof *cam->depth);
         if (layers > 1) {
-            cam->role = malloc((size_t)layers * texels);
-            cam->origin = malloc((size_t)layers * texels);
+            cam->role = wx_big_malloc((size_t)layers * texels);
+            cam->origin = wx_big_malloc((size_t)layers * texels);
         }
         if (cam->depth == NULL || (layers > 1 && (cam->role == NULL || cam->origin == NULL))) {
             wx_collider_free(collider);

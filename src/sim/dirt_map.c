@@ -1,6 +1,7 @@
 // dirt_map.c: surface dirt, the particle-surface exchange and Bresenham streaks
 // (thesis 3.5, 4.8.4.3, docs/design.md section 4).
 #include "sim/dirt_map.h"
+#include "core/big_alloc.h"
 
 #include <math.h>
 #include <stdbool.h>
@@ -24,7 +25,7 @@ wx_result wx_dirt_map_init(wx_dirt_map *map, int width, int height, int substanc
     memset(map, 0, sizeof *map);
     size_t texels = (size_t)width * (size_t)height;
     size_t S = substances > 0 ? (size_t)substances : 1;
-    map->texels = malloc(texels * S * sizeof *map->texels);
+    map->texels = wx_big_malloc(texels * S * sizeof *map->texels);
     if (map->texels == NULL) {
         return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (dirt map %d x %d)", width,
                        height);

@@ -269,7 +269,11 @@ static bool speed(long particles, long steps)
 // --- (b) memory -----------------------------------------------------------------
 
 // Runs `weathering run SCENE --out OUT --stats OUT.json` in `dir` and returns its
-// peak resident memory in MiB (wait4's ru_maxrss), or -1.
+// peak resident memory in MiB: the run's own `peak_memory_mib` (its address
+// space's high-water mark). wait4's ru_maxrss is no measure here: a child
+// forked from this benchmark keeps the benchmark's own peak (part (a) ran a
+// simulation in this process) as its ru_maxrss. -1 when the run fails.
+static double json_number(const char *text, const char *key);
 static double run_peak_mib(const char *program, const char *dir, const char *scene, const char *out)
 {
     char stats[64];
@@ -287,13 +291,17 @@ static double run_peak_mib(const char *program, const char *dir, const char *sce
         _exit(98);
     }
     int status = 0;
-    struct rusage usage;
-    if (pid < 0 || wait4(pid, &status, 0, &usage) != pid || !WIFEXITED(status) ||
+    if (pid < 0 || waitpid(pid, &status, 0) != pid || !WIFEXITED(status) ||
         WEXITSTATUS(status) != 0) {
         fprintf(stderr, "bench_layers: `weathering run %s` failed in %s\n", scene, dir);
         return -1.0;
     }
-    return (double)usage.ru_maxrss / 1024.0;
+    char path[PATH_MAX + 64];
+    snprintf(path, sizeof path, "%s/%s", dir, stats);
+    char *json = ensure_read_file(path);
+    double peak = json_number(json, "\"peak_memory_mib\": ");
+    free(json);
+    return peak;
 }
 
 // The number after `key` in `text`, or -1.
