@@ -15,6 +15,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "core/big_alloc.h"
 #include "ensure.h"
 #include "memory_fixture.h"
 
@@ -190,8 +191,76 @@ TEST(memory_estimate_bounds_meshes_and_particles_alive_at_once)
     ENSURE(failures == 0);
 }
 
+// core/big_alloc: a large block starts on a huge page and is whole; calloc's
+// zeroes; an overflowing count refused; small blocks still given.
+TEST(big_blocks_are_aligned_zeroed_and_refuse_overflow)
+{
+    const size_t huge = (size_t)2 << 20;
+    size_t bytes = 5 * huge + 12345; // a tail past the last whole huge page
+    unsigned char *p = wx_big_malloc(bytes);
+    ENSURE(p != NULL);
+    ENSURE(((uintptr_t)p & (huge - 1)) == 0);
+    memset(p, 0xab, bytes); // every byte asked for is usable
+    ENSURE(p[bytes - 1] == 0xab);
+    free(p);
+    size_t count = 3 * huge / sizeof(float) + 7;
+    float *z = wx_big_calloc(count, sizeof(float));
+    ENSURE(z != NULL);
+    size_t nonzero = 0;
+    for (size_t i = 0; i < count; ++i) {
+        nonzero += z[i] != 0.0f;
+    }
+    ENSURE(nonzero == 0);
+    free(z);
+    ENSURE(wx_big_calloc(SIZE_MAX / 2, 4) == NULL);
+    void *small = wx_big_malloc(100), *none = wx_big_calloc(0, 4);
+    ENSURE(small != NULL && none != NULL);
+    free(small);
+    free(none);
+}
+
+// --stats' peak_memory_mib is the run's own high-water mark: positive and no
+// more than what wait4 reports for the same child (which also counts this
+// test's memory at the fork).
+TEST(stats_report_the_runs_own_peak_memory)
+{
+    const char *dir = scene_dir();
+    ensure_write_file(
+        dir, "peak.xml",
+        "<Weathering>\n"
+        "  <Solver><BoundingBox size=\"4\" centerY=\"1\"/><Simulation "
+        "timeStep=\"0.01\" steps=\"20\" seed=\"1\"/></Solver>\n"
+        "  <ForceFields><Gravity acceleration=\"9.8\"/></ForceFields>\n"
+        "  <Emitters><BoxEmitter minX=\"-1\" minY=\"2.5\" minZ=\"-1\" maxX=\"1\" "
+        "maxY=\"2.5\" maxZ=\"1\" rate=\"10000\" end=\"0.1\" speed=\"5\"/>"
+        "</Emitters>\n"
+        "  <Collider><ProjectedMaps>\n"
+        "    <Ortho cameraName=\"top\"><View eye=\"0 5 0\" target=\"0 0 0\" "
+        "up=\"0 0 -1\" width=\"4\" height=\"4\" resolution=\"64\"/></Ortho>\n"
+        "    <Ortho cameraName=\"shot\" out=\"true\"><View eye=\"3 4 5\" "
+        "target=\"0 0 0\" up=\"0 1 0\" width=\"5\" height=\"5\" "
+        "resolution=\"48\"/><OutputMap file=\"mask.exr\"/></Ortho>\n"
+        "  </ProjectedMaps></Collider>\n"
+        "  <Geometry><Mesh file=\"box.obj\"><Surface material=\"*\"/></Mesh></Geometry>\n"
+        "</Weathering>\n");
+    char path[4400], stats[4400];
+    snprintf(path, sizeof path, "%s/peak.xml", dir);
+    snprintf(stats, sizeof stats, "%s/peak.json", dir);
+    double wait4_peak = run_peak_mib(path, out_dir("peak"), stats);
+    ENSURE(wait4_peak > 0.0);
+    char *json = ensure_read_file(stats);
+    const char *at = json != NULL ? strstr(json, "\"peak_memory_mib\": ") : NULL;
+    ENSURE(at != NULL);
+    double own = at != NULL ? atof(at + strlen("\"peak_memory_mib\": ")) : -1.0;
+    fprintf(stderr, "        own peak %.1f MiB, wait4's %.1f MiB\n", own, wait4_peak);
+    ENSURE(own > 0.0 && own <= wait4_peak + 1.0);
+    free(json);
+}
+
 int main(void)
 {
+    RUN(big_blocks_are_aligned_zeroed_and_refuse_overflow);
+    RUN(stats_report_the_runs_own_peak_memory);
     RUN(memory_estimate_bounds_meshes_and_particles_alive_at_once);
     return ensure_summary();
 }

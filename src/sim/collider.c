@@ -396,7 +396,7 @@ static void cell_layers(const wx_collider *collider, march *m)
     int ia = clampi(i0, 0, W - 1), ib = clampi(i0 + 1, 0, W - 1);
     int ja = clampi(j0, 0, H - 1), jb = clampi(j0 + 1, 0, H - 1);
     const float *ra = cam->depth + (size_t)ja * (size_t)W, *rb = cam->depth + (size_t)jb * (size_t)W;
-    m->near = fmin(fmin(ra[ia], ra[ib]), fmin(rb[ia], rb[ib]));
+    m->near = dmin(dmin(ra[ia], ra[ib]), dmin(rb[ia], rb[ib]));
     m->count = n;
     m->surface = n > 0;
     m->ready = false;
@@ -562,7 +562,7 @@ static double layers_first(march *m, double lo, double hi)
     if (!m->ready) {
         // In front of every crossing of the cell over [lo, hi] (d is linear
         // in s): nothing to meet here.
-        double d_far = fmax(m->D0 + lo * m->dD, m->D0 + hi * m->dD);
+        double d_far = dmax(m->D0 + lo * m->dD, m->D0 + hi * m->dD);
         if (d_far < m->near - 2.0 * sheet) {
             return INFINITY;
         }
@@ -720,7 +720,7 @@ static int pick_camera(const wx_collider *collider, const march *m, double s)
         }
         double cos_view = fabs(n[0] * cam->back[0] + n[1] * cam->back[1] + n[2] * cam->back[2]) /
                           (bl * nl);
-        double tan_view = sqrt(fmax(0.0, 1.0 - cos_view * cos_view)) / fmax(cos_view, 0.05);
+        double tan_view = sqrt(dmax(0.0, 1.0 - cos_view * cos_view)) / dmax(cos_view, 0.05);
         double precision = cam->texel_ws * (0.5 + tan_view) + collider->layered_slack;
         // The texel itself must record this surface too: between a wall and a
         // slab's edge in front of it the bilinear depth is no surface at all,
