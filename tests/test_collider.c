@@ -701,16 +701,27 @@ TEST(pane_is_a_thin_sheet_hit_from_either_side)
 // segment that hits; the sweep agrees with the point rule (no point before the
 // hit collides, and without a hit none along the segment does); every put-back
 // point is outside.
+// A porch: a floor, a roof on a post, a block under the roof and a pane in
+// front, seen by a front, a side and a top camera of 128 px (and, when asked,
+// a back camera, which sees the pane from behind).
+static void porch(lay_world *world, wx_camera cams[4])
+{
+    fx_box(&world->solids, -3, -1, -3, 3, 0, 3);                         // floor
+    fx_box(&world->solids, -1.5f, 1.5f, -1.5f, 1.5f, 1.8f, 1.5f);        // roof
+    fx_box(&world->solids, -1.5f, 0, -1.5f, -1.2f, 1.5f, -1.2f);         // a post
+    fx_box(&world->solids, 0.3f, 0.3f, -0.4f, 0.7f, 0.6f, 0.2f);         // a block under the roof
+    sheet(world, -2.0f, 0.2f, 2.2f, 2.0f, 1.2f, 2.2f, 0.0f, 0.0f, 1.0f); // pane
+    cams[0] = fx_camera(0, 0, 10, 0, 0, 0, 0, 1, 0, 7, 128);
+    cams[1] = fx_camera(10, 0, 0, 0, 0, 0, 0, 1, 0, 7, 128);
+    cams[2] = top_camera(7, 128);
+    cams[3] = fx_camera(0, 0, -10, 0, 0, 0, 0, 1, 0, 7, 128);
+}
+
 TEST(layered_sweep_agrees_with_the_point_rule)
 {
     lay_world world = { 0 };
-    fx_box(&world.solids, -3, -1, -3, 3, 0, 3);          // floor
-    fx_box(&world.solids, -1.5f, 1.5f, -1.5f, 1.5f, 1.8f, 1.5f); // roof
-    fx_box(&world.solids, -1.5f, 0, -1.5f, -1.2f, 1.5f, -1.2f);  // a post
-    fx_box(&world.solids, 0.3f, 0.3f, -0.4f, 0.7f, 0.6f, 0.2f);  // a block under the roof
-    sheet(&world, -2.0f, 0.2f, 2.2f, 2.0f, 1.2f, 2.2f, 0.0f, 0.0f, 1.0f); // pane
-    wx_camera cams[3] = { fx_camera(0, 0, 10, 0, 0, 0, 0, 1, 0, 7, 128),
-                          fx_camera(10, 0, 0, 0, 0, 0, 0, 1, 0, 7, 128), top_camera(7, 128) };
+    wx_camera cams[4];
+    porch(&world, cams);
     wx_maps maps[3];
     wx_collider col;
     ENSURE(build_layers(&col, cams, maps, 3, &world, 4));
@@ -775,6 +786,107 @@ TEST(layered_sweep_agrees_with_the_point_rule)
     ENSURE(phantom == 0);
     ENSURE(hits > 1500);
     ENSURE(cleared > 20000);
+}
+
+// The fine test (wx_collider_fine_clear, which accessibility's rays ask before
+// the swept test) never clears a segment the swept test stops, with one layer
+// and with four (the pane seen from behind: a sheet's slab starts in front of
+// its crossing): random segments, and segments leaving a hit's put-back point
+// in every direction, where it is tightest. And it clears most of those that
+// leave the surface.
+TEST(fine_test_never_clears_what_the_sweep_stops)
+{
+    lay_world world = { 0 };
+    wx_camera cams[4];
+    porch(&world, cams);
+    // The porch's cameras, and three that see every face at an angle (where
+    // a texel's neighbours lie nearer than itself).
+    wx_camera oblique[4] = { fx_camera(8, 6, 5, 0, 0.5f, 0, 0, 1, 0, 9, 128),
+                             fx_camera(-6, 7, 8, 0, 0.5f, 0, 0, 1, 0, 9, 128),
+                             fx_camera(5, 6, -8, 0, 0.5f, 0, 0, 1, 0, 9, 128), cams[3] };
+    for (int run = 0; run < 4; ++run) {
+        int layers = run % 2 == 0 ? 1 : 4;
+        wx_camera *set = run < 2 ? cams : oblique;
+        wx_maps maps[4];
+        wx_collider col;
+        ENSURE(build_layers(&col, set, maps, 4, &world, layers));
+        uint64_t state = 11;
+        int contradictions = 0, cleared = 0, near = 0, near_cleared = 0, near_free = 0;
+        for (int i = 0; i < 50000; ++i) {
+            float r[9];
+            for (int q = 0; q < 9; ++q) {
+                state = wx_mix64(state + 1);
+                r[q] = (float)((state >> 11) * (1.0 / 9007199254740992.0));
+            }
+            float len = (i % 4 == 0) ? 2.0f : 0.3f;
+            float p0[3] = { -3.2f + 6.4f * r[0], -0.5f + 3.0f * r[1], -3.2f + 6.4f * r[2] };
+            if (i % 5 == 0) {
+                // Just behind the pane (z 2.2), towards it: its slab seen from
+                // behind starts a sheet in front of the back camera's crossing.
+                p0[0] = -1.8f + 3.6f * r[0];
+                p0[1] = 0.3f + 0.8f * r[1];
+                p0[2] = 2.2f - 0.05f * r[2];
+                len = 0.1f;
+            }
+            float p1[3] = { p0[0] + len * (r[3] - 0.5f), p0[1] + len * (r[4] - 0.5f),
+                            p0[2] + len * (r[5] - 0.5f) };
+            if (wx_collider_point_collides(&col, p0)) {
+                continue;
+            }
+            wx_hit hit, again;
+            bool h = wx_collider_sweep(&col, p0, p1, &hit);
+            bool fine = wx_collider_fine_clear(&col, p0, p1);
+            cleared += fine;
+            contradictions += fine && h;
+            if (!h) {
+                continue;
+            }
+            // From the put-back point, up to 10 texels in any direction.
+            float q1[3];
+            for (int a = 0; a < 3; ++a) {
+                q1[a] = hit.front[a] + 0.6f * (r[6 + a] - 0.5f);
+            }
+            bool stops = wx_collider_sweep(&col, hit.front, q1, &again);
+            bool clears = wx_collider_fine_clear(&col, hit.front, q1);
+            near++;
+            near_free += !stops;
+            near_cleared += clears;
+            contradictions += clears && stops;
+        }
+        fprintf(stderr,
+                "        %s, %d layer%s: random segments cleared %d; from a surface %d, %d free, "
+                "%d of them cleared\n",
+                run < 2 ? "axes" : "oblique", layers, layers > 1 ? "s" : "", cleared, near,
+                near_free, near_cleared);
+        release(&col, maps, 4);
+        ENSURE(contradictions == 0);
+        ENSURE(near > 1500);
+        ENSURE(near_cleared > near_free / (run < 2 ? 4 : 8)); // (oblique: fewer)
+    }
+    // The pane alone between a front and a back camera, which agree on its
+    // slab: segments inside the slab, in front of the back camera's crossing,
+    // are stopped, and the fine test must not clear them.
+    lay_world pane = { 0 };
+    sheet(&pane, -2.0f, 0.2f, 2.2f, 2.0f, 1.2f, 2.2f, 0.0f, 0.0f, 1.0f);
+    wx_camera two[2] = { cams[0], cams[3] };
+    wx_maps maps[2];
+    wx_collider col;
+    ENSURE(build_layers(&col, two, maps, 2, &pane, 4));
+    double slab = col.cameras[1].sheet; // d units are world units here
+    int stopped = 0, contradictions = 0;
+    for (int i = 0; i < 200; ++i) {
+        float x = -1.5f + 0.015f * (float)i, y = 0.7f;
+        float z = (float)(2.2 - slab * (0.1 + 0.8 * (i % 10) / 10.0));
+        float p0[3] = { x, y, z }, p1[3] = { x + 0.01f, y, z };
+        wx_hit hit;
+        bool stops = wx_collider_sweep(&col, p0, p1, &hit);
+        stopped += stops;
+        contradictions += stops && wx_collider_fine_clear(&col, p0, p1);
+    }
+    release(&col, maps, 2);
+    fprintf(stderr, "        in the pane's slab: %d of 200 stopped\n", stopped);
+    ENSURE(stopped > 100);
+    ENSURE(contradictions == 0);
 }
 
 // A map whose only layer is given as layers = 1 works exactly as one with
@@ -958,6 +1070,7 @@ int main(void)
     RUN(tilted_underside_hit_is_exact);
     RUN(pane_is_a_thin_sheet_hit_from_either_side);
     RUN(layered_sweep_agrees_with_the_point_rule);
+    RUN(fine_test_never_clears_what_the_sweep_stops);
     RUN(one_layer_is_todays_collider);
     RUN(facing_cameras_tie_to_the_one_outside_the_surface);
     RUN(ownership_ties_go_to_the_view_outside_the_surface);

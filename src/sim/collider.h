@@ -77,6 +77,13 @@ typedef struct wx_collider_camera {
     int level_height[WX_COARSE_LEVELS];
     int level_offset[WX_COARSE_LEVELS];
     float *coarse;
+    /// Per texel, the least first-crossing depth over the 3 x 3 texels around
+    /// it (every texel a swept test reads for a point in that texel), lowered
+    /// by the pyramid's rounding margin and, where one of those texels holds a
+    /// sheet seen from behind (whose slab starts a sheet in front of its
+    /// crossing), by a sheet: a segment in front of it over each texel it
+    /// crosses is free for this camera (wx_collider_fine_clear).
+    float *near3;
     /// No texel on the map's border records a surface: the model lies inside
     /// this camera's frame, so outside the frame it sees no surface, as over a
     /// texel with none, and a point there does not collide (docs/physics.md,
@@ -165,6 +172,14 @@ uint32_t wx_collider_coarse_block(const wx_collider *collider, const int *cams, 
 
 /// The coarse test of one segment: true when it certainly does not collide.
 bool wx_collider_coarse_clear(const wx_collider *collider, const float p0[3], const float p1[3]);
+
+/// The fine test of one segment, for segments the coarse test leaves: walks
+/// each camera's texels along the segment's projection and returns true when
+/// one camera sees the whole segment inside its frame and in front of `near3`
+/// over every texel it crosses. Then the swept test finds no hit (that camera
+/// says "in front" everywhere), so it need not run; it never clears a segment
+/// the swept test would stop (docs/masks.md, "Marching").
+bool wx_collider_fine_clear(const wx_collider *collider, const float p0[3], const float p1[3]);
 
 /// Asks the memory system for the depth texels a swept test near p will read
 /// (a hint: it changes no result).

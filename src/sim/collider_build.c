@@ -131,6 +131,62 @@ static wx_result build_coarse(wx_collider_camera *cam, wx_error *err)
         }
     }
     free(blockmin);
+    // The fine test's bound: the 3 x 3 minimum of the first crossings, in rows
+    // (the minimum over three columns, then over three rows). A solid starts
+    // at a crossing, every crossing of a texel lies at or behind its first, and
+    // a cell's bilinear depth lies between its corners'; only a sheet seen from
+    // behind starts in front of its crossing, by one sheet: where some texel of
+    // the 3 x 3 holds one (in any layer), the bound is a sheet nearer.
+    size_t texels = (size_t)W * (size_t)H;
+    cam->near3 = wx_big_malloc(texels * sizeof *cam->near3);
+    float *across = wx_big_malloc(texels * sizeof *across);
+    unsigned char *sheet = wx_big_calloc(texels, 1), *sheet_across = wx_big_calloc(texels, 1);
+    if (cam->near3 == NULL || across == NULL || sheet == NULL || sheet_across == NULL) {
+        free(across);
+        free(sheet);
+        free(sheet_across);
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (collider pyramid)");
+    }
+    for (size_t at = 0; cam->layers > 1 && at < (size_t)cam->layers * texels; ++at) {
+        uint8_t role = cam->role[at];
+        if ((role & WX_ROLE_KIND) == WX_ROLE_SHEET && !(role & WX_ROLE_FACING)) {
+            sheet[at % texels] = 1;
+        }
+    }
+    for (int j = 0; j < H; ++j) {
+        size_t r = (size_t)j * (size_t)W;
+        const float *row = cam->depth + r;
+        for (int i = 0; i < W; ++i) {
+            float m = row[i];
+            m = i > 0 && row[i - 1] < m ? row[i - 1] : m;
+            m = i + 1 < W && row[i + 1] < m ? row[i + 1] : m;
+            across[r + (size_t)i] = m;
+            sheet_across[r + (size_t)i] =
+                (unsigned char)(sheet[r + (size_t)i] | (i > 0 ? sheet[r + (size_t)i - 1] : 0) |
+                                (i + 1 < W ? sheet[r + (size_t)i + 1] : 0));
+        }
+    }
+    for (int j = 0; j < H; ++j) {
+        for (int i = 0; i < W; ++i) {
+            size_t at = (size_t)j * (size_t)W + (size_t)i;
+            float m = across[at];
+            bool behind_sheet = sheet_across[at] != 0;
+            for (int y = j - 1; y <= j + 1; y += 2) {
+                size_t other = (size_t)y * (size_t)W + (size_t)i;
+                if (y >= 0 && y < H) {
+                    m = across[other] < m ? across[other] : m;
+                    behind_sheet |= sheet_across[other] != 0;
+                }
+            }
+            if (isfinite(m)) {
+                m = (float)(m - margin_base - 1e-6 * fabs(m) - (behind_sheet ? cam->sheet : 0.0));
+            }
+            cam->near3[at] = m;
+        }
+    }
+    free(across);
+    free(sheet);
+    free(sheet_across);
     return WX_OK;
 }
 
@@ -407,6 +463,7 @@ void wx_collider_free(wx_collider *collider)
         free(collider->cameras[c].role);
         free(collider->cameras[c].origin);
         free(collider->cameras[c].coarse);
+        free(collider->cameras[c].near3);
     }
     free(collider->cameras);
     memset(collider, 0, sizeof *collider);

@@ -177,6 +177,75 @@ bool wx_collider_coarse_clear(const wx_collider *collider, const float p0[3], co
     return outside || collider->camera_count == 0;
 }
 
+// --- the fine test ----------------------------------------------------------------
+
+// Whether camera `cam` sees the segment p0 + s d, s in [0, 1], inside its frame
+// and in front of near3 over each texel it crosses: a walk over the texels of
+// its projection, each compared with the segment's farthest depth over the
+// part that crosses it. The projection is the swept test's (march_init: the
+// float ends in double). Every half-texel cell of a point in texel T reads
+// texels within one of T (the bilinear cell's corners, the texel's own), and
+// a point that rounding puts across a texel's edge lies in a half cell that
+// reads T and its neighbour, so T's 3 x 3 minimum bounds every crossing the
+// swept test meets there.
+static bool camera_clears(const wx_collider_camera *cam, const double p[3], const double d[3])
+{
+    const double margin = 1.0 / 64.0; // texels kept from the frame edge, as coarse_lane
+    double W = cam->width, H = cam->height;
+    double X0 = p[0] * cam->mx[0] + p[1] * cam->mx[1] + p[2] * cam->mx[2] + cam->mx[3];
+    double Y0 = p[0] * cam->my[0] + p[1] * cam->my[1] + p[2] * cam->my[2] + cam->my[3];
+    double D0 = p[0] * cam->md[0] + p[1] * cam->md[1] + p[2] * cam->md[2] + cam->md[3];
+    double dX = d[0] * cam->mx[0] + d[1] * cam->mx[1] + d[2] * cam->mx[2];
+    double dY = d[0] * cam->my[0] + d[1] * cam->my[1] + d[2] * cam->my[2];
+    double dD = d[0] * cam->md[0] + d[1] * cam->md[1] + d[2] * cam->md[2];
+    double X1 = X0 + dX, Y1 = Y0 + dY;
+    if (!(X0 >= margin && X0 < W - margin && Y0 >= margin && Y0 < H - margin && X1 >= margin &&
+          X1 < W - margin && Y1 >= margin && Y1 < H - margin)) {
+        return false;
+    }
+    int i = (int)X0, j = (int)Y0;
+    int si = dX > 0.0 ? 1 : -1, sj = dY > 0.0 ? 1 : -1;
+    double rx = dX != 0.0 ? 1.0 / fabs(dX) : INFINITY, ry = dY != 0.0 ? 1.0 / fabs(dY) : INFINITY;
+    double tx = dX > 0.0 ? (i + 1 - X0) * rx : dX < 0.0 ? (X0 - i) * rx : INFINITY;
+    double ty = dY > 0.0 ? (j + 1 - Y0) * ry : dY < 0.0 ? (Y0 - j) * ry : INFINITY;
+    int steps = abs((int)X1 - i) + abs((int)Y1 - j) + 2;
+    double s = 0.0;
+    for (int n = 0; n <= steps; ++n) {
+        double next = tx < ty ? tx : ty;
+        next = next < 1.0 ? next : 1.0;
+        double da = D0 + s * dD, db = D0 + next * dD;
+        double far = da > db ? da : db;
+        if (i < 0 || i >= cam->width || j < 0 || j >= cam->height ||
+            !(far < cam->near3[(size_t)j * (size_t)cam->width + (size_t)i])) {
+            return false;
+        }
+        if (next >= 1.0) {
+            return true;
+        }
+        if (tx <= ty) {
+            i += si;
+            tx += rx;
+        } else {
+            j += sj;
+            ty += ry;
+        }
+        s = next;
+    }
+    return false; // (rounding kept the walk from its end: the swept test decides)
+}
+
+bool wx_collider_fine_clear(const wx_collider *collider, const float p0[3], const float p1[3])
+{
+    double p[3] = { p0[0], p0[1], p0[2] };
+    double d[3] = { (double)p1[0] - p0[0], (double)p1[1] - p0[1], (double)p1[2] - p0[2] };
+    for (int c = 0; c < collider->camera_count; ++c) {
+        if (camera_clears(&collider->cameras[c], p, d)) {
+            return true;
+        }
+    }
+    return false;
+}
+
 void wx_collider_prefetch(const wx_collider *collider, const float p[3])
 {
     for (int c = 0; c < collider->camera_count; ++c) {

@@ -151,9 +151,12 @@ static bool segment_free(const wx_collider *collider, const double a[3], const d
 static bool segment_past_coarse(const wx_collider *collider, const double a[3], const double b[3],
                                 double length, double finest)
 {
+    float fa[3] = { (float)a[0], (float)a[1], (float)a[2] };
+    float fb[3] = { (float)b[0], (float)b[1], (float)b[2] };
+    if (wx_collider_fine_clear(collider, fa, fb)) {
+        return true; // some camera sees it in front over each texel it crosses
+    }
     if (length <= finest) {
-        float fa[3] = { (float)a[0], (float)a[1], (float)a[2] };
-        float fb[3] = { (float)b[0], (float)b[1], (float)b[2] };
         wx_hit hit;
         return !wx_collider_sweep(collider, fa, fb, &hit);
     }
