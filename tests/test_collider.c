@@ -26,6 +26,15 @@ static bool build(wx_collider *col, const wx_camera *cams, wx_maps *maps, int co
     return wx_collider_init(col, cams, maps, count, nearest, &err) == WX_OK;
 }
 
+// n uniform numbers in [0, 1) from the test's own sequence.
+static void uniforms(uint64_t *state, float *r, int n)
+{
+    for (int q = 0; q < n; ++q) {
+        *state = wx_mix64(*state + 1);
+        r[q] = (float)((*state >> 11) * (1.0 / 9007199254740992.0));
+    }
+}
+
 static void release(wx_collider *col, wx_maps *maps, int count)
 {
     wx_collider_free(col);
@@ -356,10 +365,7 @@ TEST(coarse_test_is_conservative_and_put_back_is_outside)
         float x1[WX_PARTICLE_BLOCK], y1[WX_PARTICLE_BLOCK], z1[WX_PARTICLE_BLOCK];
         for (int k = 0; k < WX_PARTICLE_BLOCK; ++k) {
             float r[6];
-            for (int q = 0; q < 6; ++q) {
-                state = wx_mix64(state + 1);
-                r[q] = (float)((state >> 11) * (1.0 / 9007199254740992.0));
-            }
+            uniforms(&state, r, 6);
             float len = (k % 4 == 0) ? 2.0f : 0.2f; // a few long ones
             x0[k] = -3.4f + 6.8f * r[0];
             y0[k] = -2.4f + 5.0f * r[1];
@@ -730,10 +736,7 @@ TEST(layered_sweep_agrees_with_the_point_rule)
     int phantom = 0;
     for (int i = 0; i < 40000; ++i) {
         float r[6];
-        for (int q = 0; q < 6; ++q) {
-            state = wx_mix64(state + 1);
-            r[q] = (float)((state >> 11) * (1.0 / 9007199254740992.0));
-        }
+        uniforms(&state, r, 6);
         float len = (i % 4 == 0) ? 2.0f : 0.3f;
         float p0[3] = { -3.2f + 6.4f * r[0], -0.5f + 3.0f * r[1], -3.2f + 6.4f * r[2] };
         float p1[3] = { p0[0] + len * (r[3] - 0.5f), p0[1] + len * (r[4] - 0.5f),
@@ -814,10 +817,7 @@ TEST(fine_test_never_clears_what_the_sweep_stops)
         int contradictions = 0, cleared = 0, near = 0, near_cleared = 0, near_free = 0;
         for (int i = 0; i < 50000; ++i) {
             float r[9];
-            for (int q = 0; q < 9; ++q) {
-                state = wx_mix64(state + 1);
-                r[q] = (float)((state >> 11) * (1.0 / 9007199254740992.0));
-            }
+            uniforms(&state, r, 9);
             float len = (i % 4 == 0) ? 2.0f : 0.3f;
             float p0[3] = { -3.2f + 6.4f * r[0], -0.5f + 3.0f * r[1], -3.2f + 6.4f * r[2] };
             if (i % 5 == 0) {
