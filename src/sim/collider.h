@@ -178,7 +178,7 @@ bool wx_collider_coarse_clear(const wx_collider *collider, const float p0[3], co
 /// one camera sees the whole segment inside its frame and in front of `near3`
 /// over every texel it crosses. Then the swept test finds no hit (that camera
 /// says "in front" everywhere), so it need not run; it never clears a segment
-/// the swept test would stop (docs/masks.md, "Marching").
+/// the swept test would stop (docs/physics.md, "Fine test").
 bool wx_collider_fine_clear(const wx_collider *collider, const float p0[3], const float p1[3]);
 
 /// Asks the memory system for the depth texels a swept test near p will read
