@@ -261,34 +261,35 @@ static bool camera_may_collide(const wx_collider *collider, int c, double X, dou
 
 bool wx_collider_point_collides(const wx_collider *collider, const float p[3])
 {
+    // p in every camera's texel space, once for both passes below (a collider
+    // holds at most WX_MAX_INPUT_CAMERAS cameras).
+    double X[WX_MAX_INPUT_CAMERAS], Y[WX_MAX_INPUT_CAMERAS], D[WX_MAX_INPUT_CAMERAS];
+    bool inside[WX_MAX_INPUT_CAMERAS];
     // First the cheap bound: a camera that sees p in front of its texel's
     // near3 says "in front" (near3 bounds every crossing the rule below reads
     // there), and one such camera frees the point.
     for (int c = 0; c < collider->camera_count; ++c) {
         const wx_collider_camera *cam = &collider->cameras[c];
-        double X = p[0] * cam->mx[0] + p[1] * cam->mx[1] + p[2] * cam->mx[2] + cam->mx[3];
-        double Y = p[0] * cam->my[0] + p[1] * cam->my[1] + p[2] * cam->my[2] + cam->my[3];
-        if (X >= 0.0 && X < cam->width && Y >= 0.0 && Y < cam->height) {
-            double D = p[0] * cam->md[0] + p[1] * cam->md[1] + p[2] * cam->md[2] + cam->md[3];
-            if (D < cam->near3[(size_t)(int)Y * (size_t)cam->width + (size_t)(int)X]) {
-                return false;
-            }
+        X[c] = p[0] * cam->mx[0] + p[1] * cam->mx[1] + p[2] * cam->mx[2] + cam->mx[3];
+        Y[c] = p[0] * cam->my[0] + p[1] * cam->my[1] + p[2] * cam->my[2] + cam->my[3];
+        D[c] = p[0] * cam->md[0] + p[1] * cam->md[1] + p[2] * cam->md[2] + cam->md[3];
+        inside[c] = X[c] >= 0.0 && X[c] < cam->width && Y[c] >= 0.0 && Y[c] < cam->height;
+        if (inside[c] &&
+            D[c] < cam->near3[(size_t)(int)Y[c] * (size_t)cam->width + (size_t)(int)X[c]]) {
+            return false;
         }
     }
     bool informed = false;
     for (int c = 0; c < collider->camera_count; ++c) {
         const wx_collider_camera *cam = &collider->cameras[c];
-        double X = p[0] * cam->mx[0] + p[1] * cam->mx[1] + p[2] * cam->mx[2] + cam->mx[3];
-        double Y = p[0] * cam->my[0] + p[1] * cam->my[1] + p[2] * cam->my[2] + cam->my[3];
-        double D = p[0] * cam->md[0] + p[1] * cam->md[1] + p[2] * cam->md[2] + cam->md[3];
-        if (!(X >= 0.0 && X < cam->width && Y >= 0.0 && Y < cam->height)) {
+        if (!inside[c]) {
             if (cam->frames_model) {
                 return false; // the whole model is inside this frame, p is not
             }
             continue; // no information
         }
         informed = true;
-        if (!camera_may_collide(collider, c, X, Y, D)) {
+        if (!camera_may_collide(collider, c, X[c], Y[c], D[c])) {
             return false; // this camera sees the point in front (or no surface)
         }
     }

@@ -177,38 +177,14 @@ static bool segment_free(const wx_collider *collider, const double a[3], const d
            segment_past_coarse(collider, a, b, length, finest);
 }
 
-// True when the ray from p along unit dir travels `length` without entering a
-// surface the collider records: cut at the last camera frame it crosses, then
-// in segments of doubling length (segment_free).
-static bool ray_free(const wx_collider *collider, const double p[3], const double dir[3],
-                     double length, double first)
-{
-    if (collider == NULL) {
-        return true;
-    }
-    length = frames_exit(collider, p, dir, length);
-    double t0 = 0.0, step = first;
-    while (t0 < length) {
-        double t1 = min_of(length, t0 + step);
-        double a[3], b[3];
-        for (int k = 0; k < 3; ++k) {
-            a[k] = p[k] + dir[k] * t0;
-            b[k] = p[k] + dir[k] * t1;
-        }
-        if (!segment_free(collider, a, b, t1 - t0, first)) {
-            return false;
-        }
-        t0 = t1;
-        step *= 2.0;
-    }
-    return true;
-}
-
-// ray_free for up to RAY_BLOCK rays at once (lanes `active`; ray k from
-// start[k] along dir[k] for length[k]): their segments of doubling length go
-// side by side through the collider's vectorised coarse test, and a segment it
-// cannot clear is cut and swept as segment_free does. The segments, and so the
-// answers, are ray_free's ray by ray. Returns the lanes whose rays are free.
+// Which of up to RAY_BLOCK rays (lanes `active`; ray k from start[k] along
+// unit dir[k] for length[k]) travel their length without entering a surface
+// the collider records. Each ray is cut at the last camera frame it crosses,
+// then walked in segments of doubling length from `first`; the rays' segments
+// go side by side through the collider's vectorised coarse test, and a segment
+// it cannot clear is cut and swept as segment_free does. Each ray's answer
+// is its own, whichever rays share the block. Returns the lanes whose rays are
+// free.
 enum { RAY_BLOCK = WX_PARTICLE_BLOCK };
 static uint32_t rays_free(const wx_collider *collider, uint32_t active, double start[RAY_BLOCK][3],
                           double dir[RAY_BLOCK][3], const double length[RAY_BLOCK], double first)
@@ -417,19 +393,28 @@ static float accessibility(const job *jb, const wx_mask_def *m, size_t t, const 
 
 static float exposure(const job *jb, const double p[3], const float n[3])
 {
-    double start[3], sum = 0.0;
+    // The suns' rays side by side (at most 3 of the RAY_BLOCK lanes).
+    double start[RAY_BLOCK][3], dir[RAY_BLOCK][3], length[RAY_BLOCK], cosine[RAY_BLOCK];
+    uint32_t active = 0;
     for (int s = 0; s < jb->sun_count; ++s) {
         const double *sun = jb->suns[s];
         double c = n[0] * sun[0] + n[1] * sun[1] + n[2] * sun[2];
         if (!(c > 0.0) || jb->sun_weights[s] == 0.0) {
             continue;
         }
-        if (ray_start(jb, p, n, sun, start) < 0.0) {
+        memcpy(dir[s], sun, sizeof dir[s]);
+        if (ray_start(jb, p, n, sun, start[s]) < 0.0) {
             continue; // inside what the maps record: no light
         }
-        double length = box_exit(jb->def->scene, start, sun);
-        if (ray_free(jb->def->collider, start, sun, length, jb->first)) {
-            sum += jb->sun_weights[s] * c;
+        length[s] = box_exit(jb->def->scene, start[s], sun);
+        cosine[s] = c;
+        active |= 1u << s;
+    }
+    uint32_t lit = rays_free(jb->def->collider, active, start, dir, length, jb->first);
+    double sum = 0.0;
+    for (int s = 0; s < jb->sun_count; ++s) {
+        if ((lit >> s) & 1u) {
+            sum += jb->sun_weights[s] * cosine[s];
         }
     }
     return (float)fmin(1.0, fmax(0.0, sum));
