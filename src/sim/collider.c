@@ -250,7 +250,8 @@ double wx_collider_depth_at(const wx_collider *collider, int c, double X, double
 
 // Camera c's answer for a point (X, Y, D) inside its frame: it may collide
 // (behind its surface, or inside one of its solid intervals with layers).
-static bool camera_may_collide(const wx_collider *collider, int c, double X, double Y, double D)
+bool wx_collider_camera_may_collide(const wx_collider *collider, int c, double X, double Y,
+                                    double D)
 {
     const wx_collider_camera *cam = &collider->cameras[c];
     if (cam->layers > 1) {
@@ -289,7 +290,7 @@ bool wx_collider_point_collides(const wx_collider *collider, const float p[3])
             continue; // no information
         }
         informed = true;
-        if (!camera_may_collide(collider, c, X[c], Y[c], D[c])) {
+        if (!wx_collider_camera_may_collide(collider, c, X[c], Y[c], D[c])) {
             return false; // this camera sees the point in front (or no surface)
         }
     }
@@ -717,10 +718,15 @@ static int pick_camera(const wx_collider *collider, const march *m, double s)
                 continue;
             }
             layer_face face = hit_face(&m[c], s);
+            if (m[c].role[face.layer] & WX_ROLE_FILL) {
+                continue; // a fill is no surface
+            }
             f = face.dist;
             in_maps = maps_index(cam, face.layer, texel);
             texel += (size_t)face.layer * (size_t)cam->width * (size_t)cam->height;
             face_depth = face.offset;
+        } else if (cam->fill != NULL && cam->fill[texel]) {
+            continue;
         }
         if (closest < 0 || f < closest_f) {
             closest = c;
@@ -774,7 +780,7 @@ static bool camera_sees_in_front(const wx_collider *collider, const wx_collider_
         return false;
     }
     int c = (int)(cam - collider->cameras);
-    return !camera_may_collide(collider, c, X, Y, D);
+    return !wx_collider_camera_may_collide(collider, c, X, Y, D);
 }
 
 // Where the particle goes back after a hit at s, validated by the point rule:

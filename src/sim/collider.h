@@ -89,6 +89,13 @@ typedef struct wx_collider_camera {
     /// texel with none, and a point there does not collide (docs/physics.md,
     /// "Cameras that frame the model").
     bool frames_model;
+    /// Fills (docs/physics.md, "Surfaces a camera sees edge-on"): where this
+    /// camera missed a surface another records, solid over that stretch of its
+    /// ray and no surface. With one layer fill[t] marks a texel whose depth is
+    /// such a fill (NULL when there is none); with layers the role's
+    /// WX_ROLE_FILL bit does. fill_texels counts the texels that got one.
+    uint8_t *fill;
+    int64_t fill_texels;
 } wx_collider_camera;
 
 typedef struct wx_collider {

@@ -437,6 +437,11 @@ wx_result wx_collider_init(wx_collider *collider, const wx_camera *cameras, cons
             widen_crossings(collider, (const double(*)[3])axes, &collider->cameras[c]);
         }
     }
+    wx_result filled = wx_collider_fill_missed(collider, (const double(*)[3])axes, err);
+    if (filled != WX_OK) {
+        wx_collider_free(collider);
+        return filled;
+    }
     for (int c = 0; c < count; ++c) {
         wx_result r = build_coarse(&collider->cameras[c], err);
         if (r != WX_OK) {
@@ -464,6 +469,7 @@ void wx_collider_free(wx_collider *collider)
         free(collider->cameras[c].origin);
         free(collider->cameras[c].coarse);
         free(collider->cameras[c].near3);
+        free(collider->cameras[c].fill);
     }
     free(collider->cameras);
     memset(collider, 0, sizeof *collider);
