@@ -179,13 +179,22 @@ static void camera(text *t, const char *name, const double c[3], const double ax
 // complexity along it (wx_mesh_depth_complexity over a LAYER_GRID lattice),
 // at least 1 and at most INIT_LAYERS. A convex closed mesh needs 2 (its front
 // and its back, so the space behind it is free); a house with a roof overhang
-// and sills 4 or more.
+// and sills 4 or more. An odd count means a ray crosses a one-sided sheet (a
+// sign, a pane): one layer more, so that the last layer stays empty where it
+// does and the collider reads the sheet as a thin slab; with every layer full
+// it reads "solid behind", and two cameras facing a sheet from its two sides
+// then agree on its plane alone, which the rain passes through
+// (docs/cameras.md, "Layers").
 enum { INIT_LAYERS = 4, LAYER_GRID = 128 };
 
 static int init_layers(const wx_mesh_data *mesh, const double axis[3])
 {
     int k = wx_mesh_depth_complexity(mesh, axis, LAYER_GRID);
-    return k < 1 ? (k < 0 ? INIT_LAYERS : 1) : k > INIT_LAYERS ? INIT_LAYERS : k;
+    if (k < 1) {
+        return k < 0 ? INIT_LAYERS : 1;
+    }
+    k += k % 2;
+    return k > INIT_LAYERS ? INIT_LAYERS : k;
 }
 
 // ---------------------------------------------------------------------------
