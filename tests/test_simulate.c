@@ -490,9 +490,11 @@ TEST(same_output_bytes_for_1_2_and_4_threads)
 // The dirt maps the two produce are the same bytes.
 TEST(pinned_determinism_hash)
 {
-    const uint64_t EXPECTED_FUSED = 0xf56c50c4f810e9adull; // issue 25: cameras framing the model vouch outside
-    const uint64_t EXPECTED_UNFUSED = 0xd62af3ecefa53ad9ull;
-    const uint64_t EXPECTED_DIRT_MAPS = 0xad927048e0f0b410ull; // issue 25: cameras framing the model vouch outside
+    // Since the collider's fills (docs/physics.md, "Surfaces a camera sees
+    // edge-on"): a camera no longer cuts into a face it sees edge-on.
+    const uint64_t EXPECTED_FUSED = 0xfd4c3a406c6487dfull;
+    const uint64_t EXPECTED_UNFUSED = 0x1df98c6a2b2a41a5ull;
+    const uint64_t EXPECTED_DIRT_MAPS = 0x2f359c1f410a4904ull;
     bool fused = wx_kernels_fuse_multiply_add();
     uint64_t files[2], state[2];
     wx_sim_stats st[2];

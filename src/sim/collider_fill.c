@@ -14,12 +14,17 @@
 // that surface at a grazing angle (|n . axis_B| small) and says "not behind"
 // just inside it (p - n * a quarter of A's texel), while none of B's crossings
 // over the 3 x 3 texels around lies near p, does not know the surface is
-// there. B then stops vetoing over that stretch of its ray: its texel gets a
-// *fill*, a solid interval around p's depth (half a texel of either camera
-// wider, so that the fills of neighbouring samples join), and the other
-// cameras, which see the surface, decide where a particle meets it. A fill is
-// not a surface: it never gives a hit (pick_camera skips it), so its texel's
-// normal, impact and dirt stay unread.
+// there. The same holds along B's silhouette: where the surface lies between
+// two texel centres of B, the texel outside holds nothing, and B cut a
+// staircase of up to a texel into the solid, which turns with the model in
+// the camera grid (a closed cylinder lined up with the side cameras: its
+// flanks took 11% more rain than turned 30 degrees, against 1.2% between two
+// seeds). B then stops vetoing over that stretch of its ray: its texels
+// around get a *fill*, a solid interval around p's depth (half a texel of
+// either camera wider, so that the fills of neighbouring samples join), and
+// the other cameras, which see the surface, decide where a particle meets
+// it. A fill is not a surface: it never gives a hit (pick_camera skips it),
+// so its texel's normal, impact and dirt stay unread.
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -102,28 +107,6 @@ static bool deep_inside(const wx_collider_camera *B, size_t t, double D, double 
         if (kind == WX_ROLE_ENTER && k + 1 < B->layers && D > d + tol &&
             D < (double)B->depth[at + texels] - tol) {
             return true;
-        }
-    }
-    return false;
-}
-
-// Whether camera b says "may collide" at depth D over the point's texel or one
-// of the 8 around it: then its solid reaches within a texel of the surface
-// (a box's face between two texel centres: the next texel in is solid), its
-// precision there, not a surface it missed.
-static bool solid_near(const wx_collider *collider, int b, double X, double Y, double D)
-{
-    const wx_collider_camera *B = &collider->cameras[b];
-    if (wx_collider_camera_may_collide(collider, b, X, Y, D)) {
-        return true; // the texel itself, first
-    }
-    for (int j = -1; j <= 1; ++j) {
-        for (int i = -1; i <= 1; ++i) {
-            double x = X + i, y = Y + j;
-            if (x >= 0.0 && x < B->width && y >= 0.0 && y < B->height &&
-                wx_collider_camera_may_collide(collider, b, x, y, D)) {
-                return true;
-            }
         }
     }
     return false;
@@ -227,7 +210,8 @@ static void find_range(int64_t begin, int64_t end, int worker, void *context)
                                  (double)B->back[2] * B->back[2]);
                 double tol = 2.0 * fmax(A->texel_ws, B->texel_ws) / bl;
                 if (deep_inside(B, (size_t)(int)Y * (size_t)B->width + (size_t)(int)X, D, tol) ||
-                    solid_near(collider, b, X, Y, D) || records_near(B, (int)X, (int)Y, D, tol)) {
+                    wx_collider_camera_may_collide(collider, b, X, Y, D) ||
+                    records_near(B, (int)X, (int)Y, D, tol)) {
                     continue;
                 }
                 push_record(list, (fill_record){ b, (float)X, (float)Y, (float)D });
