@@ -700,7 +700,7 @@ static double march_entry(const wx_collider *collider, march *m, double s)
 
 static int pick_camera(const wx_collider *collider, const march *m, double s)
 {
-    int best = -1, closest = -1;
+    int best = -1, closest = -1, filled = -1;
     double best_cos = -1.0, closest_f = INFINITY;
     bool best_facing = true;
     for (int c = 0; c < collider->camera_count; ++c) {
@@ -719,6 +719,7 @@ static int pick_camera(const wx_collider *collider, const march *m, double s)
             }
             layer_face face = hit_face(&m[c], s);
             if (m[c].role[face.layer] & WX_ROLE_FILL) {
+                filled = filled < 0 ? c : filled;
                 continue; // a fill is no surface
             }
             f = face.dist;
@@ -726,6 +727,7 @@ static int pick_camera(const wx_collider *collider, const march *m, double s)
             texel += (size_t)face.layer * (size_t)cam->width * (size_t)cam->height;
             face_depth = face.offset;
         } else if (cam->fill != NULL && cam->fill[texel]) {
+            filled = filled < 0 ? c : filled;
             continue;
         }
         if (closest < 0 || f < closest_f) {
@@ -765,7 +767,9 @@ static int pick_camera(const wx_collider *collider, const march *m, double s)
             best_facing = facing;
         }
     }
-    return best >= 0 ? best : closest;
+    // Where every camera that agrees holds only a fill (a solid's edge on the
+    // silhouettes of all of them), the first of them: the hit faces its camera.
+    return best >= 0 ? best : closest >= 0 ? closest : filled;
 }
 
 // True when camera `cam` sees p inside its frame and in front of its surface (or

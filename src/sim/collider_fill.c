@@ -23,8 +23,9 @@
 // around get a *fill*, a solid interval around p's depth (half a texel of
 // either camera wider, so that the fills of neighbouring samples join), and
 // the other cameras, which see the surface, decide where a particle meets
-// it. A fill is not a surface: it never gives a hit (pick_camera skips it),
-// so its texel's normal, impact and dirt stay unread.
+// it. A fill is not a surface: it gives no hit (pick_camera skips it, but
+// where every camera that agrees holds only a fill), so its texel's normal,
+// impact and dirt stay unread.
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -38,10 +39,14 @@
 #define FILL_GRAZING 0.3
 /// Only a camera that sees the surface at a cosine of at least this vouches for it.
 #define FILL_WITNESS 0.5
+/// Two crossings whose normals meet at a cosine of at least this are one surface.
+#define SAME_SURFACE 0.7
 
 // The fills found for one camera: per texel, whether it has one and its
 // interval. Zeroed pages that are never written stay unmapped, so the three
 // planes cost memory only where fills are (wx_big_calloc).
+enum { FILL_AROUND = 1, FILL_OWN = 2 }; ///< a span's set: a sample's texel, or one around
+
 typedef struct fill_span {
     uint8_t *set; ///< NULL until a fill is needed
     float *lo, *hi;
@@ -59,9 +64,13 @@ static bool texel_to_world(const double inv[9], const wx_collider_camera *cam, d
 }
 
 // Whether some crossing of camera B over the 3 x 3 texels around (tx, ty)
-// lies within `tol` of depth D: then B records this surface (a texel off at
-// most, its silhouette), and what it says there is its precision, not a miss.
-static bool records_near(const wx_collider_camera *B, int tx, int ty, double D, double tol)
+// lies within `tol` of depth D on a surface facing the way of the sample's
+// (unit normal n, either sign: a one-layer map's normals face its camera):
+// then B records this surface (a texel off at most), and what it says there
+// is its precision, not a miss. Another surface there (the top of a box whose
+// side B sees edge-on) does not count.
+static bool records_near(const wx_collider_camera *B, int tx, int ty, double D, double tol,
+                         const double n[3])
 {
     size_t texels = (size_t)B->width * (size_t)B->height;
     for (int j = ty - 1; j <= ty + 1; ++j) {
@@ -71,11 +80,19 @@ static bool records_near(const wx_collider_camera *B, int tx, int ty, double D, 
             }
             size_t t = (size_t)j * (size_t)B->width + (size_t)i;
             for (int k = 0; k < B->layers; ++k) {
-                float d = B->depth[(size_t)k * texels + t];
+                size_t at = (size_t)k * texels + t;
+                float d = B->depth[at];
                 if (!isfinite(d)) {
                     break;
                 }
-                if (fabs(d - D) <= tol) {
+                if (!(fabs(d - D) <= tol)) {
+                    continue;
+                }
+                size_t layer = B->layers > 1 ? B->origin[at] : 0;
+                const float *m = B->normal + 3 * (layer * texels + t);
+                double ml = sqrt((double)m[0] * m[0] + (double)m[1] * m[1] + (double)m[2] * m[2]);
+                if (ml > 1e-6 &&
+                    fabs(m[0] * n[0] + m[1] * n[1] + m[2] * n[2]) >= SAME_SURFACE * ml) {
                     return true;
                 }
             }
@@ -181,7 +198,7 @@ static void find_range(int64_t begin, int64_t end, int worker, void *context)
                 !(fabs(n[0] * aa[0] + n[1] * aa[1] + n[2] * aa[2]) >= FILL_WITNESS * nl)) {
                 continue;
             }
-            double p[3];
+            double p[3], unit[3] = { n[0] / nl, n[1] / nl, n[2] / nl };
             bool placed = false;
             for (int b = 0; b < collider->camera_count; ++b) {
                 const double *ax = job->axes[b];
@@ -211,7 +228,7 @@ static void find_range(int64_t begin, int64_t end, int worker, void *context)
                 double tol = 2.0 * fmax(A->texel_ws, B->texel_ws) / bl;
                 if (deep_inside(B, (size_t)(int)Y * (size_t)B->width + (size_t)(int)X, D, tol) ||
                     wx_collider_camera_may_collide(collider, b, X, Y, D) ||
-                    records_near(B, (int)X, (int)Y, D, tol)) {
+                    records_near(B, (int)X, (int)Y, D, tol, unit)) {
                     continue;
                 }
                 push_record(list, (fill_record){ b, (float)X, (float)Y, (float)D });
@@ -245,10 +262,17 @@ static bool spread_record(const wx_collider *collider, int a, const fill_record 
             if (i < 0 || j < 0 || i >= B->width || j >= B->height) {
                 continue;
             }
+            bool own = i == (int)r->X && j == (int)r->Y;
+            // A texel around that is solid there already needs none (a face
+            // between two texel centres: the texel inside holds the solid,
+            // and a fill there would only hide its free space further on).
+            if (!own && wx_collider_camera_may_collide(collider, r->b, i + 0.5, j + 0.5, r->D)) {
+                continue;
+            }
             size_t bt = (size_t)j * (size_t)B->width + (size_t)i;
             span->lo[bt] = span->set[bt] ? fminf(span->lo[bt], lo) : lo;
             span->hi[bt] = span->set[bt] ? fmaxf(span->hi[bt], hi) : hi;
-            span->set[bt] = 1;
+            span->set[bt] |= own ? FILL_OWN : FILL_AROUND;
         }
     }
     return true;
@@ -268,7 +292,7 @@ static void apply_one_layer(wx_collider_camera *B, size_t t, float lo)
 // A camera with layers: the fill goes into the texel's outline as an interval
 // of its own (ENTER and LEAVE marked FILL) where it lies between the texel's
 // solids; without two free layers, solid from its start on (TAIL).
-static void apply_layers(wx_collider_camera *B, size_t t, float lo, float hi)
+static void apply_layers(wx_collider_camera *B, size_t t, float lo, float hi, bool own)
 {
     int K = B->layers;
     size_t texels = (size_t)B->width * (size_t)B->height;
@@ -314,7 +338,7 @@ static void apply_layers(wx_collider_camera *B, size_t t, float lo, float hi)
         role[j + 1] = WX_ROLE_LEAVE | WX_ROLE_FILL;
         origin[j] = origin[j + 1] = 0;
         n += 2;
-    } else if (j < K) {
+    } else if (j < K && own) {
         depth[j] = lo;
         role[j] = WX_ROLE_TAIL | WX_ROLE_FACING | WX_ROLE_FILL;
         origin[j] = 0;
@@ -377,7 +401,8 @@ wx_result wx_collider_fill_missed(wx_collider *collider, const double (*axes)[3]
                 if (B->layers <= 1) {
                     apply_one_layer(B, t, spans[b].lo[t]);
                 } else {
-                    apply_layers(B, t, spans[b].lo[t], spans[b].hi[t]);
+                    apply_layers(B, t, spans[b].lo[t], spans[b].hi[t],
+                                 (spans[b].set[t] & FILL_OWN) != 0);
                 }
             }
         }
