@@ -1106,6 +1106,9 @@ TEST(edge_on_sign_stops_the_drops_through_it)
 // side cameras weathered 11% differently from one turned 30 degrees). Its fill
 // (docs/physics.md, "Surfaces a camera sees edge-on") leaves the face to the
 // front camera: every drop hits it at z = 0.03, with one layer and with four.
+// (Within two texels of the box's top, and with layers of its bottom, the top
+// camera records a surface, so it is trusted there and those 0.2 of the face
+// stay cut: the drops fly between.)
 TEST(a_face_on_a_silhouette_is_hit_where_it_is)
 {
     for (int layers = 1; layers <= 4; layers += 3) {
@@ -1121,7 +1124,7 @@ TEST(a_face_on_a_silhouette_is_hit_where_it_is)
         for (int q = 0; q < 200; ++q) {
             float r[2];
             uniforms(&state, r, 2);
-            float x = -0.9f + 1.8f * r[0], y = 0.1f + 0.8f * r[1];
+            float x = -0.9f + 1.8f * r[0], y = 0.25f + 0.5f * r[1];
             float p0[3] = { x, y, 0.5f }, p1[3] = { x, y, -0.5f };
             wx_hit hit;
             if (wx_collider_sweep(&col, p0, p1, &hit)) {
