@@ -24,7 +24,8 @@ enum {
     WX_ROLE_KIND = 7,
     WX_ROLE_FACING = 8,
     /// A fill (collider_fill.c): solid where the camera missed a surface
-    /// another camera records; no surface of its own, it never gives a hit.
+    /// another camera records; no surface of its own, it gives a hit only
+    /// where every camera that agrees holds a fill (pick_camera).
     WX_ROLE_FILL = 16,
 };
 
