@@ -137,9 +137,10 @@ typedef struct fill_list {
 typedef struct fill_job {
     const wx_collider *collider;
     const double (*axes)[3];
-    int a;            ///< the witness camera
-    double inv[9];    ///< its texel space to world (linear part)
-    fill_list *lists; ///< one per worker
+    int a;                                 ///< the witness camera
+    double inv[9];                         ///< its texel space to world (linear part)
+    double back_len[WX_MAX_INPUT_CAMERAS]; ///< |back| of every camera (d units per world unit)
+    fill_list *lists;                      ///< one per worker
 } fill_job;
 
 static void push_record(fill_list *list, fill_record r)
@@ -176,11 +177,6 @@ static void find_range(int64_t begin, int64_t end, int worker, void *context)
             if (!isfinite(d)) {
                 break; // the texel's later layers are empty too
             }
-            bool filled = A->layers > 1 ? (A->role[at] & WX_ROLE_FILL) != 0
-                                        : A->fill != NULL && A->fill[t] != 0;
-            if (filled) {
-                continue; // another camera's fill is no surface
-            }
             size_t layer = A->layers > 1 ? A->origin[at] : 0;
             const float *n = A->normal + 3 * (layer * texels + (size_t)t);
             double nl = sqrt((double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2]);
@@ -215,9 +211,7 @@ static void find_range(int64_t begin, int64_t end, int worker, void *context)
                 if (!(X >= 0.0 && X < B->width && Y >= 0.0 && Y < B->height)) {
                     continue;
                 }
-                double bl = sqrt((double)B->back[0] * B->back[0] + (double)B->back[1] * B->back[1] +
-                                 (double)B->back[2] * B->back[2]);
-                double tol = 2.0 * fmax(A->texel_ws, B->texel_ws) / bl;
+                double tol = 2.0 * fmax(A->texel_ws, B->texel_ws) / job->back_len[b];
                 if (deep_inside(B, (size_t)(int)Y * (size_t)B->width + (size_t)(int)X, D, tol) ||
                     wx_collider_camera_may_collide(collider, b, X, Y, D) ||
                     records_near(B, (int)X, (int)Y, D, tol)) {
@@ -355,15 +349,19 @@ wx_result wx_collider_fill_missed(wx_collider *collider, const double (*axes)[3]
     fill_list *lists = calloc((size_t)threads, sizeof *lists);
     bool ok = lists != NULL;
     // Every camera's samples against the maps as they are (no fill is applied
-    // before all are found, so the order does not matter), in parallel over
+    // before all are found, so no sample is a fill and the order does not matter), in parallel over
     // its texels; then each camera's fills.
     for (int a = 0; a < count && ok; ++a) {
         const wx_collider_camera *A = &collider->cameras[a];
-        fill_job job = { collider, axes, a, { 0 }, lists };
+        fill_job job = { .collider = collider, .axes = axes, .a = a, .lists = lists };
         double m3[9] = { A->mx[0], A->mx[1], A->mx[2], A->my[0], A->my[1],
                          A->my[2], A->md[0], A->md[1], A->md[2] };
         if (!wx_invert3(m3, job.inv)) {
             continue;
+        }
+        for (int b = 0; b < count; ++b) {
+            const float *v = collider->cameras[b].back;
+            job.back_len[b] = sqrt((double)v[0] * v[0] + (double)v[1] * v[1] + (double)v[2] * v[2]);
         }
         for (int w = 0; w < threads; ++w) {
             lists[w].count = 0;
