@@ -86,6 +86,16 @@ static bool cell_surface(const wx_collider *collider, const wx_collider_camera *
     if (!isfinite(d00) || !isfinite(d10) || !isfinite(d01) || !isfinite(d11)) {
         return true; // silhouette: the texel's own depth
     }
+    // A fill is no surface: its start blended with a face beside it would tilt
+    // the face into the solid (along a cube's edge, a sliver behind its side
+    // said "free" and drops fell through the corner of its top).
+    if (cam->fill != NULL) {
+        const uint8_t *fa = cam->fill + (size_t)ja * (size_t)W;
+        const uint8_t *fb = cam->fill + (size_t)jb * (size_t)W;
+        if ((fa[ia] | fa[ib] | fb[ia] | fb[ib]) != 0) {
+            return true;
+        }
+    }
     bilinear_cell(cd, i0, j0, d00, d10, d01, d11);
     return true;
 }
@@ -132,8 +142,8 @@ static void layer_cell(const wx_collider *collider, const wx_collider_camera *ca
                       (unsigned)(cam->role[ra + ib] ^ own_role) |
                       (unsigned)(cam->role[rb + ia] ^ own_role) |
                       (unsigned)(cam->role[rb + ib] ^ own_role);
-    if (differ & WX_ROLE_FACING) {
-        return;
+    if (differ & (WX_ROLE_FACING | WX_ROLE_FILL)) {
+        return; // nor between a fill and a surface (cell_surface)
     }
     // Nor across a jump from one surface to another that happen to be the
     // k-th crossing of neighbouring texels (a handrail's front and the glass
