@@ -487,20 +487,16 @@ TEST(same_output_bytes_for_1_2_and_4_threads)
 // as make sanitize and make tsan do not): one hash for each. The fused hash was
 // measured on an AVX-512 (x86-64-v4) machine; an AVX2-only machine runs the same
 // fused operations in narrower vectors and is expected, not yet seen, to match.
-// The dirt maps the two produce were the same bytes until a fill stopped
-// blending with the face beside it (docs/physics.md, "Surfaces a camera sees
-// edge-on"): the depth then steps there, and a last-bit difference in a
-// particle's path may put a hit in the texel beside. One hash for each too.
+// The dirt maps the two produce are the same bytes.
 TEST(pinned_determinism_hash)
 {
     // Since the collider's fills take every texel a surface seen edge-on clips
-    // and no bilinear cell mixes a fill with a surface: a camera no longer
-    // cuts into a face it sees edge-on, nor a sliver of one along its
-    // silhouette, nor a sliver beside a fill.
-    const uint64_t EXPECTED_FUSED = 0x698803ceaec6e7d1ull;
-    const uint64_t EXPECTED_UNFUSED = 0xcd8539f9d5fcb2f7ull;
-    const uint64_t EXPECTED_DIRT_MAPS_FUSED = 0x5229925bc72596a5ull;
-    const uint64_t EXPECTED_DIRT_MAPS_UNFUSED = 0x0d9e213a5381d05eull;
+    // and no bilinear cell mixes a fill with a surface (docs/physics.md,
+    // "Surfaces a camera sees edge-on"): a camera no longer cuts into a face
+    // it sees edge-on, nor a sliver of one along its silhouette.
+    const uint64_t EXPECTED_FUSED = 0x57ffb65eb5b65349ull;
+    const uint64_t EXPECTED_UNFUSED = 0x6d3ae694ac05a79bull;
+    const uint64_t EXPECTED_DIRT_MAPS = 0x5cdb7ba385e7eeb5ull;
     bool fused = wx_kernels_fuse_multiply_add();
     uint64_t files[2], state[2];
     wx_sim_stats st[2];
@@ -513,8 +509,7 @@ TEST(pinned_determinism_hash)
            (unsigned long long)files[0]);
     ENSURE(state[1] == state[0]);
     ENSURE(state[0] == (fused ? EXPECTED_FUSED : EXPECTED_UNFUSED));
-    uint64_t maps = fused ? EXPECTED_DIRT_MAPS_FUSED : EXPECTED_DIRT_MAPS_UNFUSED;
-    ENSURE(files[0] == maps && files[1] == maps);
+    ENSURE(files[0] == EXPECTED_DIRT_MAPS && files[1] == EXPECTED_DIRT_MAPS);
 }
 
 TEST(recent_hits_are_bounded_and_newest)

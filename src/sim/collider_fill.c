@@ -125,6 +125,7 @@ static bool deep_inside(const wx_collider_camera *B, size_t t, double D, double 
 typedef struct fill_record {
     int b;
     float X, Y, D;
+    bool clipped; ///< a texel the surface's plane clips: no spreading around it
 } fill_record;
 
 // What one worker found, in a list that grows.
@@ -240,9 +241,12 @@ static void find_cut_texels(const fill_job *job, int b, const double p_in[3], co
             if (i < 0 || j < 0 || i >= B->width || j >= B->height) {
                 continue;
             }
-            // The texel's corner deepest into the solid (n . (corner - p) least).
+            // The texel's corner deepest into the solid (n . (corner - p)
+            // least), and its centre outside: a texel whose centre lies inside
+            // holds the solid (B draws it), or p_in's test above finds it.
             double m = ((nx > 0.0 ? i : i + 1) - X) * nx + ((ny > 0.0 ? j : j + 1) - Y) * ny;
-            if (!(m < -cut)) {
+            double centre = (i + 0.5 - X) * nx + (j + 0.5 - Y) * ny;
+            if (!(m < -cut) || !(centre > 0.0)) {
                 continue;
             }
             size_t t = (size_t)j * (size_t)B->width + (size_t)i;
@@ -253,7 +257,8 @@ static void find_cut_texels(const fill_job *job, int b, const double p_in[3], co
                                     ((ny > 0.0 ? j : j + 1) - Y), b)) {
                 continue;
             }
-            push_record(list, (fill_record){ b, (float)(i + 0.5), (float)(j + 0.5), (float)D });
+            push_record(list,
+                        (fill_record){ b, (float)(i + 0.5), (float)(j + 0.5), (float)D, true });
         }
     }
 }
@@ -315,7 +320,7 @@ static void find_range(int64_t begin, int64_t end, int worker, void *context)
                 if (!(deep_inside(B, (size_t)(int)Y * (size_t)B->width + (size_t)(int)X, D, tol) ||
                       wx_collider_camera_may_collide(collider, b, X, Y, D) ||
                       records_near(B, (int)X, (int)Y, D, tol))) {
-                    push_record(list, (fill_record){ b, (float)X, (float)Y, (float)D });
+                    push_record(list, (fill_record){ b, (float)X, (float)Y, (float)D, false });
                 }
                 find_cut_texels(job, b, p, n, nl, list);
             }
@@ -343,8 +348,9 @@ static bool spread_record(const wx_collider *collider, int a, const fill_record 
                      (double)B->back[2] * B->back[2]);
     double grow = 0.5 * fmax(collider->cameras[a].texel_ws, B->texel_ws) / bl;
     float lo = (float)(r->D - grow), hi = (float)(r->D + grow);
-    for (int j = (int)r->Y - 1; j <= (int)r->Y + 1; ++j) {
-        for (int i = (int)r->X - 1; i <= (int)r->X + 1; ++i) {
+    int around = r->clipped ? 0 : 1; // the texels a plane clips are found one by one
+    for (int j = (int)r->Y - around; j <= (int)r->Y + around; ++j) {
+        for (int i = (int)r->X - around; i <= (int)r->X + around; ++i) {
             if (i < 0 || j < 0 || i >= B->width || j >= B->height) {
                 continue;
             }
