@@ -250,6 +250,12 @@ static void find_cut_texels(const fill_job *job, int b, const double p_in[3], co
                 continue;
             }
             size_t t = (size_t)j * (size_t)B->width + (size_t)i;
+            // With one layer a fill replaces the texel's depth: one that holds
+            // a surface further on (a facade behind a handrail's top) would
+            // lose it, and the dust that falls there went to another camera.
+            if (B->layers <= 1 && isfinite(B->depth[t])) {
+                continue;
+            }
             if (deep_inside(B, t, D, tol) ||
                 wx_collider_camera_may_collide(collider, b, i + 0.5, j + 0.5, D) ||
                 records_near(B, i, j, D, tol) ||
