@@ -61,6 +61,15 @@ static bool texel_to_world(const double inv[9], const wx_collider_camera *cam, d
     return isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]);
 }
 
+// Texel-space point (X, Y, D) of world point p in camera `cam`.
+static void world_to_texel(const wx_collider_camera *cam, const double p[3], double *X, double *Y,
+                           double *D)
+{
+    *X = p[0] * cam->mx[0] + p[1] * cam->mx[1] + p[2] * cam->mx[2] + cam->mx[3];
+    *Y = p[0] * cam->my[0] + p[1] * cam->my[1] + p[2] * cam->my[2] + cam->my[3];
+    *D = p[0] * cam->md[0] + p[1] * cam->md[1] + p[2] * cam->md[2] + cam->md[3];
+}
+
 // Whether some crossing of camera B over the 3 x 3 texels around (tx, ty)
 // lies within `tol` of depth D: then B records a surface there (this one, a
 // texel off at most, or one it meets: the top of a box whose side B sees
@@ -138,8 +147,8 @@ typedef struct fill_list {
 typedef struct fill_job {
     const wx_collider *collider;
     const double (*axes)[3];
-    int a;                                 ///< the witness camera
-    double inv[9];                         ///< its texel space to world (linear part)
+    int a;         ///< the witness camera
+    double inv[9]; ///< its texel space to world (linear part)
     /// World displacement of one texel along X and along Y of every camera, at
     /// a constant depth (the first two columns of its inverse).
     double step_x[WX_MAX_INPUT_CAMERAS][3], step_y[WX_MAX_INPUT_CAMERAS][3];
@@ -182,9 +191,8 @@ static bool witness_sees_plane(const fill_job *job, const double p[3], const flo
     for (int k = 0; k < 3; ++k) {
         c[k] -= h * n[k] / nl; // onto the plane
     }
-    double X = c[0] * A->mx[0] + c[1] * A->mx[1] + c[2] * A->mx[2] + A->mx[3];
-    double Y = c[0] * A->my[0] + c[1] * A->my[1] + c[2] * A->my[2] + A->my[3];
-    double D = c[0] * A->md[0] + c[1] * A->md[1] + c[2] * A->md[2] + A->md[3];
+    double X, Y, D;
+    world_to_texel(A, c, &X, &Y, &D);
     if (!(X >= 0.0 && X < A->width && Y >= 0.0 && Y < A->height)) {
         return false;
     }
@@ -227,9 +235,8 @@ static void find_cut_texels(const fill_job *job, int b, const double p_in[3], co
     // The surface itself, a quarter of A's texel out from p_in.
     double p[3] = { p_in[0] + inside * n[0] / nl, p_in[1] + inside * n[1] / nl,
                     p_in[2] + inside * n[2] / nl };
-    double X = p[0] * B->mx[0] + p[1] * B->mx[1] + p[2] * B->mx[2] + B->mx[3];
-    double Y = p[0] * B->my[0] + p[1] * B->my[1] + p[2] * B->my[2] + B->my[3];
-    double D = p[0] * B->md[0] + p[1] * B->md[1] + p[2] * B->md[2] + B->md[3];
+    double X, Y, D;
+    world_to_texel(B, p, &X, &Y, &D);
     if (!(X >= 0.0 && X < B->width && Y >= 0.0 && Y < B->height)) {
         return;
     }
@@ -244,7 +251,8 @@ static void find_cut_texels(const fill_job *job, int b, const double p_in[3], co
             // The texel's corner deepest into the solid (n . (corner - p)
             // least), and its centre outside: a texel whose centre lies inside
             // holds the solid (B draws it), or p_in's test above finds it.
-            double m = ((nx > 0.0 ? i : i + 1) - X) * nx + ((ny > 0.0 ? j : j + 1) - Y) * ny;
+            double dx = (nx > 0.0 ? i : i + 1) - X, dy = (ny > 0.0 ? j : j + 1) - Y;
+            double m = dx * nx + dy * ny;
             double centre = (i + 0.5 - X) * nx + (j + 0.5 - Y) * ny;
             if (!(m < -cut) || !(centre > 0.0)) {
                 continue;
@@ -258,9 +266,7 @@ static void find_cut_texels(const fill_job *job, int b, const double p_in[3], co
             }
             if (deep_inside(B, t, D, tol) ||
                 wx_collider_camera_may_collide(collider, b, i + 0.5, j + 0.5, D) ||
-                records_near(B, i, j, D, tol) ||
-                !witness_sees_plane(job, p, n, nl, ((nx > 0.0 ? i : i + 1) - X),
-                                    ((ny > 0.0 ? j : j + 1) - Y), b)) {
+                records_near(B, i, j, D, tol) || !witness_sees_plane(job, p, n, nl, dx, dy, b)) {
                 continue;
             }
             push_record(list,
@@ -316,9 +322,8 @@ static void find_range(int64_t begin, int64_t end, int worker, void *context)
                     placed = true;
                 }
                 const wx_collider_camera *B = &collider->cameras[b];
-                double X = p[0] * B->mx[0] + p[1] * B->mx[1] + p[2] * B->mx[2] + B->mx[3];
-                double Y = p[0] * B->my[0] + p[1] * B->my[1] + p[2] * B->my[2] + B->my[3];
-                double D = p[0] * B->md[0] + p[1] * B->md[1] + p[2] * B->md[2] + B->md[3];
+                double X, Y, D;
+                world_to_texel(B, p, &X, &Y, &D);
                 if (!(X >= 0.0 && X < B->width && Y >= 0.0 && Y < B->height)) {
                     continue;
                 }
@@ -463,27 +468,29 @@ wx_result wx_collider_fill_missed(wx_collider *collider, const double (*axes)[3]
     // Every camera's samples against the maps as they are (no fill is applied
     // before all are found, so no sample is a fill and the order does not matter), in parallel over
     // its texels; then each camera's fills.
+    // Every camera's texel space to world (linear part) and |back|, once.
+    fill_job job = { .collider = collider, .axes = axes, .lists = lists };
+    double inv[WX_MAX_INPUT_CAMERAS][9];
+    bool invertible[WX_MAX_INPUT_CAMERAS];
+    for (int c = 0; c < count; ++c) {
+        const wx_collider_camera *C = &collider->cameras[c];
+        const float *v = C->back;
+        job.back_len[c] = sqrt((double)v[0] * v[0] + (double)v[1] * v[1] + (double)v[2] * v[2]);
+        double m3[9] = { C->mx[0], C->mx[1], C->mx[2], C->my[0], C->my[1],
+                         C->my[2], C->md[0], C->md[1], C->md[2] };
+        invertible[c] = wx_invert3(m3, inv[c]);
+        for (int k = 0; k < 3; ++k) {
+            job.step_x[c][k] = invertible[c] ? inv[c][3 * k] : 0.0;
+            job.step_y[c][k] = invertible[c] ? inv[c][3 * k + 1] : 0.0;
+        }
+    }
     for (int a = 0; a < count && ok; ++a) {
         const wx_collider_camera *A = &collider->cameras[a];
-        fill_job job = { .collider = collider, .axes = axes, .a = a, .lists = lists };
-        double m3[9] = { A->mx[0], A->mx[1], A->mx[2], A->my[0], A->my[1],
-                         A->my[2], A->md[0], A->md[1], A->md[2] };
-        if (!wx_invert3(m3, job.inv)) {
+        if (!invertible[a]) {
             continue;
         }
-        for (int b = 0; b < count; ++b) {
-            const wx_collider_camera *B = &collider->cameras[b];
-            const float *v = B->back;
-            job.back_len[b] = sqrt((double)v[0] * v[0] + (double)v[1] * v[1] + (double)v[2] * v[2]);
-            double mb[9] = { B->mx[0], B->mx[1], B->mx[2], B->my[0], B->my[1],
-                             B->my[2], B->md[0], B->md[1], B->md[2] };
-            double ib[9];
-            bool inverted = wx_invert3(mb, ib);
-            for (int k = 0; k < 3; ++k) {
-                job.step_x[b][k] = inverted ? ib[3 * k] : 0.0;
-                job.step_y[b][k] = inverted ? ib[3 * k + 1] : 0.0;
-            }
-        }
+        job.a = a;
+        memcpy(job.inv, inv[a], sizeof job.inv);
         for (int w = 0; w < threads; ++w) {
             lists[w].count = 0;
         }
