@@ -57,6 +57,21 @@ static const char SCENE_XML[] =
     "  </Geometry>\n"
     "</Weathering>\n";
 
+// `text` with its first `from` replaced by `to` (malloc'd).
+static char *replace_once(const char *text, const char *from, const char *to)
+{
+    const char *at = strstr(text, from);
+    if (at == NULL) {
+        return NULL;
+    }
+    size_t head = (size_t)(at - text), n = strlen(text) - strlen(from) + strlen(to);
+    char *out = malloc(n + 1);
+    if (out != NULL) {
+        snprintf(out, n + 1, "%.*s%s%s", (int)head, text, to, at + strlen(from));
+    }
+    return out;
+}
+
 static const char *scene_dir(void)
 {
     static char dir[4200];
@@ -69,20 +84,41 @@ static const char *scene_dir(void)
         ensure_write_file(dir, "box.obj", box != NULL ? box : "");
         free(box);
         ensure_write_file(dir, "scene.xml", SCENE_XML);
+        // The same with three layers a camera and an accessibility mask: a run
+        // keeps the bake's layered images for its simulation and steps through
+        // the masks' collider (pipeline/run.c); the phases read files and build
+        // a collider each.
+        char *layered = replace_once(SCENE_XML, "<Ortho cameraName=\"front\">",
+                                     "<Ortho cameraName=\"front\" layers=\"3\">");
+        char *both = replace_once(layered, "<Ortho cameraName=\"top\">",
+                                  "<Ortho cameraName=\"top\" layers=\"3\">");
+        char *masked = replace_once(both, "  <Geometry>",
+                                    "  <Masks><Accessibility name=\"ao\" rays=\"16\" "
+                                    "distance=\"1\"/></Masks>\n  <Geometry>");
+        ensure_write_file(dir, "layered.xml", masked != NULL ? masked : "");
+        free(layered);
+        free(both);
+        free(masked);
     }
     return dir;
 }
 
-// Runs `weathering ARGS` on the test scene with --out DIR; returns the exit status.
-static int weathering(const char *command, const char *out_dir)
+// Runs `weathering COMMAND` on the test scene file NAME with --out DIR; returns
+// the exit status.
+static int weathering_on(const char *command, const char *name, const char *out_dir)
 {
     char log[4096];
-    int status = ensure_shell(log, sizeof log, "'%s/weathering' %s '%s/scene.xml' --out '%s' -q",
-                              ensure_build_dir(), command, scene_dir(), out_dir);
+    int status = ensure_shell(log, sizeof log, "'%s/weathering' %s '%s/%s' --out '%s' -q",
+                              ensure_build_dir(), command, scene_dir(), name, out_dir);
     if (status != 0) {
         fprintf(stderr, "        weathering %s: status %d\n%s\n", command, status, log);
     }
     return status;
+}
+
+static int weathering(const char *command, const char *out_dir)
+{
+    return weathering_on(command, "scene.xml", out_dir);
 }
 
 static bool same_bytes(const char *dir_a, const char *dir_b, const char *name)
@@ -114,6 +150,40 @@ TEST(run_equals_bake_simulate_gather)
     for (size_t f = 0; f < sizeof files / sizeof files[0]; ++f) {
         ENSURE(same_bytes(whole, phases, files[f]));
     }
+}
+
+TEST(a_layered_run_with_masks_equals_its_phases)
+{
+    const char *whole = out_dir("layered_whole");
+    const char *phases = out_dir("layered_phases");
+    ENSURE(weathering_on("run", "layered.xml", whole) == 0);
+    ENSURE(weathering_on("bake", "layered.xml", phases) == 0);
+    ENSURE(weathering_on("simulate", "layered.xml", phases) == 0);
+    ENSURE(weathering_on("gather", "layered.xml", phases) == 0);
+    static const char *const files[] = { "front_depth.exr", "top_impact.exr", "front_dirt.exr",
+                                         "top_dirt.exr",    "mask.exr",       "mask_ao.png",
+                                         "mask_dirt.png" };
+    for (size_t f = 0; f < sizeof files / sizeof files[0]; ++f) {
+        ENSURE(same_bytes(whole, phases, files[f]));
+    }
+    // The mask holds the accessibility, and the dirt the drops brought.
+    wx_image mask;
+    wx_error err;
+    char path[4300];
+    snprintf(path, sizeof path, "%s/mask.exr", whole);
+    ENSURE(wx_exr_read(path, NULL, 0, &mask, &err) == WX_OK);
+    bool has_ao = false;
+    float most_dirt = 0.0f;
+    size_t texels = (size_t)mask.width * (size_t)mask.height;
+    for (int c = 0; c < mask.channel_count; ++c) {
+        has_ao = has_ao || strcmp(mask.channel_names[c], "ao.Y") == 0;
+        for (size_t t = 0; strcmp(mask.channel_names[c], "dirt.Y") == 0 && t < texels; ++t) {
+            most_dirt = fmaxf(most_dirt, mask.channels[c][t]);
+        }
+    }
+    wx_image_free(&mask);
+    ENSURE(has_ao);
+    ENSURE(most_dirt > 0.0f);
 }
 
 TEST(simulating_again_starts_from_the_initial_dirt)
@@ -288,21 +358,6 @@ TEST(default_scene_has_a_clean_band_and_streaks_below_the_sills)
     ENSURE(below > 5.0 * below0);
 }
 
-// `text` with its first `from` replaced by `to` (malloc'd).
-static char *replace_once(const char *text, const char *from, const char *to)
-{
-    const char *at = strstr(text, from);
-    if (at == NULL) {
-        return NULL;
-    }
-    size_t head = (size_t)(at - text), n = strlen(text) - strlen(from) + strlen(to);
-    char *out = malloc(n + 1);
-    if (out != NULL) {
-        snprintf(out, n + 1, "%.*s%s%s", (int)head, text, to, at + strlen(from));
-    }
-    return out;
-}
-
 // A run in which no particle reaches the geometry ends with exit 0, an all-zero
 // mask and a warning that says so (issue 13).
 TEST(a_run_without_a_single_hit_warns)
@@ -414,6 +469,7 @@ TEST(failures_leave_nothing_behind)
 int main(void)
 {
     RUN(run_equals_bake_simulate_gather);
+    RUN(a_layered_run_with_masks_equals_its_phases);
     RUN(simulating_again_starts_from_the_initial_dirt);
     RUN(simulated_dirt_map_holds_result_and_initial_dirt);
     RUN(default_scene_has_a_clean_band_and_streaks_below_the_sills);

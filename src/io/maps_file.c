@@ -21,6 +21,7 @@ enum { DECODED_FILES = 4 };
 typedef struct decoded_files {
     const char *path[DECODED_FILES];
     wx_image *image[DECODED_FILES]; ///< NULL: not read, or unreadable (read directly)
+    bool borrowed[DECODED_FILES];   ///< the caller's (wx_maps_load_given): not freed here
     int count;
 } decoded_files;
 
@@ -39,7 +40,7 @@ typedef struct size_check {
 static void decoded_free(decoded_files *files)
 {
     for (int k = 0; k < files->count; ++k) {
-        if (files->image[k] != NULL) {
+        if (files->image[k] != NULL && !files->borrowed[k]) {
             wx_image_free(files->image[k]);
             free(files->image[k]);
         }
@@ -71,6 +72,7 @@ static const wx_image *decoded(size_check *check, const char *path)
         image = NULL;
     }
     files->path[files->count] = path;
+    files->borrowed[files->count] = false;
     files->image[files->count++] = image;
     return image;
 }
@@ -595,12 +597,33 @@ wx_result wx_maps_load_layers(wx_maps *maps, unsigned which, int threads, const 
                               int layers, const char *depth_path, const char *normal_path,
                               const char *impact_path, const char *dirt_path, wx_error *err)
 {
+    const char *const paths[4] = { depth_path, normal_path, impact_path, dirt_path };
+    return wx_maps_load_given(maps, which, threads, scene, layers, paths, NULL, err);
+}
+
+wx_result wx_maps_load_given(wx_maps *maps, unsigned which, int threads, const wx_scene *scene,
+                             int layers, const char *const paths[4], const wx_image *const given[4],
+                             wx_error *err)
+{
+    const char *depth_path = paths[0], *normal_path = paths[1], *impact_path = paths[2],
+               *dirt_path = paths[3];
+    // The files in memory stand for the files: every read goes through the
+    // decoded images, whose planes, names and attributes are the files'.
+    decoded_files files = { .count = 0 };
+    for (int k = 0; k < 4 && given != NULL; ++k) {
+        if (given[k] != NULL && paths[k] != NULL) {
+            files.path[files.count] = paths[k];
+            files.image[files.count] = (wx_image *)given[k]; // read only: borrowed
+            files.borrowed[files.count++] = true;
+        }
+    }
     if (layers <= 1) {
-        return load_layer(maps, which, threads, scene, 0, depth_path, normal_path, impact_path,
-                          dirt_path, NULL, err);
+        wx_result r = load_layer(maps, which, threads, scene, 0, depth_path, normal_path,
+                                 impact_path, dirt_path, files.count > 0 ? &files : NULL, err);
+        decoded_free(&files);
+        return r;
     }
     wx_maps one;
-    decoded_files files = { .count = 0 };
     wx_result r = load_layer(maps, which, threads, scene, 0, depth_path, normal_path, impact_path,
                              dirt_path, &files, err);
     if (r != WX_OK) {

@@ -5,6 +5,7 @@
 #define WX_MAPS_FILE_H
 
 #include "core/error.h"
+#include "model/image.h"
 #include "model/maps.h"
 #include "model/scene.h"
 
@@ -39,6 +40,15 @@ wx_result wx_maps_load_scene(wx_maps *maps, unsigned which, int threads, const w
 wx_result wx_maps_load_layers(wx_maps *maps, unsigned which, int threads, const wx_scene *scene,
                               int layers, const char *depth_path, const char *normal_path,
                               const char *impact_path, const char *dirt_path, wx_error *err);
+
+/// wx_maps_load_layers with some files already in memory: given[k] (NULL: read
+/// the file) holds what the file at paths[k] holds (depth, normal, impact,
+/// dirt; its planes, channel names and string and matrix attributes, as
+/// `bake` hands them to the writer of that file), and is read in its place.
+/// The maps are the same as from the files; `given` is only read.
+wx_result wx_maps_load_given(wx_maps *maps, unsigned which, int threads, const wx_scene *scene,
+                             int layers, const char *const paths[4], const wx_image *const given[4],
+                             wx_error *err);
 
 /// Loads the maps selected by `which` from the given paths (NULL or "" for a map
 /// not wanted). Depth reads channel R or Z, normal R G B, impact R G, dirt R G B.

@@ -31,6 +31,7 @@ typedef struct bake_writer {
     wx_scene *scene;
     const wx_run_def *opts;
     wx_maps *output_maps; ///< when not NULL: the output camera's depth and normal kept
+    wx_image *kept;       ///< when not NULL: the input cameras' images, 4 per scene camera
     bool prepared; ///< the output folder exists (made with the first camera's maps)
     map_file files[4];
 } bake_writer;
@@ -118,6 +119,13 @@ static wx_result write_maps(int camera, wx_image *maps, int count, void *user, w
         wx_result r = keep_output_maps(&maps[0], &maps[1], w->output_maps, err);
         if (r != WX_OK) {
             return r;
+        }
+    }
+    if (!sc->is_output && w->kept != NULL) {
+        // Taken over, not copied: the bake allocates the next camera's anew.
+        for (int k = 0; k < count; ++k) {
+            w->kept[4 * camera + k] = maps[k];
+            memset(&maps[k], 0, sizeof maps[k]);
         }
     }
     char **dest[4] = { &sc->depth_path, &sc->normal_path, &sc->impact_path, &sc->dirt_path };
@@ -261,7 +269,8 @@ wx_result wx_bake_geometry_into(const wx_scene *scene, const wx_run_def *opts,
 }
 
 wx_result wx_bake_geometry(wx_scene *scene, const wx_run_def *opts, wx_geometry *geometry,
-                           wx_maps *output_maps, wx_bake_stats *stats, wx_error *err)
+                           wx_maps *output_maps, wx_image *kept, wx_bake_stats *stats,
+                           wx_error *err)
 {
     bake_writer *writer = calloc(1, sizeof *writer); // four paths: off the stack
     if (writer == NULL) {
@@ -270,6 +279,7 @@ wx_result wx_bake_geometry(wx_scene *scene, const wx_run_def *opts, wx_geometry 
     writer->scene = scene;
     writer->opts = opts;
     writer->output_maps = output_maps;
+    writer->kept = kept;
     wx_result r = wx_bake_geometry_into(scene, opts, geometry, write_maps, writer, stats, err);
     free(writer);
     return r;
@@ -285,7 +295,7 @@ wx_result wx_bake_scene_stats(wx_scene *scene, const wx_run_def *opts, wx_bake_s
         r = wx_geometry_load(scene, opts->quiet, &geometry, err);
     }
     if (r == WX_OK) {
-        r = wx_bake_geometry(scene, opts, &geometry, NULL, stats, err);
+        r = wx_bake_geometry(scene, opts, &geometry, NULL, NULL, stats, err);
     }
     wx_geometry_free(&geometry);
     return r;

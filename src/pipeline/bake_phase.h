@@ -43,10 +43,14 @@ wx_result wx_bake_geometry_into(const wx_scene *scene, const wx_run_def *opts,
 /// Bakes with the geometry already imported (wx_geometry_load);
 /// its mesh arrays are released as they are uploaded. When `output_maps` is not
 /// NULL and the output camera is baked, its depth and normal are kept there
-/// too (the gather of the same run reads them instead of the files). `stats`
-/// may be NULL.
+/// too (the gather of the same run reads them instead of the files). When
+/// `kept` is not NULL (4 images per scene camera, zeroed), each baked input
+/// camera's images (depth, normal, impact, dirt), as written to its files, are
+/// moved there for the simulation of the same run (wx_load_simulation_maps);
+/// the caller frees them with wx_image_free. `stats` may be NULL.
 wx_result wx_bake_geometry(wx_scene *scene, const wx_run_def *opts, wx_geometry *geometry,
-                           wx_maps *output_maps, wx_bake_stats *stats, wx_error *err);
+                           wx_maps *output_maps, wx_image *kept, wx_bake_stats *stats,
+                           wx_error *err);
 
 /// The whole phase: imports the geometry when some camera is baked, then
 /// wx_bake_geometry. `stats` may be NULL.

@@ -15,8 +15,8 @@
 #include "io/exr.h"
 #include "io/maps_file.h"
 
-wx_result wx_load_simulation_maps(const wx_scene *scene, int threads, wx_maps *maps,
-                                  wx_error *err)
+wx_result wx_load_simulation_maps(const wx_scene *scene, int threads, wx_image *baked,
+                                  wx_maps *maps, wx_error *err)
 {
     int k = 0;
     for (int c = 0; c < scene->camera_count; ++c) {
@@ -35,8 +35,17 @@ wx_result wx_load_simulation_maps(const wx_scene *scene, int threads, wx_maps *m
             // started from (channel initialDirt), so running again is repeatable.
             which |= WX_MAPS_DIRT | WX_MAPS_INITIAL_DIRT;
         }
-        wx_result r = wx_maps_load_layers(&maps[k], which, threads, scene, cam->layers, cam->depth_path,
-                                         cam->normal_path, cam->impact_path, cam->dirt_path, err);
+        const char *const paths[4] = { cam->depth_path, cam->normal_path, cam->impact_path,
+                                       cam->dirt_path };
+        const wx_image *given[4] = { NULL, NULL, NULL, NULL };
+        for (int f = 0; f < 4 && baked != NULL; ++f) {
+            given[f] = baked[4 * c + f].channel_count > 0 ? &baked[4 * c + f] : NULL;
+        }
+        wx_result r =
+            wx_maps_load_given(&maps[k], which, threads, scene, cam->layers, paths, given, err);
+        for (int f = 0; f < 4 && baked != NULL; ++f) {
+            wx_image_free(&baked[4 * c + f]); // loaded: the peak holds one camera's twice
+        }
         if (r != WX_OK) {
             wx_error_prefix(err, "camera '%s'", cam->name);
             return r;

@@ -13,9 +13,12 @@
 /// scene->input_count entries) as the simulation reads them: depth, normal,
 /// impact and, when the camera has one, its dirt map (from the channel
 /// initialDirt when an earlier `simulate` wrote it, so a second run starts
-/// where the first started). Errors name the camera and the file.
-wx_result wx_load_simulation_maps(const wx_scene *scene, int threads, wx_maps *maps,
-                                  wx_error *err);
+/// where the first started). Errors name the camera and the file. `baked`
+/// (NULL: read every file) holds 4 images per scene camera that this run's
+/// bake kept (wx_bake_geometry): a camera with them is read from them, not
+/// from its files (the same maps), and they are freed once it is loaded.
+wx_result wx_load_simulation_maps(const wx_scene *scene, int threads, wx_image *baked,
+                                  wx_maps *maps, wx_error *err);
 
 /// Loads the maps of every input camera as the gather reads them: depth,
 /// normal, and the dirt `simulate` left in the output folder

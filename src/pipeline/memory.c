@@ -163,7 +163,7 @@ void wx_memory_estimate_geometry(const wx_scene *scene, unsigned phases,
             : NULL;
 
     double largest = -1.0, input_texels = 0.0, largest_input = 0.0, output_texels = 0.0;
-    double framebuffer = 0.0, images = 0.0, baked_inputs = 0.0;
+    double framebuffer = 0.0, images = 0.0, baked_inputs = 0.0, kept_images = 0.0;
     bool bake = (phases & WX_PHASE_BAKE) && wx_scene_needs_bake(scene);
     double input_image =
         WX_BAKE_INPUT_IMAGE_BYTES_PER_TEXEL + WX_PLANE_BYTES_PER_TEXEL * baked_extra;
@@ -193,6 +193,7 @@ void wx_memory_estimate_geometry(const wx_scene *scene, unsigned phases,
                                       (sc->is_output ? WX_BAKE_OUTPUT_IMAGE_BYTES_PER_TEXEL
                                                      : input_image));
             baked_inputs += sc->is_output ? 0.0 : layers * texels;
+            kept_images += sc->is_output ? 0.0 : layers * texels * input_image;
         }
     }
     if (bake) {
@@ -216,9 +217,13 @@ void wx_memory_estimate_geometry(const wx_scene *scene, unsigned phases,
                 need->mesh_line = scene->meshes[m].line;
             }
         }
-        // Two cameras' images at once, the visibility test's depth planes, the
-        // readback strip (1 Mi floats), and the meshes as imported and uploaded.
-        need->bake_bytes = WX_BAKE_CONTEXT_BYTES + framebuffer + 2.0 * images +
+        // Two cameras' images at once (a run that simulates keeps every input
+        // camera's for its simulation: pipeline/run.c), the visibility test's
+        // depth planes, the readback strip (1 Mi floats), and the meshes as
+        // imported and uploaded.
+        double held =
+            (phases & WX_PHASE_SIMULATE) ? fmax(2.0 * images, images + kept_images) : 2.0 * images;
+        need->bake_bytes = WX_BAKE_CONTEXT_BYTES + framebuffer + held +
                            4.0 * (input_texels > baked_inputs ? input_texels : baked_inputs) +
                            4.0 * 1024.0 * 1024.0 + need->mesh_bytes;
     }
@@ -301,6 +306,12 @@ void wx_memory_estimate_geometry(const wx_scene *scene, unsigned phases,
         double kept = need->frame_bytes == 0.0 && bake && (phases & WX_PHASE_GATHER)
                           ? WX_BAKE_OUTPUT_IMAGE_BYTES_PER_TEXEL * output_texels
                           : 0.0;
+        // A run that gathers builds the derived masks' collider before the
+        // simulation, which steps through it (pipeline/run.c): the context's
+        // own planes (zero impact, noise tables) live through the simulation.
+        if (need->frame_bytes == 0.0 && (phases & WX_PHASE_GATHER) && collider > 0.0) {
+            kept += collider - WX_MASK_COLLIDER_BYTES_PER_TEXEL * input_texels;
+        }
         need->sim_map_bytes = per_input * input_texels + fmax(write, need->frame_bytes) + kept +
                               need->texture_raster_bytes;
         largest = -1.0;

@@ -75,6 +75,7 @@ wx_result wx_run_phases(wx_scene *scene, const wx_run_def *opts, unsigned phases
     memset(&masks, 0, sizeof masks);
     wx_maps output_maps;
     memset(&output_maps, 0, sizeof output_maps);
+    wx_image *baked = NULL; // the input cameras' images, kept from the bake for the simulation
     char created[WX_PATH_MAX] = "";
     wx_result r = WX_OK;
     bool bake = (phases & WX_PHASE_BAKE) && mark_baked_cameras(scene);
@@ -149,10 +150,18 @@ wx_result wx_run_phases(wx_scene *scene, const wx_run_def *opts, unsigned phases
 
     if (r == WX_OK && (phases & WX_PHASE_BAKE)) {
         double t0 = wx_now_s();
-        if (bake) {
-            // The output camera's maps stay in memory for the gather below.
+        if (bake && (phases & WX_PHASE_SIMULATE)) {
+            baked = calloc(4 * (size_t)scene->camera_count, sizeof *baked);
+            if (baked == NULL) {
+                r = wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (maps)");
+            }
+        }
+        if (bake && r == WX_OK) {
+            // The output camera's maps stay in memory for the gather below,
+            // and the input cameras' for the simulation: not read back.
             r = wx_bake_geometry(scene, opts, &geometry,
-                                 (phases & WX_PHASE_GATHER) ? &output_maps : NULL, NULL, err);
+                                 (phases & WX_PHASE_GATHER) ? &output_maps : NULL, baked, NULL,
+                                 err);
         } else if (phases == WX_PHASE_BAKE) {
             wx_note(opts->quiet, "%s: every camera has its maps; nothing to bake", scene->path);
         }
@@ -167,13 +176,15 @@ wx_result wx_run_phases(wx_scene *scene, const wx_run_def *opts, unsigned phases
     if (r == WX_OK && (phases & WX_PHASE_SIMULATE)) {
         double t0 = wx_now_s();
         maps = calloc((size_t)scene->input_count + 1, sizeof *maps);
-        r = maps != NULL ? wx_load_simulation_maps(scene, opts->threads, maps, err)
+        r = maps != NULL ? wx_load_simulation_maps(scene, opts->threads, baked, maps, err)
                          : wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (maps)");
         double t1 = wx_now_s();
-        // A run that gathers frames keeps the derived masks' context over
-        // them and the final gather: the geometric masks are computed once.
-        if (r == WX_OK && (phases & WX_PHASE_GATHER) && wx_masks_worth_keeping(scene)) {
-            r = wx_mask_context_init(scene, maps, true, &masks, err);
+        // A run that gathers builds the derived masks' collider now: the
+        // simulation steps through it too (with the maps' impact) instead of
+        // building its own. One that gathers frames keeps the context's
+        // masks over them and the final gather: computed once.
+        if (r == WX_OK && (phases & WX_PHASE_GATHER)) {
+            r = wx_mask_context_init(scene, maps, wx_masks_worth_keeping(scene), &masks, err);
         }
         if (r == WX_OK) {
             r = wx_simulate_maps(scene, opts, maps,
@@ -238,6 +249,10 @@ wx_result wx_run_phases(wx_scene *scene, const wx_run_def *opts, unsigned phases
     scene->surface_sample = NULL;
     scene->surface_sample_count = 0;
     free(surface_sample);
+    for (int k = 0; baked != NULL && k < 4 * scene->camera_count; ++k) {
+        wx_image_free(&baked[k]); // what an early failure left unread
+    }
+    free(baked);
     free_maps(maps, scene->input_count);
     wx_maps_free(&output_maps);
     wx_textures_free(&textures);

@@ -283,9 +283,12 @@ wx_result wx_write_dirt_maps(const wx_scene *scene, const wx_run_def *opts, cons
 // The run's simulation on `maps`, spread over the ranks of an MPI run (all of
 // them create it alike: wx_simulate_follow).
 static wx_result create_simulation(const wx_scene *scene, const wx_run_def *opts,
-                                   const wx_maps *maps, wx_sim **sim, wx_error *err)
+                                   const wx_maps *maps, const wx_mask_context *masks, wx_sim **sim,
+                                   wx_error *err)
 {
     wx_sim_def config = wx_default_sim_def(scene);
+    // The derived masks' collider, when the run built one: the same geometry.
+    config.shared_collider = masks != NULL && masks->ready ? &masks->collider : NULL;
     config.seed = opts->seed;
     // The ranks on one machine step at the same time: they share its threads
     // (rank 0 has them all again for what it does alone: bake, frames, gather).
@@ -311,7 +314,7 @@ wx_result wx_simulate_maps(const wx_scene *scene, const wx_run_def *opts, wx_map
     detail = detail != NULL ? detail : &local;
     double t0 = wx_now_s();
     wx_sim *sim = NULL;
-    wx_result r = create_simulation(scene, opts, maps, &sim, err);
+    wx_result r = create_simulation(scene, opts, maps, masks, &sim, err);
     double t1 = wx_now_s();
     detail->setup = t1 - t0;
     if (r != WX_OK) {
@@ -390,7 +393,7 @@ wx_result wx_simulate_scene(const wx_scene *scene, const wx_run_def *opts,
     if (maps == NULL) {
         return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (maps)");
     }
-    wx_result r = wx_load_simulation_maps(scene, opts->threads, maps, err);
+    wx_result r = wx_load_simulation_maps(scene, opts->threads, NULL, maps, err);
     if (r == WX_OK) {
         r = wx_simulate_maps(scene, opts, maps, NULL, NULL, NULL, stats, NULL, err);
     }
@@ -411,11 +414,11 @@ wx_result wx_simulate_follow(wx_scene *scene, const wx_run_def *opts, wx_error *
     // (or an earlier `bake` had): the maps its own simulation reads.
     wx_result r = wx_use_baked_maps(scene, opts, err);
     if (r == WX_OK) {
-        r = wx_load_simulation_maps(scene, opts->threads, maps, err);
+        r = wx_load_simulation_maps(scene, opts->threads, NULL, maps, err);
     }
     wx_sim *sim = NULL;
     if (r == WX_OK) {
-        r = create_simulation(scene, opts, maps, &sim, err);
+        r = create_simulation(scene, opts, maps, NULL, &sim, err);
     }
     int64_t total = total_steps(scene);
     for (int64_t s = 0; s < total && r == WX_OK; ++s) {

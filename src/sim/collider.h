@@ -109,6 +109,9 @@ typedef struct wx_collider {
     /// the head-on camera records, and pick_camera allows that much more
     /// (0 with one layer everywhere: today's rule).
     double layered_slack;
+    /// A view of another collider (wx_collider_view): its planes are that
+    /// one's, and wx_collider_free frees only the cameras array.
+    bool view;
 } wx_collider;
 
 /// Builds the collider over `count` cameras and their maps (depth, normal and
@@ -129,6 +132,14 @@ wx_result wx_collider_init(wx_collider *collider, const wx_camera *cameras, cons
 /// and another camera (a top camera, solid below its first surface) could
 /// catch it: rain falling past a slab's edge was caught under the slab.
 void wx_collider_frame_box(wx_collider *collider, const double lo[3], const double hi[3]);
+
+/// The collider `shared` with the hits reading maps[c].impact (absorption,
+/// bounce) for camera c: the same geometry, every plane borrowed from `shared`
+/// (which must outlive the view, and be built over the same cameras, with
+/// maps[c]'s size and layers). A run builds one collider for its derived masks
+/// and its simulation this way (pipeline/run.c): the masks need no impact.
+wx_result wx_collider_view(wx_collider *view, const wx_collider *shared, const wx_maps *maps,
+                           wx_error *err);
 
 /// Frees what the collider owns; the struct is zeroed.
 void wx_collider_free(wx_collider *collider);

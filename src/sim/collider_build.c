@@ -461,9 +461,35 @@ wx_result wx_collider_init(wx_collider *collider, const wx_camera *cameras, cons
     return WX_OK;
 }
 
+wx_result wx_collider_view(wx_collider *view, const wx_collider *shared, const wx_maps *maps,
+                           wx_error *err)
+{
+    memset(view, 0, sizeof *view);
+    for (int c = 0; c < shared->camera_count; ++c) {
+        const wx_collider_camera *cam = &shared->cameras[c];
+        if (maps[c].impact == NULL || maps[c].width != cam->width ||
+            maps[c].height != cam->height || wx_maps_layers(&maps[c]) != cam->layers) {
+            return wx_fail(err, WX_CAUSE_BAD_ARGUMENT,
+                           "input camera %d: its impact map does not match the shared collider", c);
+        }
+    }
+    *view = *shared;
+    view->cameras = malloc((size_t)shared->camera_count * sizeof *view->cameras + 1);
+    if (view->cameras == NULL) {
+        memset(view, 0, sizeof *view);
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "collider: out of memory");
+    }
+    memcpy(view->cameras, shared->cameras, (size_t)shared->camera_count * sizeof *view->cameras);
+    for (int c = 0; c < shared->camera_count; ++c) {
+        view->cameras[c].impact = maps[c].impact;
+    }
+    view->view = true;
+    return WX_OK;
+}
+
 void wx_collider_free(wx_collider *collider)
 {
-    for (int c = 0; c < collider->camera_count; ++c) {
+    for (int c = 0; c < collider->camera_count && !collider->view; ++c) {
         free(collider->cameras[c].depth);
         free(collider->cameras[c].role);
         free(collider->cameras[c].origin);

@@ -491,14 +491,16 @@ wx_result wx_sim_create(const wx_scene *scene, const wx_sim_def *config, wx_sim 
             r = wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (simulation)");
         }
     }
+    bool shared = config->shared_collider != NULL && !config->nearest_depth;
     if (r == WX_OK) {
         for (int c = 0; c < sim->input_count; ++c) {
             cameras[c] = scene->cameras[sim->input_camera[c]].camera;
         }
-        r = wx_collider_init(&sim->collider, cameras, sim->maps, sim->input_count,
-                             config->nearest_depth, err);
+        r = shared ? wx_collider_view(&sim->collider, config->shared_collider, sim->maps, err)
+                   : wx_collider_init(&sim->collider, cameras, sim->maps, sim->input_count,
+                                      config->nearest_depth, err);
     }
-    if (r == WX_OK && scene->tile.present) {
+    if (r == WX_OK && scene->tile.present && !shared) {
         // The tile's cameras are cut to where its particles live.
         const double lo[3] = { sim->bbox_lo[0], sim->bbox_lo[1], sim->bbox_lo[2] };
         const double hi[3] = { sim->bbox_hi[0], sim->bbox_hi[1], sim->bbox_hi[2] };

@@ -43,6 +43,12 @@ typedef struct wx_sim_def {
     /// scene, maps and seed and steps it as often; the results are those of
     /// one process, on every rank. False (default): this process alone.
     bool distributed;
+    /// A collider already built over the same cameras and maps, with bilinear
+    /// depth and the scene's tile box (a run's derived masks': pipeline/run.c),
+    /// which must outlive the simulation: stepped through with the maps'
+    /// impact (wx_collider_view) rather than built again. NULL (default):
+    /// built here. Ignored with nearest_depth.
+    const struct wx_collider *shared_collider;
 } wx_sim_def;
 
 /// Default configuration for a scene: its seed, one thread per core.

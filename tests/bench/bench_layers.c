@@ -105,7 +105,7 @@ static bool house_load(house *h, const char *out_dir, int layers)
     if (wx_output_prepare(&h->scene, &opts, NULL, &err) != WX_OK ||
         wx_bake_scene(&h->scene, &opts, &err) != WX_OK ||
         wx_use_baked_maps(&h->scene, &opts, &err) != WX_OK ||
-        wx_load_simulation_maps(&h->scene, THREADS, h->maps, &err) != WX_OK) {
+        wx_load_simulation_maps(&h->scene, THREADS, NULL, h->maps, &err) != WX_OK) {
         fprintf(stderr, "bench_layers: %s\n", err.message);
         return false;
     }
