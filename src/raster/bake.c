@@ -323,6 +323,17 @@ static wx_result compute_initial_dirt(baker *b, int c, const wx_owner_view *view
     float texel_area = (frame_w / (float)width) * (frame_h / (float)height);
 
     size_t texels = (size_t)width * (size_t)height;
+    // No dirt to own and no area asked: every amount stays 0 (the surfaces
+    // start clean, as most scenes' do), and the ownership is not needed.
+    bool clean = area == NULL;
+    for (int s = 0; s < planes_count && clean; ++s) {
+        for (size_t t = 0; t < texels && clean; ++t) {
+            clean = planes[s][t] == 0.0f;
+        }
+    }
+    if (clean) {
+        return WX_OK;
+    }
     float *share = wx_big_malloc((texels > 0 ? texels : 1) * sizeof *share);
     if (share == NULL) {
         return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "bake: out of memory");
