@@ -550,11 +550,8 @@ static bool run_lumpy(const char *dir, const char *model, int seed, int layers, 
 // before each camera's crossings were widened by their margin
 // (docs/physics.md, "Which camera's surface a particle meets") the sliding
 // followed whichever camera's surface lay innermost: 0.0235, 0.0300, 1.277.
-// 5 December 2026: 0.0230, 0.0268, 1.164 before a slide's next sweep started
-// a quarter of a texel above it (docs/physics.md, "A slide's next step starts
-// above it"), 0.0245, 0.0283, 1.155 after (in issue 25's setup the ratio fell
-// further: docs/performance.md). The run is deterministic, so the bound tells
-// the crossings' widening apart; issue 25's 1.05 is not met.
+// The run is deterministic, so the bound between the two tells them apart;
+// issue 25's 1.05 is not met (docs/performance.md).
 #define MAX_TURN_RATIO 1.24
 TEST(lumpy_sphere_turned_slides_as_a_new_seed_does)
 {

@@ -490,11 +490,13 @@ TEST(same_output_bytes_for_1_2_and_4_threads)
 // The dirt maps the two produce are the same bytes.
 TEST(pinned_determinism_hash)
 {
-    // Since a slide's next swept test starts a quarter of a texel above its
-    // contact (docs/physics.md, "A slide's next step starts above it").
-    const uint64_t EXPECTED_FUSED = 0xf2411082efe43841ull;
-    const uint64_t EXPECTED_UNFUSED = 0x77b9f6aee981fbd7ull;
-    const uint64_t EXPECTED_DIRT_MAPS = 0xb33694393f1a1814ull;
+    // Since the collider's fills take every texel a surface seen edge-on clips
+    // and no bilinear cell mixes a fill with a surface (docs/physics.md,
+    // "Surfaces a camera sees edge-on"): a camera no longer cuts into a face
+    // it sees edge-on, nor a sliver of one along its silhouette.
+    const uint64_t EXPECTED_FUSED = 0x029e7149149dc28bull;
+    const uint64_t EXPECTED_UNFUSED = 0xf482b84ffe1ac73bull;
+    const uint64_t EXPECTED_DIRT_MAPS = 0x2206e9abd14ba566ull;
     bool fused = wx_kernels_fuse_multiply_add();
     uint64_t files[2], state[2];
     wx_sim_stats st[2];

@@ -2,7 +2,6 @@
 // chunks of particles: forces and the Euler step, the coarse and the swept
 // collision tests, the mechanical reaction, and the records (events, deaths)
 // the serial phase of simulate.c applies.
-#include <math.h>
 #include <string.h>
 
 #include "sim/solver_internal.h"
@@ -82,44 +81,6 @@ integrate_block(const wx_forces *restrict forces, float t, float dt, const float
     }
 }
 
-// How far above its last contact a sliding particle's sweep starts, in that
-// camera's texels (docs/physics.md, "Sliding").
-#define SLIDE_LIFT 0.25f
-
-// Where the swept test of particle i's step starts. A particle that slid in
-// the step before (`slide`: its last contact's map and texel, step.c's
-// streaks) starts SLIDE_LIFT texels above that contact, along the texel's
-// normal turned against its velocity, and comes down onto the surface within
-// the step: put back a hundredth of a texel in front of one camera's surface,
-// it would otherwise meet, at the start of its next step, the steps of up to a
-// texel where the cameras' surfaces cross, which lie along the camera grid and
-// not the model (docs/performance.md, "Where the lumpy sphere's turn comes
-// from"). The start stays p0 where the lifted point collides (a ceiling
-// above, the particle's own surface turned).
-static void sweep_start(const wx_sim *sim, uint32_t slide, const float p0[3], const float v[3],
-                        float out[3])
-{
-    memcpy(out, p0, 3 * sizeof(float));
-    if (slide == WX_NO_SLIDE) {
-        return;
-    }
-    int view = 0;
-    while (view + 1 < sim->view_count && sim->slide_base[view + 1] <= slide) {
-        view++;
-    }
-    const float *n = sim->views[view].normal + 3 * (size_t)(slide - sim->slide_base[view]);
-    float len = sqrtf(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-    if (!(len > 1e-6f)) {
-        return;
-    }
-    float away = n[0] * v[0] + n[1] * v[1] + n[2] * v[2] > 0.0f ? -1.0f : 1.0f;
-    float h = SLIDE_LIFT * sim->collider.cameras[sim_view_camera(sim, view)].texel_ws * away / len;
-    float q[3] = { p0[0] + h * n[0], p0[1] + h * n[1], p0[2] + h * n[2] };
-    if (!wx_collider_point_collides(&sim->collider, q)) {
-        memcpy(out, q, sizeof q);
-    }
-}
-
 // A segment the coarse test did not clear: the swept test, and on a hit the
 // Russian roulette, the reaction and the event.
 static void collide_one(wx_sim *sim, sim_worker *w, int64_t i, const float p0[3], const float p1[3],
@@ -128,9 +89,7 @@ static void collide_one(wx_sim *sim, sim_worker *w, int64_t i, const float p0[3]
     wx_particles *P = &sim->particles;
     wx_hit hit;
     hit.layer = 0;
-    float start[3];
-    sweep_start(sim, P->last_slide[i], p0, v, start);
-    if (!wx_collider_sweep(&sim->collider, start, p1, &hit)) {
+    if (!wx_collider_sweep(&sim->collider, p0, p1, &hit)) {
         // The Euler step stands (already stored); a step without a hit ends a streak.
         P->last_slide[i] = WX_NO_SLIDE;
         if (!inside_box(sim, p1)) {
