@@ -77,8 +77,10 @@ static double tolerance(const wx_owner_view *view, const float n[3], double d, d
     return view->texel_ws * (0.5 + tan_view) + 4e-6 * (fabs(d) + fabs(own));
 }
 
-// wx_owner_sees with p already in the view's map space (uvd).
-static bool sees_projected(const wx_owner_view *view, const double uvd[3], const float n[3])
+// wx_owner_sees with p already in the view's map space (uvd), its depth known
+// to within `slack` (world units; 0: exactly) besides the view's own tolerance.
+static bool sees_projected(const wx_owner_view *view, const double uvd[3], const float n[3],
+                           double slack)
 {
     if (view->normal != NULL) {
         // A layer's normals point out of the solid, either way along the view:
@@ -91,7 +93,7 @@ static bool sees_projected(const wx_owner_view *view, const double uvd[3], const
         size_t t = (size_t)j * (size_t)view->width + (size_t)i;
         double own = view->depth[t];
         if (wx_depth_is_empty(view->depth[t]) ||
-            !(fabs(uvd[2] - own) <= tolerance(view, n, uvd[2], own))) {
+            !(fabs(uvd[2] - own) <= fmax(tolerance(view, n, uvd[2], own), slack))) {
             return false;
         }
         const float *m = view->normal + 3 * t;
@@ -104,7 +106,7 @@ static bool sees_projected(const wx_owner_view *view, const double uvd[3], const
     if (!depth_at(view->depth, view->width, view->height, x, y, &own, &between)) {
         return false;
     }
-    double precision = tolerance(view, n, uvd[2], own);
+    double precision = fmax(tolerance(view, n, uvd[2], own), slack);
     return fabs(uvd[2] - own) <= precision && fabs(uvd[2] - between) <= precision;
 }
 
@@ -117,7 +119,7 @@ bool wx_owner_sees(const wx_owner_view *view, const double p[3], const float n[3
     }
     double uvd[3];
     wx_matrix_apply_affine(view->camera->wtc, p, uvd);
-    return sees_projected(view, uvd, n);
+    return sees_projected(view, uvd, n, 0.0);
 }
 
 // |d - depth| of p against the texel of `view` it falls in (+inf outside).
@@ -147,7 +149,7 @@ typedef struct projection {
 } projection;
 
 static bool sees_cached(const wx_owner_view *view, const double p[3], const float n[3],
-                        projection *cache)
+                        double slack, projection *cache)
 {
     float facing = n[0] * view->view[0] + n[1] * view->view[1] + n[2] * view->view[2];
     if (view->normal == NULL && !(facing < FACING_SLACK)) {
@@ -159,11 +161,12 @@ static bool sees_cached(const wx_owner_view *view, const double p[3], const floa
         wx_matrix_apply_affine(view->camera->wtc, p, cache->uvd);
         cache->camera = view->camera;
     }
-    return sees_projected(view, cache->uvd, n);
+    return sees_projected(view, cache->uvd, n, slack);
 }
 
-int wx_owner_of(const wx_owner_view *views, int count, const double p[3], const float n[3],
-                int known)
+// wx_owner_of for a point known to within `slack` (sees_projected).
+static int owner_within(const wx_owner_view *views, int count, const double p[3], const float n[3],
+                        int known, double slack)
 {
     int best = -1;
     float best_cos = -1.0f;
@@ -181,7 +184,7 @@ int wx_owner_of(const wx_owner_view *views, int count, const double p[3], const 
         bool outside = v->normal == NULL || along < 0.0f;
         if (best >= 0 && outside != best_outside && c >= best_cos - TIE_COSINE &&
             c <= best_cos + TIE_COSINE) {
-            if (outside && (k == known || sees_cached(v, p, n, &cache))) {
+            if (outside && (k == known || sees_cached(v, p, n, slack, &cache))) {
                 best = k;
                 best_cos = c;
                 best_outside = true;
@@ -194,19 +197,26 @@ int wx_owner_of(const wx_owner_view *views, int count, const double p[3], const 
             // the depth tolerance of each other) to the layer whose surface p
             // is on.
             if (best >= 0 && v->normal != NULL && c >= best_cos - TIE_COSINE &&
-                same_camera(v, &views[best]) && (k == known || sees_cached(v, p, n, &cache)) &&
+                same_camera(v, &views[best]) &&
+                (k == known || sees_cached(v, p, n, slack, &cache)) &&
                 (k == known || depth_error(v, p) < depth_error(&views[best], p))) {
                 best = k;
             }
             continue;
         }
-        if (k == known || sees_cached(v, p, n, &cache)) {
+        if (k == known || sees_cached(v, p, n, slack, &cache)) {
             best = k;
             best_cos = c;
             best_outside = outside;
         }
     }
     return best;
+}
+
+int wx_owner_of(const wx_owner_view *views, int count, const double p[3], const float n[3],
+                int known)
+{
+    return owner_within(views, count, p, n, known, 0.0);
 }
 
 typedef struct owned_job {
@@ -296,6 +306,16 @@ static void borders(int64_t begin, int64_t end, int worker, void *context)
             if (!mixed) {
                 continue;
             }
+            // A point between texel centres lies on the surface only to this
+            // view's precision (half a texel plus the surface's slope across
+            // one: the rule's tolerance), so another view whose surface lies
+            // within that of it sees it. Seen at a grazing angle that
+            // precision is many of another view's: held to its own tolerance,
+            // a head-on view missed the points of a silhouette texel whose
+            // centre it owns, and the texel owned a share of a surface whose
+            // deposits the collider (deciding at the hit, exactly) never gave
+            // it, which read as a dark streak along the silhouette (docs/mask.md).
+            double slack = tolerance(v, n, d, d);
             int owned = 0;
             for (int sy = 0; sy < SUB; ++sy) {
                 for (int sx = 0; sx < SUB; ++sx) {
@@ -305,7 +325,7 @@ static void borders(int64_t begin, int64_t end, int worker, void *context)
                         between = d;
                     }
                     world_point(job, x, y, between, p);
-                    owned += wx_owner_of(job->views, job->count, p, n, job->c) == job->c;
+                    owned += owner_within(job->views, job->count, p, n, job->c, slack) == job->c;
                 }
             }
             job->out[t] = (float)owned / (float)(SUB * SUB);

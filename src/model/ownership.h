@@ -60,7 +60,10 @@ int wx_owner_of(const wx_owner_view *views, int count, const double p[3], const 
 /// The share of each texel of view c's surface that view c owns, in [0, 1]
 /// (0 where the texel has no surface), into out[width*height]: the texel's
 /// centre decides, and a texel whose neighbours are not all decided alike is
-/// cut into 4 x 4 points, each decided on its own. Normals are read as
+/// cut into 4 x 4 points, each decided on its own. Those points lie on the
+/// surface only to view c's precision (its tolerance at the texel), so another
+/// view sees one when its surface lies within that of it, or within its own
+/// tolerance when that is larger. Normals are read as
 /// nx[t*stride] ... (interleaved: stride 3; planes: stride 1). Rows are shared
 /// among `threads` workers; the result does not depend on their number.
 /// WX_FAIL when out of memory.
