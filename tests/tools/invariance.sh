@@ -9,6 +9,12 @@
 # Prints, per block size, the RMS difference over the mean between seeds, between
 # orientations, and their ratio (build/tools/texture_compare). Outputs in
 # BUILD/invariance/.
+#
+# ABSORB=1: every drop absorbed at its first hit (every Surface's absorption
+# 1), with the exposure from straight above (`<Exposure name="exp"
+# elevation="90"/>`, the exact density up to a factor where nothing slides)
+# in the same TextureMap; the comparison reads its `dirt.Y`. What the rain's
+# first hits and the gather give, without the slides.
 set -eu
 build=$1
 mesh=$2
@@ -34,6 +40,14 @@ sed -e 's/<Wind strength="[0-9.e+-]*"/<Wind strength="0"/' -e 's/spread="[0-9.]*
 end=$(grep -o ' end="[^"]*"' "$dir/turned.tmp" | head -1 | sed 's/.*"\(.*\)"/\1/')
 rate=$(awk -v n="$particles" -v e="$end" 'BEGIN { printf "%.0f", n / e }')
 sed -e "s/rate=\"[0-9.e+-]*\"/rate=\"$rate\"/" "$dir/turned.tmp" > "$dir/turned.xml"
+channel=Y
+if [ "${ABSORB:-0}" = 1 ]; then
+    sed -e 's/absorption="[0-9.e+-]*"/absorption="1"/' \
+        -e 's|^  <Geometry>|  <Masks><Exposure name="exp" elevation="90"/></Masks>\n  <Geometry>|' \
+        "$dir/turned.xml" > "$dir/turned.tmp"
+    mv "$dir/turned.tmp" "$dir/turned.xml"
+    channel=dirt.Y
+fi
 sed -e 's|turned.obj|model.obj|' -e 's|turned_texture.exr|model_texture.exr|' \
     "$dir/turned.xml" > "$dir/model.xml"
 for m in model turned; do
@@ -43,10 +57,10 @@ for m in model turned; do
     done
 done
 c=$build/tools/texture_compare
-$c "$dir/model1/model_texture.exr" "$dir/model2/model_texture.exr" > "$dir/seeds_model"
-$c "$dir/turned1/turned_texture.exr" "$dir/turned2/turned_texture.exr" > "$dir/seeds_turned"
-$c "$dir/model1/model_texture.exr" "$dir/turned1/turned_texture.exr" > "$dir/turn_1"
-$c "$dir/model2/model_texture.exr" "$dir/turned2/turned_texture.exr" > "$dir/turn_2"
+$c "$dir/model1/model_texture.exr" "$dir/model2/model_texture.exr" "$channel" > "$dir/seeds_model"
+$c "$dir/turned1/turned_texture.exr" "$dir/turned2/turned_texture.exr" "$channel" > "$dir/seeds_turned"
+$c "$dir/model1/model_texture.exr" "$dir/turned1/turned_texture.exr" "$channel" > "$dir/turn_1"
+$c "$dir/model2/model_texture.exr" "$dir/turned2/turned_texture.exr" "$channel" > "$dir/turn_2"
 for k in 1 2 4 8 16 32; do
     get() { awk -v k="$k" '$1 == "block" && $2 + 0 == k { print $4 }' "$dir/$1"; }
     awk -v k="$k" -v a="$(get seeds_model)" -v b="$(get seeds_turned)" -v c="$(get turn_1)" \
