@@ -325,6 +325,16 @@ static void borders(int64_t begin, int64_t end, int worker, void *context)
                         between = d;
                     }
                     world_point(job, x, y, between, p);
+                    // A point this view would not see itself lies on no
+                    // surface of the texel (a layer's neighbours holding
+                    // other surfaces, the depth between them in mid-air):
+                    // its centre's verdict stands for it.
+                    double uvd[3];
+                    wx_matrix_apply_affine(v->camera->wtc, p, uvd);
+                    if (!sees_projected(v, uvd, n, 0.0)) {
+                        owned += b->centre[t] > 0.5f;
+                        continue;
+                    }
                     owned += owner_within(job->views, job->count, p, n, job->c, slack) == job->c;
                 }
             }

@@ -63,7 +63,9 @@ int wx_owner_of(const wx_owner_view *views, int count, const double p[3], const 
 /// cut into 4 x 4 points, each decided on its own. Those points lie on the
 /// surface only to view c's precision (its tolerance at the texel), so another
 /// view sees one when its surface lies within that of it, or within its own
-/// tolerance when that is larger. Normals are read as
+/// tolerance when that is larger; a point view c would not see itself (its
+/// depth between neighbours that hold other surfaces) takes the centre's
+/// verdict. Normals are read as
 /// nx[t*stride] ... (interleaved: stride 3; planes: stride 1). Rows are shared
 /// among `threads` workers; the result does not depend on their number.
 /// WX_FAIL when out of memory.
