@@ -457,6 +457,15 @@ static bool before(const crossing *a, const crossing *b, const double view[3])
     return fa > 0.0 && !(fb > 0.0); // leaving (n . view > 0) first
 }
 
+// Where texel (i, j)'s view ray leaves the camera's d = 0 plane.
+static void texel_origin(const wx_camera *cam, int i, int j, float o[3])
+{
+    float uvd[3];
+    wx_map_texel_center(cam->width, cam->height, i, j, &uvd[0], &uvd[1]);
+    uvd[2] = 0.0f;
+    wx_camera_map_to_world(cam, uvd, o);
+}
+
 // Renders the first `layers` crossings of every texel's view ray (fx_render's
 // depth convention: distance from the camera's d = 0 plane), layer k's block
 // at k*W*H in each plane.
@@ -477,10 +486,8 @@ static void render_layers(const wx_camera *cam, const lay_world *world, int laye
     for (int j = 0; j < H; ++j) {
         for (int i = 0; i < W; ++i) {
             size_t t = (size_t)j * (size_t)W + (size_t)i;
-            float uvd[3], eye[3];
-            wx_map_texel_center(W, H, i, j, &uvd[0], &uvd[1]);
-            uvd[2] = 0.0f;
-            wx_camera_map_to_world(cam, uvd, eye);
+            float eye[3];
+            texel_origin(cam, i, j, eye);
             double o[3] = { eye[0], eye[1], eye[2] };
             crossing list[2 * 2 * FX_MAX_SOLIDS];
             int count = 0;
@@ -1024,10 +1031,8 @@ static void render_cylinder(const wx_camera *cam, int layers, float *depth, floa
     for (int j = 0; j < H; ++j) {
         for (int i = 0; i < W; ++i) {
             size_t t = (size_t)j * (size_t)W + (size_t)i;
-            float uvd[3], o[3];
-            wx_map_texel_center(W, H, i, j, &uvd[0], &uvd[1]);
-            uvd[2] = 0.0f;
-            wx_camera_map_to_world(cam, uvd, o);
+            float o[3];
+            texel_origin(cam, i, j, o);
             double at[4], n[4][2];
             int count = 0;
             // |o + s d|^2 = 1 in x, y: both roots, normals out.
