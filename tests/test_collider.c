@@ -457,6 +457,18 @@ static bool before(const crossing *a, const crossing *b, const double view[3])
     return fa > 0.0 && !(fb > 0.0); // leaving (n . view > 0) first
 }
 
+// Sorts a ray's crossings nearest first (insertion sort: a few per ray).
+static void sort_crossings(crossing *list, int count, const double view[3])
+{
+    for (int a = 1; a < count; ++a) {
+        for (int b = a; b > 0 && before(&list[b], &list[b - 1], view); --b) {
+            crossing x = list[b];
+            list[b] = list[b - 1];
+            list[b - 1] = x;
+        }
+    }
+}
+
 // Where texel (i, j)'s view ray leaves the camera's d = 0 plane.
 static void texel_origin(const wx_camera *cam, int i, int j, float o[3])
 {
@@ -507,13 +519,7 @@ static void render_layers(const wx_camera *cam, const lay_world *world, int laye
             // Nearest first; where two solids touch (a post on a floor), the
             // leaving crossing before the entering one at the same depth, as
             // the collider needs (docs/physics.md, "Layered maps").
-            for (int a = 1; a < count; ++a) {
-                for (int b = a; b > 0 && before(&list[b], &list[b - 1], d); --b) {
-                    crossing x = list[b];
-                    list[b] = list[b - 1];
-                    list[b - 1] = x;
-                }
-            }
+            sort_crossings(list, count, d);
             for (int k = 0; k < layers; ++k) {
                 size_t at = (size_t)k * n + t;
                 maps->depth[at] = k < count ? (float)list[k].t : INFINITY;
@@ -1025,33 +1031,35 @@ static void render_cylinder(const wx_camera *cam, int layers, float *depth, floa
 {
     int W = cam->width, H = cam->height;
     size_t plane = (size_t)W * (size_t)H;
-    float d[3];
-    wx_camera_view_dir(cam, d);
+    float dir[3];
+    wx_camera_view_dir(cam, dir);
+    const double d[3] = { dir[0], dir[1], dir[2] };
     const double lo[2] = { 1.5, -1.0 }, hi[2] = { 2.0, 1.2 };
     for (int j = 0; j < H; ++j) {
         for (int i = 0; i < W; ++i) {
             size_t t = (size_t)j * (size_t)W + (size_t)i;
             float o[3];
             texel_origin(cam, i, j, o);
-            double at[4], n[4][2];
+            crossing list[4];
             int count = 0;
             // |o + s d|^2 = 1 in x, y: both roots, normals out.
-            double a = (double)d[0] * d[0] + (double)d[1] * d[1];
-            double b = 2.0 * ((double)o[0] * d[0] + (double)o[1] * d[1]);
+            double a = d[0] * d[0] + d[1] * d[1];
+            double b = 2.0 * (o[0] * d[0] + o[1] * d[1]);
             double c = (double)o[0] * o[0] + (double)o[1] * o[1] - 1.0;
             double disc = b * b - 4.0 * a * c;
             for (int r = 0; r < 2 && a > 0.0 && disc > 0.0; ++r) {
                 double s = (-b + (r == 0 ? -1.0 : 1.0) * sqrt(disc)) / (2.0 * a);
-                at[count] = s;
-                n[count][0] = o[0] + s * d[0];
-                n[count][1] = o[1] + s * d[1];
-                count++;
+                crossing *x = &list[count++];
+                x->t = s;
+                x->n[0] = (float)(o[0] + s * d[0]);
+                x->n[1] = (float)(o[1] + s * d[1]);
+                x->n[2] = 0.0f;
             }
             // The block: the slabs in x and y (the cameras look along an axis).
             double enter = -INFINITY, leave = INFINITY;
             int in_axis = -1, out_axis = -1;
             for (int k = 0; k < 2; ++k) {
-                if (d[k] == 0.0f) {
+                if (d[k] == 0.0) {
                     if (o[k] < lo[k] || o[k] > hi[k]) {
                         leave = -INFINITY;
                     }
@@ -1068,32 +1076,20 @@ static void render_cylinder(const wx_camera *cam, int layers, float *depth, floa
                 }
             }
             if (in_axis >= 0 && out_axis >= 0 && enter <= leave) {
-                at[count] = enter;
-                n[count][0] = in_axis == 0 ? -copysign(1.0, d[0]) : 0.0;
-                n[count][1] = in_axis == 1 ? -copysign(1.0, d[1]) : 0.0;
-                count++;
-                at[count] = leave;
-                n[count][0] = out_axis == 0 ? copysign(1.0, d[0]) : 0.0;
-                n[count][1] = out_axis == 1 ? copysign(1.0, d[1]) : 0.0;
-                count++;
+                crossing in = { enter, { 0.0f, 0.0f, 0.0f } };
+                crossing out = { leave, { 0.0f, 0.0f, 0.0f } };
+                in.n[in_axis] = (float)-copysign(1.0, d[in_axis]);
+                out.n[out_axis] = (float)copysign(1.0, d[out_axis]);
+                list[count++] = in;
+                list[count++] = out;
             }
-            for (int x = 1; x < count; ++x) { // nearest first
-                for (int y = x; y > 0 && at[y] < at[y - 1]; --y) {
-                    double ta = at[y], na[2] = { n[y][0], n[y][1] };
-                    at[y] = at[y - 1];
-                    n[y][0] = n[y - 1][0];
-                    n[y][1] = n[y - 1][1];
-                    at[y - 1] = ta;
-                    n[y - 1][0] = na[0];
-                    n[y - 1][1] = na[1];
-                }
-            }
+            sort_crossings(list, count, d);
             for (int k = 0; k < layers; ++k) {
                 size_t q = (size_t)k * plane + t;
-                depth[q] = k < count ? (float)at[k] : INFINITY;
-                normal[3 * q] = k < count ? (float)n[k][0] : 0.0f;
-                normal[3 * q + 1] = k < count ? (float)n[k][1] : 0.0f;
-                normal[3 * q + 2] = 0.0f;
+                depth[q] = k < count ? (float)list[k].t : INFINITY;
+                for (int e = 0; e < 3; ++e) {
+                    normal[3 * q + e] = k < count ? list[k].n[e] : 0.0f;
+                }
             }
         }
     }

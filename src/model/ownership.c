@@ -320,21 +320,20 @@ static void borders(int64_t begin, int64_t end, int worker, void *context)
             for (int sy = 0; sy < SUB; ++sy) {
                 for (int sx = 0; sx < SUB; ++sx) {
                     double x = i + (sx + 0.5) / SUB - 0.5, y = (double)j + (sy + 0.5) / SUB - 0.5;
-                    double own, between, p[3];
-                    if (!depth_at(v->depth, W, H, x, y, &own, &between)) {
-                        between = d;
-                    }
-                    world_point(job, x, y, between, p);
-                    // A point this view would not see itself lies on no
-                    // surface of the texel (a layer's neighbours holding
-                    // other surfaces, the depth between them in mid-air):
-                    // its centre's verdict stands for it.
-                    double uvd[3];
-                    wx_matrix_apply_affine(v->camera->wtc, p, uvd);
-                    if (!sees_projected(v, uvd, n, 0.0)) {
+                    double own = d, between = d, p[3];
+                    (void)depth_at(v->depth, W, H, x, y, &own, &between); // texel t holds d
+                    // A point this view would not see itself (the depth
+                    // between the texel centres off the texel's own by more
+                    // than the rule's tolerance: a layer's neighbours holding
+                    // other surfaces, the point in mid-air) lies on no
+                    // surface of the texel: its centre's verdict stands for
+                    // it. (wx_owner_sees' test of this view at p, without
+                    // projecting p back: p's texel is t, whose normal is n.)
+                    if (!(fabs(between - own) <= tolerance(v, n, between, own))) {
                         owned += b->centre[t] > 0.5f;
                         continue;
                     }
+                    world_point(job, x, y, between, p);
                     owned += owner_within(job->views, job->count, p, n, job->c, slack) == job->c;
                 }
             }
