@@ -14,10 +14,11 @@
 
 #include "ensure.h"
 
-/// Runs `weathering run SCENE --out DIR -q` (with `--stats STATS` unless
+/// Runs `weathering COMMAND SCENE --out DIR -q` (with `--stats STATS` unless
 /// stats is NULL) from the repository's root and returns its peak resident
 /// memory in MiB (wait4's ru_maxrss), or -1 when it did not exit with status 0.
-static inline double run_peak_mib(const char *scene, const char *dir, const char *stats)
+static inline double command_peak_mib(const char *command, const char *scene, const char *dir,
+                                      const char *stats)
 {
     char program[4200];
     snprintf(program, sizeof program, "%s/weathering", ensure_build_dir());
@@ -27,10 +28,10 @@ static inline double run_peak_mib(const char *scene, const char *dir, const char
         dup2(null, STDOUT_FILENO);
         dup2(null, STDERR_FILENO);
         if (stats != NULL) {
-            execl(program, program, "run", scene, "--out", dir, "-q", "--stats", stats,
+            execl(program, program, command, scene, "--out", dir, "-q", "--stats", stats,
                   (char *)NULL);
         } else {
-            execl(program, program, "run", scene, "--out", dir, "-q", (char *)NULL);
+            execl(program, program, command, scene, "--out", dir, "-q", (char *)NULL);
         }
         _exit(98);
     }
@@ -41,6 +42,12 @@ static inline double run_peak_mib(const char *scene, const char *dir, const char
         return -1.0;
     }
     return (double)usage.ru_maxrss / 1024.0;
+}
+
+/// command_peak_mib of `weathering run`.
+static inline double run_peak_mib(const char *scene, const char *dir, const char *stats)
+{
+    return command_peak_mib("run", scene, dir, stats);
 }
 
 /// info's "memory: about N MiB at the peak" of a scene; -1 when info fails (the

@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/big_alloc.h"
 #include "core/dist.h"
 #include "core/progress.h"
 #include "model/geometry.h"
@@ -168,6 +169,11 @@ wx_result wx_run_phases(wx_scene *scene, const wx_run_def *opts, unsigned phases
         report->times.bake = wx_now_s() - t0;
     }
     wx_geometry_free(&geometry);
+    if (phases & WX_PHASE_BAKE) {
+        // What the renderer and the meshes freed stays resident in the heap
+        // unless given back: the phases after it would sit on it.
+        wx_release_freed_memory();
+    }
     if (r == WX_OK && (phases & WX_PHASE_SIMULATE)) {
         // An MPI run's other ranks join the simulation now that the maps are
         // baked (wx_simulate_follow; nothing with one process).

@@ -76,7 +76,7 @@ typedef struct wx_bake_def {
     /// (the initial-dirt visibility test needs every input camera's depth when
     /// some surface starts with dirt), or NULL when no such camera is needed.
     const wx_maps *given_depth;
-    int threads;              ///< llvmpipe's threads (LP_NUM_THREADS unless set)
+    int threads;              ///< worker threads (the initial dirt's visibility test)
     bool quiet;               ///< no progress bar, no warnings
     wx_bake_maps_fn *on_maps; ///< called once per baked camera, in scene order
     void *user;

@@ -92,11 +92,14 @@ static wx_result create_program(baker *b, wx_error *err)
 wx_result bake_create_context(baker *b, wx_error *err)
 {
     // llvmpipe takes its thread count from the environment when it starts.
-    if (b->def->threads > 0 && getenv("LP_NUM_THREADS") == NULL) {
-        char n[16];
-        snprintf(n, sizeof n, "%d", b->def->threads);
-        setenv("LP_NUM_THREADS", n, 0);
-    }
+    // With rasteriser threads it starts a new scene (its binned triangles,
+    // up to 36 MiB each) whenever drawing outruns them and keeps each one
+    // until the context ends: 70 to 150 MiB more on the shipped scenes, and
+    // a count that depends on the threads' timing, so no estimate bounds it.
+    // Rasterising on the calling thread keeps one scene; on two cores the
+    // bake takes about as long (docs/reliability.md, "Memory estimate").
+    // A user's LP_NUM_THREADS wins.
+    setenv("LP_NUM_THREADS", "0", 0);
     const int attribs[] = { OSMESA_FORMAT,
                             OSMESA_RGBA,
                             OSMESA_DEPTH_BITS,
