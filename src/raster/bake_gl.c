@@ -94,7 +94,7 @@ wx_result bake_create_context(baker *b, wx_error *err)
     // llvmpipe takes its thread count from the environment when it starts.
     // With rasteriser threads it starts a new scene (its binned triangles,
     // up to 36 MiB each) whenever drawing outruns them and keeps each one
-    // until the context ends: 70 to 150 MiB more on the shipped scenes, and
+    // until the context ends: 110 to 180 MiB more on the shipped scenes, and
     // a count that depends on the threads' timing, so no estimate bounds it.
     // Rasterising on the calling thread keeps one scene; on two cores the
     // bake takes about as long (docs/reliability.md, "Memory estimate").
