@@ -23,9 +23,9 @@ void *wx_big_calloc(size_t count, size_t size);
 /// Gives the pages of freed heap memory back to the kernel (glibc's
 /// malloc_trim; nothing elsewhere). glibc keeps what a phase freed in its
 /// heap, resident, below what is still allocated: after the bake that is the
-/// renderer's scenes and the smooth surfaces, 120 to 240 MiB on the shipped
-/// scenes, which the simulation and the gather would otherwise sit on
-/// (docs/reliability.md, "Memory estimate").
+/// renderer's scene and the smooth surfaces, 110 to 130 MiB on the teapot,
+/// Spot and the bunny, which the simulation and the gather would otherwise
+/// sit on (docs/reliability.md, "What the renderer keeps").
 void wx_release_freed_memory(void);
 
 /// Below this many bytes (one huge page) a block is plain malloc.

@@ -169,9 +169,10 @@ wx_result wx_run_phases(wx_scene *scene, const wx_run_def *opts, unsigned phases
         report->times.bake = wx_now_s() - t0;
     }
     wx_geometry_free(&geometry);
-    if (phases & WX_PHASE_BAKE) {
+    if ((phases & WX_PHASE_BAKE) && (phases & (WX_PHASE_SIMULATE | WX_PHASE_GATHER))) {
         // What the renderer and the meshes freed stays resident in the heap
-        // unless given back: the phases after it would sit on it.
+        // unless given back: the phases after it would sit on it (a command
+        // that only bakes ends here).
         wx_release_freed_memory();
     }
     if (r == WX_OK && (phases & WX_PHASE_SIMULATE)) {

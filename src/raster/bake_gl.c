@@ -97,7 +97,7 @@ wx_result bake_create_context(baker *b, wx_error *err)
     // until the context ends: 110 to 180 MiB more on the shipped scenes, and
     // a count that depends on the threads' timing, so no estimate bounds it.
     // Rasterising on the calling thread keeps one scene; on two cores the
-    // bake takes about as long (docs/reliability.md, "Memory estimate").
+    // bake takes about as long (docs/reliability.md, "What the renderer keeps").
     // A user's LP_NUM_THREADS wins.
     setenv("LP_NUM_THREADS", "0", 0);
     const int attribs[] = { OSMESA_FORMAT,
