@@ -10,6 +10,15 @@
 # orientations, and their ratio (build/tools/texture_compare). Outputs in
 # BUILD/invariance/.
 #
+# SEEDS=N (default 2, the issue's measure): seeds 1 to N for each orientation;
+# with N > 2 it also prints the figures over every pair: the seeds' as the
+# quadratic mean over the N(N-1)/2 pairs of each orientation (with the least
+# and the largest pair), the orientations' over the N same-seed pairs. One
+# pair of seeds is not a steady yardstick: with low-discrepancy starts the
+# noise of a run is a pattern that a seed shifts, and two seeds can differ
+# less or more by chance (docs/performance.md, "How steady one pair of seeds
+# is").
+#
 # ABSORB=1: every drop absorbed at its first hit (every Surface's absorption
 # 1), with the exposure from straight above (`<Exposure name="exp"
 # elevation="90"/>`, the exact density up to a factor where nothing slides)
@@ -50,8 +59,12 @@ if [ "${ABSORB:-0}" = 1 ]; then
 fi
 sed -e 's|turned.obj|model.obj|' -e 's|turned_texture.exr|model_texture.exr|' \
     "$dir/turned.xml" > "$dir/model.xml"
+seeds=${SEEDS:-2}
+case $seeds in
+'' | *[!0-9]* | 0 | 1) echo "invariance.sh: SEEDS must be 2 or more" >&2; exit 2 ;;
+esac
 for m in model turned; do
-    for s in 1 2; do
+    for s in $(seq 1 "$seeds"); do
         echo "invariance: $m, seed $s" >&2
         (cd "$dir" && "../weathering" run "$m.xml" --out "$m$s" --seed "$s" -q)
     done
@@ -67,3 +80,23 @@ for k in 1 2 4 8 16 32; do
         -v d="$(get turn_2)" 'BEGIN { s = (a + b) / 2; o = (c + d) / 2
         printf "block %2d: seeds %.4f  orientations %.4f  ratio %.3f\n", k, s, o, o / s }'
 done
+[ "$seeds" -gt 2 ] || exit 0
+# Every pair: one line per comparison, "kind block rms".
+for m in model turned; do
+    for s in $(seq 1 "$seeds"); do
+        for t in $(seq $((s + 1)) "$seeds"); do
+            $c "$dir/$m$s/${m}_texture.exr" "$dir/$m$t/${m}_texture.exr" "$channel" |
+                awk '$1 == "block" { print "seeds", $2 + 0, $4 }'
+        done
+    done
+done > "$dir/pairs"
+for s in $(seq 1 "$seeds"); do
+    $c "$dir/model$s/model_texture.exr" "$dir/turned$s/turned_texture.exr" "$channel" |
+        awk '$1 == "block" { print "orientations", $2 + 0, $4 }'
+done >> "$dir/pairs"
+echo "over every pair of seeds 1 to $seeds:"
+awk '{ q[$1, $2] += $3 * $3; n[$1, $2]++
+       if ($1 == "seeds") { if (!(($2) in lo) || $3 < lo[$2]) lo[$2] = $3; if ($3 > hi[$2]) hi[$2] = $3 } }
+     END { for (k = 1; k <= 32; k *= 2) if (n["seeds", k] > 0) {
+               s = sqrt(q["seeds", k] / n["seeds", k]); o = sqrt(q["orientations", k] / n["orientations", k])
+               printf "block %2d: seeds %.4f (pairs %.4f to %.4f)  orientations %.4f  ratio %.3f\n", k, s, lo[k], hi[k], o, o / s } }' "$dir/pairs"
