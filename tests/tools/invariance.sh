@@ -28,6 +28,10 @@ set -eu
 build=$1
 mesh=$2
 particles=${3:-810000}
+seeds=${SEEDS:-2}
+case $seeds in
+'' | *[!0-9]* | 0 | 1) echo "invariance.sh: SEEDS must be 2 or more" >&2; exit 2 ;;
+esac
 dir=$build/invariance
 rm -rf "$dir"
 mkdir -p "$dir"
@@ -59,10 +63,6 @@ if [ "${ABSORB:-0}" = 1 ]; then
 fi
 sed -e 's|turned.obj|model.obj|' -e 's|turned_texture.exr|model_texture.exr|' \
     "$dir/turned.xml" > "$dir/model.xml"
-seeds=${SEEDS:-2}
-case $seeds in
-'' | *[!0-9]* | 0 | 1) echo "invariance.sh: SEEDS must be 2 or more" >&2; exit 2 ;;
-esac
 for m in model turned; do
     for s in $(seq 1 "$seeds"); do
         echo "invariance: $m, seed $s" >&2
