@@ -13,8 +13,8 @@
 # gather and the texture do with the same deposits in the other camera grid;
 # common_part.py keeps the part both seeds share. Both the real orientations'
 # part and the replay's are printed. Extra arguments are environment settings
-# both runs get (the patch's knobs: WX_NOCLEAN=1, WX_TEXP=P, WX_NOSMOOTH=1,
-# WX_MAXR=F).
+# both runs get (the patch's switches, listed at its top: WX_NOCLEAN=1,
+# WX_TEXP=P, WX_MAXR=F, ...).
 set -eu
 build=$1
 shift
