@@ -15,17 +15,19 @@
 # model's own maps (the control), then gathers each. What the turned replay
 # differs from the control is what the gather and the texture do with the
 # same deposits in the other camera grid; common_part.py keeps the part both
-# seeds share. Printed: the simulated orientations' part, the control's
-# against the model (the cost of the replay itself) and the turned replay's
-# against the control. Extra arguments are environment settings
-# both runs get (the patch's switches, listed at its top: WX_NOCLEAN=1,
-# WX_TEXP=P, WX_MAXR=F, ...).
+# seeds share. Printed: the simulated orientations' part (invariance.sh's own
+# runs, which no switch touched), the control's against the model run here
+# (the cost of the replay itself) and the turned replay's against the
+# control. Extra arguments are environment settings every run here gets (the
+# patch's switches, listed at its top: WX_NOCLEAN=1, WX_TEXP=P, WX_MAXR=F,
+# ...).
 set -eu
 build=$1
 shift
 dir=$build/invariance
 here=$(cd "$(dirname "$0")" && pwd)
-[ -f "$dir/model.xml" ] && [ -f "$dir/turned1/turned_texture.exr" ] ||
+[ -f "$dir/model.xml" ] && [ -f "$dir/model2/model_texture.exr" ] &&
+    [ -f "$dir/turned2/turned_texture.exr" ] ||
     { echo "transplant.sh: run tests/tools/invariance.sh $build MESH first" >&2; exit 2; }
 read cx cz < "$dir/centre"
 out=$dir/transplant
@@ -44,8 +46,9 @@ for s in 1 2; do
         ../weathering run turned_replay.xml --out "transplant/replay$s" -q)
     (cd "$dir" && env "$@" WX_CX="$cx" WX_CZ="$cz" WX_ANGLE=0 WX_REPLAY="$out/dump$s.bin" \
         ../weathering run model_replay.xml --out "transplant/control$s" -q)
-    for r in model replay control turned; do
+    for r in simulated model replay control turned; do
         case $r in
+        simulated) f=$dir/model$s/model_texture.exr ;;
         model) f=$out/model$s/model_texture.exr ;;
         replay) f=$out/replay$s/turned_texture.exr ;;
         control) f=$out/control$s/model_texture.exr ;;
@@ -56,7 +59,7 @@ for s in 1 2; do
     done
 done
 echo "the model turned, as simulated (turned - model, seeds 1 and 2):"
-python3 "$here/common_part.py" "$out/turned1" "$out/model1" "$out/turned2" "$out/model2" "$channel"
+python3 "$here/common_part.py" "$out/turned1" "$out/simulated1" "$out/turned2" "$out/simulated2" "$channel"
 echo "the deposits put back in the model's own grid (control - model):"
 python3 "$here/common_part.py" "$out/control1" "$out/model1" "$out/control2" "$out/model2" "$channel"
 echo "the same deposits gathered in the turned grid (replay - control):"
