@@ -365,7 +365,10 @@ static bool spread_record(const wx_collider *collider, int a, const fill_record 
             if (i < 0 || j < 0 || i >= B->width || j >= B->height) {
                 continue;
             }
-            bool own = i == (int)r->X && j == (int)r->Y;
+            // A clipped texel's centre lies outside the surface: it is never
+            // the sample's own, whose fill may make the rest of the texel's
+            // ray solid where no layer is left for an interval (apply_layers).
+            bool own = !r->clipped && i == (int)r->X && j == (int)r->Y;
             // A texel around that is solid there already needs none (a face
             // between two texel centres: the texel inside holds the solid,
             // and a fill there would only hide its free space further on).
