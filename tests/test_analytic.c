@@ -397,8 +397,10 @@ TEST(shelter_edge_at_30_degrees_to_the_cameras_is_straight)
 // writes beside the dirt in the same TextureMap. Once as it is and once turned
 // 30 degrees about the vertical, with the same cameras and drops.
 // Written as `name` in `dir`; inward: every face wound the other way, as an
-// export with flipped normals gives it.
-static void lumpy_sphere(const char *dir, const char *name, double turn_degrees, bool inward)
+// export with flipped normals gives it; squash: its heights scaled about
+// y = 1.2 (1 for the sphere).
+static void lumpy_sphere_squashed(const char *dir, const char *name, double turn_degrees,
+                                  bool inward, double squash)
 {
     static char obj[200000];
     const size_t size = sizeof obj;
@@ -410,7 +412,8 @@ static void lumpy_sphere(const char *dir, const char *name, double turn_degrees,
         for (int i = 0; i <= nu; ++i) {
             double th = 2.0 * M_PI * i / nu;
             double r = 1.0 + 0.12 * sin(3.0 * th) * sin(2.0 * ph) + 0.08 * cos(5.0 * ph);
-            double x = r * sin(ph) * cos(th), y = r * cos(ph) + 1.2, z = r * sin(ph) * sin(th);
+            double x = r * sin(ph) * cos(th), y = squash * r * cos(ph) + 1.2;
+            double z = r * sin(ph) * sin(th);
             n += (size_t)snprintf(obj + n, size - n, "v %.6f %.6f %.6f\n", c * x + s * z, y,
                                   -s * x + c * z);
         }
@@ -438,6 +441,11 @@ static void lumpy_sphere(const char *dir, const char *name, double turn_degrees,
         }
     }
     ensure_write_file(dir, name, obj);
+}
+
+static void lumpy_sphere(const char *dir, const char *name, double turn_degrees, bool inward)
+{
+    lumpy_sphere_squashed(dir, name, turn_degrees, inward, 1.0);
 }
 
 // 400 000 drops over 3 x 3 m: F = 44 444 per square metre. Input cameras of
@@ -551,8 +559,9 @@ static bool run_lumpy(const char *dir, const char *model, int seed, int layers, 
 // (docs/physics.md, "Which camera's surface a particle meets") the sliding
 // followed whichever camera's surface lay innermost: 0.0235, 0.0300, 1.277.
 // The run is deterministic, so the bound between the two tells them apart;
-// issue 25's 1.05 is not met (docs/performance.md).
-#define MAX_TURN_RATIO 1.24
+// issue 25's 1.05 is not met (docs/performance.md). 6 December 2026, with the
+// margins' reach at 32 texels and the fills' fix: 0.0220, 0.0256, 1.161.
+#define MAX_TURN_RATIO 1.20
 TEST(lumpy_sphere_turned_slides_as_a_new_seed_does)
 {
     SLOW();
@@ -604,6 +613,78 @@ TEST(lumpy_sphere_turned_slides_as_a_new_seed_does)
            "ratio %.3f\n",
            blocks, seeds, turn, turn / seeds);
     ENSURE(turn <= MAX_TURN_RATIO * seeds);
+}
+
+// Contour lines on a flat top (docs/physics.md, "Contour lines on flat
+// tops"): the lumpy sphere squashed to 0.35 of its height, a dome whose top
+// the side cameras see at grazing angles, under the rain preset's sliding
+// drops, five cameras of four layers. Between two of its rows' crossings a
+// side camera's surface lies inside a curved top; a margin capped at two
+// texels left those grooves, one per row along lines of equal height, and
+// the sliding drops drew them in the top camera's hits. Binned by where the
+// height of each top texel with N.y > 0.97 lies within the side cameras' rows
+// (ten bins), the hits per texel (0.44 each, 64 644 texels) varied by 3.2% RMS
+// from bin to bin then (0.94 to 1.05 of their mean); with the margin's reach
+// at 32 texels, by 1.2% (0.99 to 1.03), about what 2 800 hits per bin leave.
+// The run is deterministic, so the bound between the two tells them apart.
+TEST(sliding_rain_draws_no_contours_on_a_flat_top)
+{
+    SLOW();
+    const char *dir = ensure_tmpdir();
+    lumpy_sphere_squashed(dir, "dome.obj", 0.0, false, 0.35);
+    float *dirt = NULL, *sun = NULL, *seen = NULL;
+    ENSURE(run_lumpy_with(dir, "dome", 1, 4, &SLIDE, &dirt, &sun, &seen));
+    free(dirt);
+    free(sun);
+    free(seen);
+    char path[4300];
+    int w[3], h[3];
+    snprintf(path, sizeof path, "%s/dome1_4_s/top_depth.exr", dir);
+    float *depth = ensure_read_channel(path, "R", &w[0], &h[0]);
+    snprintf(path, sizeof path, "%s/dome1_4_s/top_normal.exr", dir);
+    float *ny = ensure_read_channel(path, "G", &w[1], &h[1]);
+    snprintf(path, sizeof path, "%s/dome1_4_s/top_dirt.exr", dir);
+    float *hits = ensure_read_channel(path, "hits", &w[2], &h[2]);
+    ENSURE(depth != NULL && ny != NULL && hits != NULL);
+    const int px = SLIDE.resolution;
+    for (int k = 0; k < 3; ++k) {
+        ENSURE(w[k] == px && h[k] == px);
+    }
+    // The top camera's eye is at y = 5; the side cameras' rows are 3 / px
+    // tall from y = 1.2 - 1.5.
+    enum { BINS = 10 };
+    double sum[BINS] = { 0 }, count[BINS] = { 0 };
+    const double row = 3.0 / px;
+    for (size_t t = 0; t < (size_t)px * (size_t)px; ++t) {
+        if (!(depth[t] < 1e6f) || !(ny[t] > 0.97f) || !isfinite(hits[t])) {
+            continue;
+        }
+        double height = 5.0 - depth[t];
+        double phase = (height - (1.2 - 1.5)) / row;
+        int bin = (int)((phase - floor(phase)) * BINS) % BINS;
+        sum[bin] += hits[t];
+        count[bin] += 1.0;
+    }
+    free(depth);
+    free(ny);
+    free(hits);
+    double mean = 0.0, spread = 0.0, least = INFINITY, most = 0.0, texels = 0.0;
+    for (int b = 0; b < BINS; ++b) {
+        ENSURE(count[b] > 500.0);
+        mean += sum[b] / count[b] / BINS;
+        texels += count[b];
+    }
+    for (int b = 0; b < BINS; ++b) {
+        double r = sum[b] / count[b] / mean;
+        spread += (r - 1.0) * (r - 1.0) / BINS;
+        least = fmin(least, r);
+        most = fmax(most, r);
+    }
+    spread = sqrt(spread);
+    printf("        %.0f top texels with N.y > 0.97, %.2f hits each: by the height's place in "
+           "the side cameras' rows %.3f to %.3f of the mean, %.4f RMS\n",
+           texels, mean, least, most, spread);
+    ENSURE(spread < 0.02);
 }
 
 // Measured (3 December 2026): each run within 1.6% RMS of the exact density
@@ -805,6 +886,7 @@ int main(void)
     RUN(shelter_edge_at_30_degrees_to_the_cameras_is_straight);
     RUN(lumpy_sphere_turned_in_the_camera_grid_keeps_its_exact_rain);
     RUN(lumpy_sphere_turned_slides_as_a_new_seed_does);
+    RUN(sliding_rain_draws_no_contours_on_a_flat_top);
     RUN(lumpy_sphere_bottom_stays_dry_under_a_layered_top_camera);
     RUN(lumpy_sphere_wound_inwards_weathers_as_wound_outwards);
     return ensure_summary();

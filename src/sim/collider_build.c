@@ -299,8 +299,14 @@ static void classify_layers(wx_collider_camera *cam)
 // full texel's last one) towards the camera, a leaving face away from it; a
 // sheet's slab stays. The most head-on camera keeps its surface, which is
 // then the collision surface, and the others' solids reach past it. At most
-// MARGIN_MAX_TAN half texels.
-#define MARGIN_MAX_TAN 4.0
+// MARGIN_MAX_TAN half texels: 32 texels, the whole margin of a slope down to
+// 0.9 degrees. A cap of two texels (tan 4, slopes of 14 degrees) left a side
+// camera's rows, each a step of texel * tan(theta) along its axis, cutting
+// notches a fraction of its texel deep into a near-flat top along lines of
+// equal height; sliding rain hit 15-20% more or less by the height's place
+// within those rows (docs/physics.md, "Which camera's surface a particle
+// meets").
+#define MARGIN_MAX_TAN 64.0
 
 static double tan_of_cos(double c)
 {
