@@ -300,12 +300,11 @@ static void classify_layers(wx_collider_camera *cam)
 // sheet's slab stays. The most head-on camera keeps its surface, which is
 // then the collision surface, and the others' solids reach past it. At most
 // MARGIN_MAX_TAN half texels: 32 texels, the whole margin of a slope down to
-// 0.9 degrees. A cap of two texels (tan 4, slopes of 14 degrees) left a side
-// camera's rows, each a step of texel * tan(theta) along its axis, cutting
-// notches a fraction of its texel deep into a near-flat top along lines of
-// equal height; sliding rain hit 15-20% more or less by the height's place
-// within those rows (docs/physics.md, "Which camera's surface a particle
-// meets").
+// 0.9 degrees. Between two of a side camera's rows' crossings its surface
+// lies inside a curved near-flat top; capped at two texels (tan 4, slopes of
+// 14 degrees) the margin left grooves there along lines of equal height, and
+// sliding rain hit up to 16% more or less by the height's place within those
+// rows (docs/physics.md, "Contour lines on flat tops").
 #define MARGIN_MAX_TAN 64.0
 
 static double tan_of_cos(double c)
