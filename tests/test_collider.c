@@ -1163,6 +1163,24 @@ TEST(a_grazing_silhouette_owns_nothing_another_view_sees_head_on)
     ENSURE(wrong_side == 0);
 }
 
+// 40 drops falling straight down from height `top` to below the floor
+// (y = 0), at x across -1.5..1.35 and z = z0 + dz * i: those that hit the
+// floor, to within the front camera's texel (its ramp from the floor's front
+// to the wall, as with one layer), and those stopped above it.
+static void drop_onto_the_floor(const wx_collider *col, float top, float z0, float dz, int *landed,
+                                int *stopped)
+{
+    for (int i = 0; i < 40; ++i) {
+        float x = -1.5f + 0.0731f * (float)i, z = z0 + dz * (float)i;
+        float a[3] = { x, top, z }, b[3] = { x, -0.4f, z };
+        wx_hit hit;
+        if (wx_collider_sweep(col, a, b, &hit)) {
+            *landed += fabsf(hit.point[1]) <= 0.05f;
+            *stopped += hit.point[1] > 0.05f;
+        }
+    }
+}
+
 // A handrail in front of a wall, under two slabs that use up the top camera's
 // four layers (so below them it cannot tell free space: its tail). In the
 // front camera's row where the handrail ends, layer 0 is the handrail in one
@@ -1183,17 +1201,7 @@ TEST(layer_ramp_does_not_jump_from_a_handrail_to_the_wall_behind)
     wx_collider col;
     ENSURE(build_layers(&col, cams, maps, 2, &world, 4));
     int stopped = 0, landed = 0;
-    for (int i = 0; i < 40; ++i) {
-        float x = -1.5f + 0.0731f * (float)i, z = 0.2f + 0.023f * (float)i;
-        float a[3] = { x, 1.6f, z }, b[3] = { x, -0.4f, z };
-        wx_hit hit;
-        if (wx_collider_sweep(&col, a, b, &hit)) {
-            // On the floor, to within the front camera's texel (its ramp
-            // from the floor's front to the wall, as with one layer).
-            stopped += hit.point[1] > 0.05f;
-            landed += fabsf(hit.point[1]) <= 0.05f;
-        }
-    }
+    drop_onto_the_floor(&col, 1.6f, 0.2f, 0.023f, &landed, &stopped);
     release(&col, maps, 2);
     ENSURE(stopped == 0);
     ENSURE(landed == 40);
@@ -1365,15 +1373,7 @@ TEST(a_clipped_texel_without_room_is_not_made_solid)
     wx_collider col;
     ENSURE(build_layers(&col, cams, maps, 2, &world, 4));
     int landed = 0, stopped = 0;
-    for (int i = 0; i < 40; ++i) {
-        float x = -1.5f + 0.0731f * (float)i, z = 0.1f + 0.02f * (float)i;
-        float a[3] = { x, 1.9f, z }, b[3] = { x, -0.4f, z };
-        wx_hit hit;
-        if (wx_collider_sweep(&col, a, b, &hit)) {
-            landed += fabsf(hit.point[1]) <= 0.05f;
-            stopped += hit.point[1] > 0.05f;
-        }
-    }
+    drop_onto_the_floor(&col, 1.9f, 0.1f, 0.02f, &landed, &stopped);
     printf("        front camera fills %lld texels; %d drops landed, %d stopped above the floor\n",
            (long long)col.cameras[0].fill_texels, landed, stopped);
     release(&col, maps, 2);
