@@ -18,6 +18,7 @@ follow the edge. For each angle (default 0 30 45) it prints:
   edge, divided by the exposed wall's, read as where a sharp edge would put
   that many hits (what the flight and the collider give, before the gather).
 
+EDGE_LAYERS=K gives the three input cameras `layers="K"` (default: one layer).
 Environment settings reach the runs, so a build of transplant.patch takes its
 switches (WX_NOCLEAN=1, WX_EDGECOV=1, ...). Needs numpy (Debian's python3-numpy:
 run it with /usr/bin/python3). docs/performance.md, "The gather's part lies on
@@ -53,6 +54,8 @@ def write_scene(d, angle):
     dx, dz = s / c, -1.0 / c
     cx, cz, half = -4.0 * dx, 4.0826, 2.732051 / c + 0.6
     rate = 3732050 * (2 * half) ** 2 / (2 * 2.732051) ** 2
+    layers = os.environ.get("EDGE_LAYERS", "")
+    layers = f' layers="{int(layers)}"' if layers else ""
     with open(os.path.join(d, "edge.xml"), "w") as f:
         f.write(f"""<Weathering>
   <Solver>
@@ -66,9 +69,9 @@ def write_scene(d, angle):
   </Emitters>
   <Collider>
     <ProjectedMaps>
-      <Ortho cameraName="front"><View eye="0 1.6 10" target="0 1.6 0" up="0 1 0" width="6" height="6" resolution="384"/></Ortho>
-      <Ortho cameraName="top"><View eye="0 10 0.5" target="0 0 0.5" up="0 0 -1" width="6" height="6" resolution="384"/></Ortho>
-      <Ortho cameraName="right"><View eye="10 1.6 0" target="0 1.6 0" up="0 1 0" width="6" height="6" resolution="384"/></Ortho>
+      <Ortho cameraName="front"{layers}><View eye="0 1.6 10" target="0 1.6 0" up="0 1 0" width="6" height="6" resolution="384"/></Ortho>
+      <Ortho cameraName="top"{layers}><View eye="0 10 0.5" target="0 0 0.5" up="0 0 -1" width="6" height="6" resolution="384"/></Ortho>
+      <Ortho cameraName="right"{layers}><View eye="10 1.6 0" target="0 1.6 0" up="0 1 0" width="6" height="6" resolution="384"/></Ortho>
       <Ortho cameraName="shot" out="true">
         <View eye="{0.4 * s} {2 - 0.4 * c} 10" target="{0.4 * s} {2 - 0.4 * c} 0" up="{-s} {c} 0"
               width="4" height="4" resolution="512"/>
