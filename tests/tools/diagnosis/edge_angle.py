@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """edge_angle.py BUILD DIR [ANGLE ...]: where a shelter edge lands, against the
 angle at which it crosses the input cameras' texels.
 
