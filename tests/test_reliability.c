@@ -732,6 +732,76 @@ TEST(out_of_memory_in_the_bake_is_exit_1)
     ENSURE(failed >= 2);
 }
 
+// A full disk while a run bakes (a tmpfs too small for the maps): exit status 1
+// naming the camera whose file did not fit, whether that file was written while
+// the next camera rendered or at the end; nothing torn, no temporary left.
+TEST(a_full_disk_in_the_bake_is_exit_1_naming_the_camera)
+{
+    SLOW();
+    char dir[PATH_MAX];
+    ENSURE(realpath(ensure_tmpdir(), dir) != NULL);
+    char mnt[PATH_MAX + 16];
+    snprintf(mnt, sizeof mnt, "%s/full", dir);
+    ENSURE(mkdir(mnt, 0777) == 0);
+    if (ensure_shell(out, sizeof out, "mount -t tmpfs -o size=64k tmpfs %s", mnt) != 0) {
+        SKIP("no tmpfs can be mounted here (needs root)");
+    }
+    // init's scene for the teapot at 256 texels: input cameras front, back, left,
+    // right and top (four layers each), then the output camera. The space each
+    // camera's files take on the tmpfs (whole pages), in the order they are written.
+    static const char *const cameras[] = { "front", "back", "left", "right", "top", "shot" };
+    ENSURE(ensure_shell(out, sizeof out,
+                        "%s/weathering init xml_scenes/meshes/teapot.obj --resolution 256 "
+                        "-o %s/teapot.xml -q && %s/weathering bake %s/teapot.xml --out %s/whole -q",
+                        ensure_build_dir(), dir, ensure_build_dir(), dir, dir) == 0);
+    long used[6] = { 0 };
+    for (int c = 0; c < 6; ++c) {
+        ENSURE(ensure_shell(out, sizeof out, "for f in %s/whole/%s_*.exr; do stat -c %%s $f; done",
+                            dir, cameras[c]) == 0);
+        for (char *line = out; *line != '\0'; line = strchr(line, '\n') + 1) {
+            used[c] += (atol(line) + 4095) / 4096 * 4096;
+            if (strchr(line, '\n') == NULL) {
+                break;
+            }
+        }
+        ENSURE(used[c] > 0);
+    }
+    // A disk that fills in the middle of the files of back (written while left
+    // renders, its failure met when left's are handed over) and of top (written
+    // while the output camera renders, met when the bake ends).
+    const int fill[] = { 1, 4 };
+    for (int k = 0; k < 2; ++k) {
+        long size = used[fill[k]] / 2;
+        for (int c = 0; c < fill[k]; ++c) {
+            size += used[c];
+        }
+        size = (size / 4096 + 1) * 4096;
+        ENSURE(ensure_shell(out, sizeof out, "mount -o remount,size=%ld %s", size, mnt) == 0);
+        char out_dir[sizeof mnt + 16];
+        snprintf(out_dir, sizeof out_dir, "%s/o%d", mnt, k);
+        int status = ensure_shell(out, sizeof out, "%s/weathering run %s/teapot.xml --out %s -q",
+                                  ensure_build_dir(), dir, out_dir);
+        char want[64];
+        snprintf(want, sizeof want, "weathering: bake camera '%s': ", cameras[fill[k]]);
+        bool ok = status == 1 && strncmp(out, want, strlen(want)) == 0 &&
+                  ensure_contains(out, "No space left on device");
+        if (!ok) {
+            fprintf(stderr, "        %ld bytes: expected \"%s...\", status 1, got %d: %s", size,
+                    want, status, out);
+        }
+        int files = 0, temps = 0;
+        bool read_back = outputs_read_back(out_dir, &files, &temps);
+        ensure_shell(out, sizeof out, "rm -rf %s", out_dir);
+        if (!ok || !read_back || temps != 0) {
+            ensure_shell(out, sizeof out, "umount %s", mnt);
+        }
+        ENSURE(ok);
+        ENSURE(read_back);
+        ENSURE(temps == 0);
+    }
+    ensure_shell(out, sizeof out, "umount %s", mnt);
+}
+
 int main(void)
 {
     RUN(bad_inputs_exit_2_with_their_message);
@@ -742,6 +812,7 @@ int main(void)
     RUN(output_names_fit_the_file_system_with_their_temporaries);
     RUN(no_output_is_written_non_finite);
     RUN(out_of_memory_in_the_bake_is_exit_1);
+    RUN(a_full_disk_in_the_bake_is_exit_1_naming_the_camera);
     RUN(sigint_stops_a_run_cleanly);
     RUN(sigkill_never_leaves_a_torn_file);
     return ensure_summary();

@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <pthread.h>
 
 #include "core/parallel.h"
 #include "io/exr.h"
@@ -27,28 +28,77 @@ typedef struct map_file {
     wx_error err;
 } map_file;
 
+// The map files of one baked camera, written together.
+typedef struct file_batch {
+    map_file files[4];
+    int count;
+    int threads;
+    char camera[WX_NAME_MAX]; ///< the camera's name, for errors
+} file_batch;
+
 typedef struct bake_writer {
     wx_scene *scene;
     const wx_run_def *opts;
     wx_maps *output_maps; ///< when not NULL: the output camera's depth and normal kept
     wx_image *kept;       ///< when not NULL: the input cameras' images, 4 per scene camera
     bool prepared; ///< the output folder exists (made with the first camera's maps)
-    map_file files[4];
+    file_batch now; ///< written before write_maps returns
+    // A camera whose images the run keeps is written on a thread of its own
+    // while the next camera renders (the render leaves a core idle): at most
+    // one such batch at a time, joined before the next one and at the end.
+    file_batch later;
+    pthread_t thread;
+    bool in_flight;
 } bake_writer;
 
-// Writes files [begin, end) of the camera in hand (one per worker).
+// Writes files [begin, end) of a batch (one per worker).
 static void write_files(int64_t begin, int64_t end, int worker, void *context)
 {
     (void)worker;
-    bake_writer *w = context;
+    file_batch *b = context;
     for (int64_t k = begin; k < end; ++k) {
-        map_file *f = &w->files[k];
+        map_file *f = &b->files[k];
         // Every map but the depth (whose +inf means no surface) holds finite values.
         f->result = k > 0 ? wx_image_check_finite(f->image, f->path, &f->err) : WX_OK;
         if (f->result == WX_OK) {
             f->result = wx_exr_write(f->path, f->image, &f->err);
         }
     }
+}
+
+static void write_batch(file_batch *b)
+{
+    wx_parallel_for(b->threads, b->count, 1, write_files, b);
+}
+
+static void *write_batch_thread(void *context)
+{
+    write_batch(context);
+    return NULL;
+}
+
+// The first failure of a written batch, named by its camera.
+static wx_result batch_result(const file_batch *b, wx_error *err)
+{
+    for (int k = 0; k < b->count; ++k) {
+        if (b->files[k].result != WX_OK) {
+            *err = b->files[k].err;
+            wx_error_prefix(err, "bake camera '%s'", b->camera);
+            return b->files[k].result;
+        }
+    }
+    return WX_OK;
+}
+
+// Waits for the batch written in the background, if any, and gives its result.
+static wx_result join_later(bake_writer *w, wx_error *err)
+{
+    if (!w->in_flight) {
+        return WX_OK;
+    }
+    pthread_join(w->thread, NULL);
+    w->in_flight = false;
+    return batch_result(&w->later, err);
 }
 
 // The output camera's depth and normal as the gather reads them (depth +inf
@@ -79,7 +129,8 @@ static wx_result keep_output_maps(const wx_image *depth, const wx_image *normal,
 }
 
 // wx_bake_maps_fn: names the camera's files, stamps the headers, writes them in
-// parallel, and points the camera at them.
+// parallel (in the background when the run keeps the images), and points the
+// camera at them.
 static wx_result write_maps(int camera, wx_image *maps, int count, void *user, wx_error *err)
 {
     bake_writer *w = user;
@@ -91,11 +142,22 @@ static wx_result write_maps(int camera, wx_image *maps, int count, void *user, w
         }
         w->prepared = true;
     }
+    // Kept images are the run's from here on, and the bake allocates the next
+    // camera's anew: they can be written while the next camera renders.
+    bool keep = !sc->is_output && w->kept != NULL;
+    wx_result r = keep ? join_later(w, err) : WX_OK;
+    if (r != WX_OK) {
+        return r;
+    }
+    file_batch *b = keep ? &w->later : &w->now;
+    b->count = count;
+    b->threads = w->opts->threads;
+    snprintf(b->camera, sizeof b->camera, "%s", sc->name);
     for (int k = 0; k < count; ++k) {
-        map_file *f = &w->files[k];
+        map_file *f = &b->files[k];
         char name[sizeof sc->name + 32];
         wx_map_file_name(sc->name, k, name, sizeof name);
-        wx_result r = wx_output_path(w->scene, w->opts, name, f->path, err);
+        r = wx_output_path(w->scene, w->opts, name, f->path, err);
         if (r != WX_OK) {
             wx_error_prefix(err, "bake camera '%s'", sc->name);
             return r;
@@ -104,33 +166,36 @@ static wx_result write_maps(int camera, wx_image *maps, int count, void *user, w
         wx_image_set_m44f(&maps[k], "CTWMatrix", sc->camera.ctw);
         wx_image_set_string(&maps[k], "cameraName", sc->name);
         maps[k].zip_level = 1; // the pipeline's own intermediates: the fastest zlib
-        f->image = &maps[k];
         f->result = WX_OK;
-    }
-    wx_parallel_for(w->opts->threads, count, 1, write_files, w);
-    for (int k = 0; k < count; ++k) {
-        if (w->files[k].result != WX_OK) {
-            *err = w->files[k].err;
-            wx_error_prefix(err, "bake camera '%s'", sc->name);
-            return w->files[k].result;
-        }
-    }
-    if (sc->is_output && w->output_maps != NULL) {
-        wx_result r = keep_output_maps(&maps[0], &maps[1], w->output_maps, err);
-        if (r != WX_OK) {
-            return r;
-        }
-    }
-    if (!sc->is_output && w->kept != NULL) {
-        // Taken over, not copied: the bake allocates the next camera's anew.
-        for (int k = 0; k < count; ++k) {
+        if (keep) {
+            // Taken over, not copied: the bake allocates the next camera's anew.
             w->kept[4 * camera + k] = maps[k];
             memset(&maps[k], 0, sizeof maps[k]);
+            f->image = &w->kept[4 * camera + k];
+        } else {
+            f->image = &maps[k];
         }
+    }
+    if (keep) {
+        if (pthread_create(&w->thread, NULL, write_batch_thread, b) == 0) {
+            w->in_flight = true;
+        } else {
+            write_batch(b); // no thread to be had: written here
+            r = batch_result(b, err);
+        }
+    } else {
+        write_batch(b);
+        r = batch_result(b, err);
+        if (r == WX_OK && sc->is_output && w->output_maps != NULL) {
+            r = keep_output_maps(&maps[0], &maps[1], w->output_maps, err);
+        }
+    }
+    if (r != WX_OK) {
+        return r;
     }
     char **dest[4] = { &sc->depth_path, &sc->normal_path, &sc->impact_path, &sc->dirt_path };
     for (int k = 0; k < count; ++k) {
-        if (!wx_scene_set_path(dest[k], w->files[k].path)) {
+        if (!wx_scene_set_path(dest[k], b->files[k].path)) {
             return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "bake: out of memory");
         }
     }
@@ -281,6 +346,14 @@ wx_result wx_bake_geometry(wx_scene *scene, const wx_run_def *opts, wx_geometry 
     writer->output_maps = output_maps;
     writer->kept = kept;
     wx_result r = wx_bake_geometry_into(scene, opts, geometry, write_maps, writer, stats, err);
+    // Joined whatever the bake's result. Its camera came before any camera the
+    // bake failed in: errors are told in the cameras' order, whatever the timing.
+    wx_error late;
+    wx_result written = join_later(writer, &late);
+    if (written != WX_OK) {
+        *err = late;
+        r = written;
+    }
     free(writer);
     return r;
 }
