@@ -277,7 +277,8 @@ sanitize: | deps
 # make tsan: the tests of the threaded phases (simulate's chunk hand-off and
 # ordered dirt exchange, the gather's rows, fixed and adaptive) built with ThreadSanitizer in
 # $(TSAN_BUILD). Without function multiversioning: its load-time resolvers run
-# before ThreadSanitizer is set up. The bake is left out: its threads are Mesa's.
+# before ThreadSanitizer is set up. The bake is left out: its threads are Mesa's (and
+# the one that writes a run's camera files while the next renders; docs/reliability.md).
 TSAN_BUILD ?= $(BUILD)-tsan
 TSAN_CFLAGS := -O1 -g -fno-omit-frame-pointer -fsanitize=thread -DWX_NO_CLONES
 TSAN_TESTS := test_simulate test_gather test_adaptive
