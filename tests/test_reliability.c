@@ -740,12 +740,6 @@ TEST(a_full_disk_in_the_bake_is_exit_1_naming_the_camera)
     SLOW();
     char dir[PATH_MAX];
     ENSURE(realpath(ensure_tmpdir(), dir) != NULL);
-    char mnt[PATH_MAX + 16];
-    snprintf(mnt, sizeof mnt, "%s/full", dir);
-    ENSURE(mkdir(mnt, 0777) == 0);
-    if (ensure_shell(out, sizeof out, "mount -t tmpfs -o size=64k tmpfs %s", mnt) != 0) {
-        SKIP("no tmpfs can be mounted here (needs root)");
-    }
     // init's scene for the teapot at 256 texels: input cameras front, back, left,
     // right and top (four layers each), then the output camera. The space each
     // camera's files take on the tmpfs (whole pages), in the order they are written.
@@ -766,6 +760,13 @@ TEST(a_full_disk_in_the_bake_is_exit_1_naming_the_camera)
         }
         ENSURE(used[c] > 0);
     }
+    // Mounted last: every check from here on unmounts it before it can fail.
+    char mnt[PATH_MAX + 16];
+    snprintf(mnt, sizeof mnt, "%s/full", dir);
+    ENSURE(mkdir(mnt, 0777) == 0);
+    if (ensure_shell(out, sizeof out, "mount -t tmpfs -o size=64k tmpfs %s", mnt) != 0) {
+        SKIP("no tmpfs can be mounted here (needs root)");
+    }
     // A disk that fills in the middle of the files of back (written while left
     // renders, its failure met when left's are handed over) and of top (written
     // while the output camera renders, met when the bake ends).
@@ -776,7 +777,10 @@ TEST(a_full_disk_in_the_bake_is_exit_1_naming_the_camera)
             size += used[c];
         }
         size = (size / 4096 + 1) * 4096;
-        ENSURE(ensure_shell(out, sizeof out, "mount -o remount,size=%ld %s", size, mnt) == 0);
+        if (ensure_shell(out, sizeof out, "mount -o remount,size=%ld %s", size, mnt) != 0) {
+            ensure_shell(out, sizeof out, "umount %s", mnt);
+            ENSURE(!"the tmpfs could not be resized");
+        }
         char out_dir[sizeof mnt + 16];
         snprintf(out_dir, sizeof out_dir, "%s/o%d", mnt, k);
         int status = ensure_shell(out, sizeof out, "%s/weathering run %s/teapot.xml --out %s -q",
