@@ -176,19 +176,14 @@ static wx_result write_maps(int camera, wx_image *maps, int count, void *user, w
             f->image = &maps[k];
         }
     }
-    if (keep) {
-        if (pthread_create(&w->thread, NULL, write_batch_thread, b) == 0) {
-            w->in_flight = true;
-        } else {
-            write_batch(b); // no thread to be had: written here
-            r = batch_result(b, err);
-        }
+    if (keep && pthread_create(&w->thread, NULL, write_batch_thread, b) == 0) {
+        w->in_flight = true;
     } else {
-        write_batch(b);
+        write_batch(b); // not kept, or no thread to be had: written here
         r = batch_result(b, err);
-        if (r == WX_OK && sc->is_output && w->output_maps != NULL) {
-            r = keep_output_maps(&maps[0], &maps[1], w->output_maps, err);
-        }
+    }
+    if (r == WX_OK && sc->is_output && w->output_maps != NULL) {
+        r = keep_output_maps(&maps[0], &maps[1], w->output_maps, err);
     }
     if (r != WX_OK) {
         return r;

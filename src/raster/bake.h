@@ -55,7 +55,8 @@ typedef struct wx_bake_stats {
     double setup_s;         ///< GL context, shaders, uploads
     double render_s;        ///< draws and readback, all cameras
     double dirt_s;          ///< initial dirt ownership (visibility between cameras)
-    double write_s;         ///< in the caller's on_maps (writing the files)
+    double write_s;         ///< in the caller's on_maps (writing the files; a run's input
+                            ///< cameras only hand theirs to a writer thread)
     double cameras_s;       ///< all cameras: render, dirt and on_maps, wall-clock
     double total_s;
 } wx_bake_stats;
