@@ -14,7 +14,7 @@
 #include "model/scene.h"
 
 #define FX_MAX_PLANES 8
-#define FX_MAX_SOLIDS 8
+#define FX_MAX_SOLIDS  64
 #define FX_MAX_CAMERAS 4
 
 typedef struct fx_solid {
