@@ -214,7 +214,7 @@ gallery: $(BUILD)/weathering $(BUILD)/tools/render_texture $(BUILD)/tools/galler
 # make previews: the other pictures of docs/images, from today's code
 # (tests/tools/previews.sh: the shipped scenes and the house's derived masks;
 # about 2 minutes on two cores).
-previews: $(BUILD)/weathering $(BUILD)/tools/render_texture
+previews: $(BUILD)/weathering $(BUILD)/tools/render_texture $(BUILD)/tools/exr_channel
 	sh tests/tools/previews.sh $(BUILD)
 
 # Bakes, simulates and gathers the default scene into out/<scene name>/ (mask.exr
