@@ -100,8 +100,8 @@ enum { SLIDE_CONTACTS = 16 };
 // It takes nothing off the move, so the slide would meet it again at once:
 // the particle goes back a little further in front of it, along that
 // contact's camera axis, 1/100 texel more at the first such contact in a row
-// and twice as far at each next one (where that point is free), so it climbs
-// a bump of h texels in about log2(100 h) contacts.
+// and twice as far at each next one (where the way there is free), so it
+// climbs a bump of h texels in about log2(100 h) contacts.
 static void rest_of_step(const wx_sim *sim, const float from[3], float time, const float v[3],
                          int contacts, float out[3])
 {
@@ -142,7 +142,11 @@ static void rest_of_step(const wx_sim *sim, const float from[3], float time, con
         for (int k = 0; k < 3; ++k) {
             up[k] = at[k] + lift * cam->back[k];
         }
-        if (!wx_collider_point_collides(collider, up)) {
+        // Only where the way there is free: a lift must not carry the
+        // particle through a slab or a pane between it and the camera.
+        wx_hit above;
+        if (wx_collider_coarse_clear(collider, at, up) ||
+            !wx_collider_sweep(collider, at, up, &above)) {
             memcpy(at, up, sizeof up);
         }
         climb *= 2.0f;
