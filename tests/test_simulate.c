@@ -248,12 +248,10 @@ static double half_pipe_swing(int px, double *speed)
     fx_gravity(&f, 9.8f);
     wx_sim *sim = start(&f, 1);
     double a = 60.0 * pi / 180, x_before = R * sin(a), bottom = -1;
-    if (sim == NULL ||
-        !spawn(sim, (float)x_before, (float)(R - R * cos(a) + 1e-3), 0.1f, 0, 0, 0, 1, 100000)) {
-        return -1;
-    }
+    bool spawned = sim != NULL && spawn(sim, (float)x_before, (float)(R - R * cos(a) + 1e-3), 0.1f,
+                                        0, 0, 0, 1, 100000);
     *speed = 0;
-    for (int s = 1; s <= 100 && bottom < 0; ++s) {
+    for (int s = 1; spawned && s <= 100 && bottom < 0; ++s) {
         wx_particle_view view;
         if (!run(sim, 1) || (wx_sim_particles(sim, &view), view.count != 1)) {
             break;

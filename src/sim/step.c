@@ -82,6 +82,14 @@ integrate_block(const wx_forces *restrict forces, float t, float dt, const float
     }
 }
 
+// Whether segment a -> b meets a surface (then `hit` holds where): the coarse
+// test first, the swept test for what it cannot clear.
+static bool meets_surface(const wx_collider *collider, const float a[3], const float b[3],
+                          wx_hit *hit)
+{
+    return !wx_collider_coarse_clear(collider, a, b) && wx_collider_sweep(collider, a, b, hit);
+}
+
 // Contacts a slide may meet in the rest of one step (rest_of_step).
 enum { SLIDE_CONTACTS = 16 };
 
@@ -115,8 +123,7 @@ static void rest_of_step(const wx_sim *sim, const float from[3], float time, con
     for (int c = 1;; ++c) {
         float to[3] = { at[0] + move[0], at[1] + move[1], at[2] + move[2] };
         wx_hit again;
-        if (wx_collider_coarse_clear(collider, at, to) ||
-            !wx_collider_sweep(collider, at, to, &again)) {
+        if (!meets_surface(collider, at, to, &again)) {
             memcpy(out, to, sizeof to);
             return;
         }
@@ -145,8 +152,7 @@ static void rest_of_step(const wx_sim *sim, const float from[3], float time, con
         // Only where the way there is free: a lift must not carry the
         // particle through a slab or a pane between it and the camera.
         wx_hit above;
-        if (wx_collider_coarse_clear(collider, at, up) ||
-            !wx_collider_sweep(collider, at, up, &above)) {
+        if (!meets_surface(collider, at, up, &above)) {
             memcpy(at, up, sizeof up);
         }
         climb *= 2.0f;
