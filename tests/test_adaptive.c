@@ -312,6 +312,51 @@ TEST(adaptive_does_not_cross_a_shadow_edge)
     ENSURE(i90 >= 62 && i10 <= 66);
 }
 
+// The wall ends at column 100, its edge along the camera's rows (a roof's eave
+// lined up with the grid, seen from above), and that last column got none of
+// the rain (as it did when the wall's camera took the eave's hits: collider.c,
+// pick_camera). One empty column with nothing beyond it is no clean region:
+// the smoothing fills it from the wall's side. When the clean test counted the
+// texel's own column, the whole column read 0 (a texture, which reads the
+// camera bilinearly, drew a dark line two of its texels wide that a grid
+// turned 30 degrees did not draw).
+static double four_but_the_last_column(int i, int j)
+{
+    (void)j;
+    return i < 100 ? 4.0 : 0.0;
+}
+
+TEST(adaptive_keeps_an_empty_last_column_of_a_silhouette)
+{
+    quad wall = big_wall();
+    test_maps in = render(wall_camera(), &wall, 1, NULL);
+    test_maps out = render(wall_camera(), &wall, 1, NULL);
+    for (int j = 0; j < 128; ++j) {
+        for (int i = 101; i < 128; ++i) {
+            in.depth[j * 128 + i] = out.depth[j * 128 + i] = INFINITY; // beyond the edge
+        }
+    }
+    simulated sim = simulate_hits(&in, four_but_the_last_column, 0.0f, 10);
+    float *mask = run_adaptive(&out, &in, &sim, 0.04f, 3.0f, 2, NULL);
+    ENSURE(mask != NULL);
+    double column[128] = { 0 };
+    for (int j = 16; j < 112; ++j) {
+        for (int i = 0; i < 128; ++i) {
+            column[i] += mask[j * 128 + i] / 96.0;
+        }
+    }
+    free(mask);
+    free(sim.initial);
+    free(sim.hits);
+    maps_free(&in);
+    maps_free(&out);
+    fprintf(stderr, "        columns 96-101: %.0f %.0f %.0f %.0f %.0f %.0f (lit 400)\n", column[96],
+            column[97], column[98], column[99], column[100], column[101]);
+    ENSURE(column[101] == 0.0); // no surface
+    ENSURE(column[100] > 400.0 * 0.7); // 333 (was 0)
+    ENSURE(column[99] > 400.0 * 0.75); // 343 (395)
+}
+
 // What the particles left is kept: the mask integrates to the dirt (here over a
 // density that rises across the wall) within 1%, and 1 or 2 threads give the
 // same bytes.
@@ -400,6 +445,7 @@ int main(void)
     RUN(adaptive_counts_as_capped_only_what_impacts_reach);
     RUN(adaptive_keeps_the_initial_dirt_exact);
     RUN(adaptive_does_not_cross_a_shadow_edge);
+    RUN(adaptive_keeps_an_empty_last_column_of_a_silhouette);
     RUN(adaptive_keeps_the_dirt_and_its_bytes);
     RUN(adaptive_does_not_cross_creases_or_depth_jumps);
     return ensure_summary();

@@ -990,6 +990,47 @@ TEST(facing_cameras_tie_to_the_one_outside_the_surface)
     ENSURE(back.camera == 0 && back.layer == 0);
 }
 
+// A block seen from above and from the front (texels of 0.1 m). A drop falling
+// 3 cm behind the front edge lands on the top; a drop flying level into the
+// front face 3 cm below the edge lands on the front. Each time the other
+// camera's surface lies within its precision of the hit (half a texel, and
+// with layers a texel more) and sees its own face as head-on, so the most
+// head-on rule alone gave the top's hit to the front camera, which put the
+// drop back in front of the wall: off the roof it had landed on (collider.c,
+// pick_camera: the surface the segment enters decides).
+TEST(a_drop_by_an_edge_is_recorded_on_the_face_it_lands_on)
+{
+    // Both orders of the cameras: ties of |N.view| go to the one listed first.
+    for (int run = 0; run < 4; ++run) {
+        int layers = run < 2 ? 1 : 4, top = run & 1, front = 1 - top;
+        lay_world world;
+        memset(&world, 0, sizeof world);
+        fx_box(&world.solids, -1, 0, -0.5f, 1, 1, 0.5f);
+        wx_camera cams[2];
+        cams[top] = top_camera(6.4f, 64);
+        cams[front] = fx_camera(0, 0.5f, 10, 0, 0.5f, 0, 0, 1, 0, 6.4f, 64);
+        wx_maps maps[2];
+        wx_collider col;
+        ENSURE(build_layers(&col, cams, maps, 2, &world, layers));
+        float a0[3] = { 0.13f, 2.0f, 0.47f }, a1[3] = { 0.13f, 0.5f, 0.47f };
+        float b0[3] = { 0.13f, 0.97f, 2.0f }, b1[3] = { 0.13f, 0.97f, 0.0f };
+        wx_hit down, level;
+        bool hd = wx_collider_sweep(&col, a0, a1, &down);
+        bool hl = wx_collider_sweep(&col, b0, b1, &level);
+        release(&col, maps, 2);
+        ENSURE(hd && hl);
+        fprintf(stderr, "        %d layer(s), %s first: falling on the %s, level on the %s\n", layers,
+                top == 0 ? "top" : "front", down.camera == top ? "top" : "front",
+                level.camera == top ? "top" : "front");
+        ENSURE(down.camera == top);
+        ENSURE_NEAR(down.point[1], 1.0, 1e-4);
+        ENSURE(down.front[1] >= 1.0f && down.front[2] < 0.5f); // back on the top
+        ENSURE(level.camera == front);
+        ENSURE_NEAR(level.point[2], 0.5, 1e-4);
+        ENSURE(level.front[2] >= 0.5f);
+    }
+}
+
 // The same block: its front face is owned by the front camera's first layer,
 // not by the back camera's second, which is listed first (model/ownership.h).
 TEST(ownership_ties_go_to_the_view_outside_the_surface)
@@ -1419,6 +1460,7 @@ int main(void)
     RUN(fine_test_never_clears_what_the_sweep_stops);
     RUN(one_layer_is_todays_collider);
     RUN(facing_cameras_tie_to_the_one_outside_the_surface);
+    RUN(a_drop_by_an_edge_is_recorded_on_the_face_it_lands_on);
     RUN(ownership_ties_go_to_the_view_outside_the_surface);
     RUN(a_grazing_silhouette_owns_nothing_another_view_sees_head_on);
     RUN(layer_ramp_does_not_jump_from_a_handrail_to_the_wall_behind);

@@ -150,10 +150,14 @@ static void half_rect(int i, int j, int k, int side, int r[4])
 
 // Whether texel (i, j), holding no impact of its own, lies in a clean region:
 // on some side the largest empty half-rectangle reaches at least k_min texels
-// out and covers enough surface texels that `density` (impacts per texel) would
-// have put CLEAN_EXPECTED there. k_min (half the texel's radius) keeps the
-// sparse fringe of a dense region, where empty pockets are small next to the
-// radius, from being cut out of the mask.
+// out and covers enough surface texels beside the texel's own row or column
+// that `density` (impacts per texel) would have put CLEAN_EXPECTED there. (The
+// own line counted too until 6 December 2026: along a silhouette lined up with
+// the grid, whose last row had lost its hits to another camera, that row alone
+// made a long empty half-rectangle, and the texture drew a dark line two texels
+// wide along the model's edge that turning the model took away.) k_min (half
+// the texel's radius) keeps the sparse fringe of a dense region, where empty
+// pockets are small next to the radius, from being cut out of the mask.
 static bool is_clean(const job *jb, int i, int j, double density, int k_min, int k_max)
 {
     for (int side = 0; side < 4; ++side) {
@@ -174,7 +178,12 @@ static bool is_clean(const job *jb, int i, int j, double density, int k_min, int
             lo = hi;
         }
         half_rect(i, j, lo, side, r);
-        double surface = rect_sum(jb, jb->sat_surface, r[0], r[1], r[2], r[3]);
+        // The surface beside the texel's own line: a silhouette's last row,
+        // with nothing beyond it, is no evidence of a clean region however
+        // long it runs empty along the row.
+        double surface = rect_sum(jb, jb->sat_surface, r[0], r[1], r[2], r[3]) -
+                         (side < 2 ? rect_sum(jb, jb->sat_surface, i, r[1], i, r[3])
+                                   : rect_sum(jb, jb->sat_surface, r[0], j, r[2], j));
         if (lo >= k_min && density * surface >= CLEAN_EXPECTED) {
             return true;
         }

@@ -704,15 +704,36 @@ static double march_entry(const wx_collider *collider, march *m, double s)
 // the hit texel's own depth), the most head-on one (largest |N.view|,
 // the camera `bake` gives initial dirt to) gives the hit; without any, the
 // smallest d - depth. -1 when no camera sees a surface at s.
+//
+// Along a convex edge two cameras can be within their precision of the hit
+// and hold two surfaces: a drop falling on a roof a few millimetres from its
+// eave lies within the front camera's precision (and, with layers, its slack
+// of a texel) behind the wall it sees head-on. That camera took the hit, put
+// the drop back in front of the wall (off the roof, where it fell), and the
+// roof's last texel row got none of its rain (docs/physics.md, "Where a hit
+// lands"). So the surface hit is the one the segment enters most (the least
+// N . dir of the candidates' normals), and only cameras whose normal agrees
+// with that one's (PICK_SAME_SURFACE) compete by |N.view|: on a smooth
+// surface every candidate agrees and the rule above is unchanged.
 // Ties of |N.view| within this go to the camera outside the surface
 // (model/ownership.c's TIE_COSINE).
 #define PICK_TIE_COSINE 1e-4
+// Two candidates' unit normals hold the same surface when N1 . N2 is at least
+// this (60 degrees: a texel's normals on a curved surface agree far better;
+// the faces of an edge a camera grid resolves meet at more).
+#define PICK_SAME_SURFACE 0.5
 
-static int pick_camera(const wx_collider *collider, const march *m, double s)
+static int pick_camera(const wx_collider *collider, const march *m, double s, const double dir[3])
 {
     int best = -1, closest = -1, filled = -1;
     double best_cos = -1.0, closest_f = INFINITY;
     bool best_facing = true;
+    // The cameras that may record the hit (within their precision), with
+    // their |N.view|, facing and unit normal.
+    int cand[WX_MAX_INPUT_CAMERAS];
+    double cand_cos[WX_MAX_INPUT_CAMERAS], cand_n[WX_MAX_INPUT_CAMERAS][3];
+    bool cand_facing[WX_MAX_INPUT_CAMERAS];
+    int cands = 0;
     for (int c = 0; c < collider->camera_count; ++c) {
         if (!march_inside(&m[c], s) || !m[c].surface) {
             continue;
@@ -767,14 +788,39 @@ static int pick_camera(const wx_collider *collider, const march *m, double s)
         // surface's deposits do not follow those patches.
         bool facing = cam->layers <= 1 ||
                       n[0] * cam->back[0] + n[1] * cam->back[1] + n[2] * cam->back[2] > 0.0f;
-        bool better = cos_view > best_cos;
-        if (facing != best_facing && fabs(cos_view - best_cos) <= PICK_TIE_COSINE) {
-            better = facing;
+        if (f * bl <= precision && off <= precision) {
+            cand[cands] = c;
+            cand_cos[cands] = cos_view;
+            cand_facing[cands] = facing;
+            for (int k = 0; k < 3; ++k) {
+                cand_n[cands][k] = n[k] / nl;
+            }
+            cands++;
         }
-        if (f * bl <= precision && off <= precision && better) {
-            best = c;
-            best_cos = cos_view;
-            best_facing = facing;
+    }
+    // The surface the segment enters most: the candidates' reference.
+    int entered = 0;
+    double least = INFINITY;
+    for (int q = 0; q < cands; ++q) {
+        double e = cand_n[q][0] * dir[0] + cand_n[q][1] * dir[1] + cand_n[q][2] * dir[2];
+        if (e < least) {
+            least = e;
+            entered = q;
+        }
+    }
+    for (int q = 0; q < cands; ++q) {
+        const double *a = cand_n[q], *b = cand_n[entered];
+        if (!(a[0] * b[0] + a[1] * b[1] + a[2] * b[2] >= PICK_SAME_SURFACE)) {
+            continue; // another surface of the edge
+        }
+        bool better = cand_cos[q] > best_cos;
+        if (cand_facing[q] != best_facing && fabs(cand_cos[q] - best_cos) <= PICK_TIE_COSINE) {
+            better = cand_facing[q];
+        }
+        if (better) {
+            best = cand[q];
+            best_cos = cand_cos[q];
+            best_facing = cand_facing[q];
         }
     }
     // Where every camera that agrees holds only a fill (a solid's edge on the
@@ -891,7 +937,7 @@ bool wx_collider_sweep(const wx_collider *collider, const float p0[3], const flo
     if (!agreed) {
         return false;
     }
-    int best = pick_camera(collider, m, s);
+    int best = pick_camera(collider, m, s, d);
     double best_f = best >= 0 ? m[best].A + s * (m[best].B + s * m[best].C) : 0.0;
     if (best < 0) {
         return false; // only when rounding puts s on a frame edge: no surface there
