@@ -1316,6 +1316,34 @@ TEST(closed_parts_wound_inwards_are_turned_outwards)
     wx_mesh_data_free(&m);
 }
 
+// A cube one of whose faces is wound the other way (exported inside out, or
+// built by hand as the first trough of docs/performance.md, "Edges", and the
+// shipped tank's ledge and eave undersides were): counted, so that `info` and
+// `run` warn; it is neither closed nor turned. A cube wound one way, either
+// way, and a lone open quad count nothing.
+TEST(a_part_wound_both_ways_is_counted)
+{
+    static char obj[4096];
+    const char *dir = ensure_tmpdir();
+    wx_error err = { 0 };
+    wx_mesh_data m;
+    const char *cube = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
+                       "v 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
+                       "f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\n%s\n";
+    snprintf(obj, sizeof obj, cube, "f 4 1 5 8");
+    ENSURE(wx_mesh_import(ensure_write_file(dir, "one_way.obj", obj), &m, &err) == WX_OK);
+    ENSURE(m.parts_wound_both_ways == 0 && m.parts_turned == 0);
+    wx_mesh_data_free(&m);
+    snprintf(obj, sizeof obj, cube, "f 8 5 1 4");
+    ENSURE(wx_mesh_import(ensure_write_file(dir, "both_ways.obj", obj), &m, &err) == WX_OK);
+    ENSURE(m.parts_wound_both_ways == 1 && m.parts_turned == 0);
+    wx_mesh_data_free(&m);
+    snprintf(obj, sizeof obj, "%s", "v 0 0 0\nv 1 0 0\nv 1 0 1\nv 0 0 1\nf 1 2 3 4\n");
+    ENSURE(wx_mesh_import(ensure_write_file(dir, "quad.obj", obj), &m, &err) == WX_OK);
+    ENSURE(m.parts_wound_both_ways == 0);
+    wx_mesh_data_free(&m);
+}
+
 int main(void)
 {
     RUN(smooth_surface_of_a_coarse_sphere_is_rounder);
@@ -1346,5 +1374,6 @@ int main(void)
     RUN(a_huge_polygon_is_refused_at_once);
     RUN(a_fan_of_many_faces_smooths_in_bounded_time);
     RUN(closed_parts_wound_inwards_are_turned_outwards);
+    RUN(a_part_wound_both_ways_is_counted);
     return ensure_summary();
 }

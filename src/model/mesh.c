@@ -504,6 +504,7 @@ typedef struct part_sums {
     double lo[3], hi[3];
     int64_t first;  // its first triangle
     bool open;
+    bool mixed;     // an edge two triangles run the same way
 } part_sums;
 
 // Closed, and of a volume above a millionth of its bounding box's.
@@ -562,6 +563,7 @@ wx_result wx_mesh_orient_outwards(wx_mesh_data *mesh, int64_t *turned, wx_error 
     if (turned != NULL) {
         *turned = 0;
     }
+    mesh->parts_wound_both_ways = 0;
     const int64_t V = mesh->vertex_count, T = mesh->triangle_count;
     if (V <= 0 || T <= 0 || mesh->positions == NULL || mesh->indices == NULL ||
         V > (int64_t)UINT32_MAX || T > INT64_MAX / 48) {
@@ -671,7 +673,13 @@ wx_result wx_mesh_orient_outwards(wx_mesh_data *mesh, int64_t *turned, wx_error 
         if (j - i != 2 || edges[i].forward == edges[i + 1].forward) {
             parts[edges[i].part].open = true;
         }
+        if (j - i == 2 && edges[i].forward == edges[i + 1].forward) {
+            parts[edges[i].part].mixed = true;
+        }
         i = j;
+    }
+    for (uint32_t q = 0; q < part_count; ++q) {
+        mesh->parts_wound_both_ways += parts[q].mixed;
     }
 
     // The sums per part.

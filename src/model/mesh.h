@@ -43,6 +43,11 @@ typedef struct wx_mesh_data {
     /// Closed parts whose normals pointed into them, turned outwards by the
     /// import (wx_mesh_orient_outwards).
     int64_t parts_turned;
+    /// Parts with an edge two triangles run the same way (faces wound both
+    /// ways, some inside out): left as they are, and warned about, since
+    /// the layered maps then read a solid's side as a sheet and particles
+    /// pass through (wx_mesh_orient_outwards).
+    int64_t parts_wound_both_ways;
 } wx_mesh_data;
 
 /// Frees the vertex and triangle arrays only (once uploaded), keeping counts,

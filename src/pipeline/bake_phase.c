@@ -284,6 +284,16 @@ wx_result wx_geometry_load(const wx_scene *scene, bool quiet, wx_geometry *out, 
                     scene->path, mesh->line, wx_mesh_display_name(scene, mesh),
                     (long long)g->data.parts_turned, g->data.parts_turned == 1 ? "" : "s");
         }
+        if (g->data.parts_wound_both_ways > 0) {
+            wx_warn(quiet,
+                    "%s:%d: mesh '%s': %lld part%s with faces wound both ways (some inside "
+                    "out): the cameras may read a solid's side as a thin sheet and let "
+                    "particles through; make the winding consistent in the modeller "
+                    "(Blender: Mesh > Normals > Recalculate Outside)",
+                    scene->path, mesh->line, wx_mesh_display_name(scene, mesh),
+                    (long long)g->data.parts_wound_both_ways,
+                    g->data.parts_wound_both_ways == 1 ? "" : "s");
+        }
         int materials = g->data.material_count;
         g->surface = calloc(materials > 0 ? (size_t)materials : 1, sizeof *g->surface);
         if (g->surface == NULL) {

@@ -33,14 +33,14 @@ ledge_out_high = ring(R + 0.12, 1.54)
 ledge_top = ring(R, 1.54)
 top = ring(R, H)
 band(base, low, "iron", outward=False)
-band(ledge_in, ledge_out_low, "iron", outward=True)       # underside of the ledge, facing down
+band(ledge_in, ledge_out_low, "iron", outward=False)      # underside of the ledge, facing down
 band(ledge_out_low, ledge_out_high, "iron", outward=False)
 band(ledge_out_high, ledge_top, "iron", outward=False)     # top of the ledge, facing up
 band(ledge_top, top, "iron", outward=False)
 # Roof: an overhanging eave (underside facing down) and a cone up to the apex.
 eave_in = ring(R, H)
 eave_out = ring(R + 0.15, H)
-band(eave_in, eave_out, "iron", outward=True)
+band(eave_in, eave_out, "iron", outward=False)  # facing down
 cone = ring(R + 0.15, H)
 apex = vert(0.0, H + 0.6, 0.0)
 for k in range(N):
