@@ -10,6 +10,10 @@
 
 #include "core/limits.h"
 
+// The least contact: the clamp the gather and the bake use for |N . view|
+// (docs/mask.md), so a texel seen edge-on still erodes.
+#define MIN_CONTACT 1e-3f
+
 static float unit_clamp(float v)
 {
     if (!(v > 0.0f)) {
@@ -20,7 +24,8 @@ static float unit_clamp(float v)
 
 wx_result wx_dirt_map_init(wx_dirt_map *map, int width, int height, int substances,
                            const float *dirt, const float *deposit, const float *erosion,
-                           float D, float E, const float *depth, wx_error *err)
+                           float D, float E, const float *depth, const float *normal,
+                           const float view[3], wx_error *err)
 {
     memset(map, 0, sizeof *map);
     size_t texels = (size_t)width * (size_t)height;
@@ -38,6 +43,12 @@ wx_result wx_dirt_map_init(wx_dirt_map *map, int width, int height, int substanc
         size_t plane = s * texels;
         for (size_t t = 0; t < texels; ++t) {
             wx_dirt_texel *x = &map->texels[t * S + s];
+            x->contact = 1.0f;
+            if (normal != NULL) {
+                const float *n = normal + 3 * t;
+                float c = fabsf(n[0] * view[0] + n[1] * view[1] + n[2] * view[2]);
+                x->contact = c >= MIN_CONTACT ? (c < 1.0f ? c : 1.0f) : MIN_CONTACT; // NaN too
+            }
             float v = dirt != NULL ? dirt[plane + t] : 0.0f;
             x->dirt = isfinite(v) ? v : 0.0;
             x->deposit = unit_clamp(D * (deposit != NULL ? deposit[plane + t] : 0.0f));
@@ -83,7 +94,7 @@ void wx_dirt_map_exchange(wx_dirt_map *map, uint32_t texel, double *load, float 
     wx_dirt_texel *t = &map->texels[(size_t)texel * (size_t)S];
     for (int s = 0; s < S; ++s) {
         double dep = t[s].deposit * load[s];
-        double ero = t[s].erosion * t[s].dirt;
+        double ero = t[s].erosion * t[s].contact * t[s].dirt;
         load[s] += ero - dep;
         t[s].dirt += dep - ero;
     }
@@ -182,7 +193,7 @@ void wx_dirt_map_exchange_line(wx_dirt_map *map, uint32_t from, uint32_t to, dou
         wx_dirt_texel *t = &map->texels[texel * (size_t)S];
         for (int s = 0; s < S; ++s) {
             double dep = t[s].deposit * p[s] * share;
-            double ero = t[s].erosion * t[s].dirt * share;
+            double ero = t[s].erosion * t[s].contact * t[s].dirt * share;
             t[s].dirt += dep - ero;
             change[s] += ero - dep;
         }

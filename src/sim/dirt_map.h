@@ -20,6 +20,12 @@ typedef struct wx_dirt_texel {
     double dirt;
     float deposit; ///< clamp(D * kd, 0, 1)
     float erosion; ///< clamp(E * ke, 0, 1)
+    /// The share of the texel's dirt one contact meets: |N . view| of its
+    /// surface (in [1e-3, 1]; 1 without normals). The texel holds the dirt of
+    /// texel area / |N . view| of surface, and a particle's contact meets the
+    /// dirt of a head-on texel's area of it, so erosion takes
+    /// erosion * contact * dirt (docs/physics.md, "Chemistry").
+    float contact;
     /// The particles that exchanged here, each counted by the share of itself
     /// it spent here (its weight, wx_particles.weight: a particle counts once
     /// over all its hits): what the gather's adaptive smoothing counts as its
@@ -41,11 +47,14 @@ typedef struct wx_dirt_map {
 /// Builds the map from the planes of `substances` substances, each plane
 /// W*H floats one after the other (plane s at s*W*H; any of the three may be
 /// NULL: zeros), and the collider's D and E. `depth` (borrowed, may be NULL)
-/// marks the texels with a surface (finite depth). Fails with WX_FAIL when out
-/// of memory.
+/// marks the texels with a surface (finite depth). `normal` (3*W*H, may be
+/// NULL: every contact 1) and `view` (the camera's unit axis, either sense)
+/// give each texel's contact, |N . view|. Fails with WX_FAIL when out of
+/// memory.
 wx_result wx_dirt_map_init(wx_dirt_map *map, int width, int height, int substances,
                            const float *dirt, const float *deposit, const float *erosion,
-                           float D, float E, const float *depth, wx_error *err);
+                           float D, float E, const float *depth, const float *normal,
+                           const float view[3], wx_error *err);
 
 /// Frees the texels; the struct is zeroed.
 void wx_dirt_map_free(wx_dirt_map *map);

@@ -537,9 +537,17 @@ wx_result wx_sim_create(const wx_scene *scene, const wx_sim_def *config, wx_sim 
         int cam = sim_view_camera(sim, c);
         const float *depth = wx_maps_layers(&sim->maps[cam]) > 1 ? m->depth
                                                                  : sim->collider.cameras[cam].depth;
+        // Each texel's contact, |N . view| (docs/physics.md, "Chemistry").
+        const float *back = sim->collider.cameras[cam].back;
+        float bl = sqrtf(back[0] * back[0] + back[1] * back[1] + back[2] * back[2]);
+        float view[3] = { 0.0f, 0.0f, 0.0f };
+        for (int k = 0; k < 3 && bl > 0.0f; ++k) {
+            view[k] = back[k] / bl;
+        }
         r = wx_dirt_map_init(&sim->dirt[c], m->width, m->height, sim->substances, m->dirt,
                              m->deposit, m->erosion, scene->collider.deposit,
-                             scene->collider.erosion, depth, err);
+                             scene->collider.erosion, depth, bl > 0.0f ? m->normal : NULL, view,
+                             err);
         if (r == WX_OK) {
             for (int s = 0; s < sim->substances; ++s) {
                 sim->stats.substance[s].initial_surface += wx_dirt_map_total(&sim->dirt[c], s);
