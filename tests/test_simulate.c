@@ -413,7 +413,7 @@ TEST(streaks_are_continuous)
 // Each contact took half the texel's dirt: the tilted camera's particle
 // picked up twice as much (0.06 against 0.03), and on a model a surface eroded more where a
 // camera seeing it at an angle recorded its slides (the texture changed with
-// the model's turn in the camera grid: docs/physics.md, "Chemistry"). With
+// the model's turn in the camera grid: docs/physics.md, "Dirt exchange"). With
 // the contact |N . view| both pick up the same. The dirt it picked up:
 static double slide_load(bool tilted, int64_t *collisions)
 {

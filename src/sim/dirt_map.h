@@ -24,7 +24,7 @@ typedef struct wx_dirt_texel {
     /// surface (in [1e-3, 1]; 1 without normals). The texel holds the dirt of
     /// texel area / |N . view| of surface, and a particle's contact meets the
     /// dirt of a head-on texel's area of it, so erosion takes
-    /// erosion * contact * dirt (docs/physics.md, "Chemistry").
+    /// erosion * contact * dirt (docs/physics.md, "Dirt exchange").
     float contact;
     /// The particles that exchanged here, each counted by the share of itself
     /// it spent here (its weight, wx_particles.weight: a particle counts once

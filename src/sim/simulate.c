@@ -537,7 +537,7 @@ wx_result wx_sim_create(const wx_scene *scene, const wx_sim_def *config, wx_sim 
         int cam = sim_view_camera(sim, c);
         const float *depth = wx_maps_layers(&sim->maps[cam]) > 1 ? m->depth
                                                                  : sim->collider.cameras[cam].depth;
-        // Each texel's contact, |N . view| (docs/physics.md, "Chemistry").
+        // Each texel's contact, |N . view| (docs/physics.md, "Dirt exchange").
         const float *back = sim->collider.cameras[cam].back;
         float bl = sqrtf(back[0] * back[0] + back[1] * back[1] + back[2] * back[2]);
         float view[3] = { 0.0f, 0.0f, 0.0f };
