@@ -561,7 +561,10 @@ static bool run_lumpy(const char *dir, const char *model, int seed, int layers, 
 // The run is deterministic, so the bound between the two tells them apart;
 // issue 25's 1.05 is not met (docs/performance.md). 6 December 2026, with the
 // margins' reach at 32 texels and the fills' fix: 0.0220, 0.0256, 1.161.
-#define MAX_TURN_RATIO 1.20
+// Later the same day, erosion per contact (docs/physics.md, "Dirt
+// exchange"): 0.0217, 0.0237, 1.092; with the old exchange (and the edges'
+// changes since) it reads 0.0222, 0.0256, 1.152: the bound keeps the gain.
+#define MAX_TURN_RATIO 1.12
 TEST(lumpy_sphere_turned_slides_as_a_new_seed_does)
 {
     SLOW();
