@@ -411,10 +411,11 @@ TEST(streaks_are_continuous)
 // seen from straight above and once from 60 degrees off the vertical, where
 // each texel holds twice the floor (its dirt twice the top camera's texel's).
 // Each contact took half the texel's dirt: the tilted camera's particle
-// picked up twice as much (0.06 against 0.03), and on a model a surface eroded more where a
-// camera seeing it at an angle recorded its slides (the texture changed with
-// the model's turn in the camera grid: docs/physics.md, "Dirt exchange"). With
-// the contact |N . view| both pick up the same. The dirt it picked up:
+// picked up twice as much (0.06 against 0.03), and on a model a surface
+// eroded more where a camera seeing it at an angle recorded its slides (the
+// texture changed with the model's turn in the camera grid: docs/physics.md,
+// "Dirt exchange"). With the contact |N . view| both pick up the same. The
+// dirt it picked up:
 static double slide_load(bool tilted, int64_t *collisions)
 {
     fx_scene f;
@@ -429,8 +430,9 @@ static double slide_load(bool tilted, int64_t *collisions)
     const int px = 200;
     float texel = size / px, cosine = tilted ? cosf(tilt) : 1.0f;
     world.dirt = texel * texel / cosine; // 1 per square metre of floor
-    wx_camera cam = tilted ? fx_camera(0, 10 * cosf(tilt), 10 * sinf(tilt), 0, 0, 0, 0, 1, 0, size, px)
-                           : top_camera(size, px);
+    wx_camera cam = tilted
+                        ? fx_camera(0, 10 * cosf(tilt), 10 * sinf(tilt), 0, 0, 0, 0, 1, 0, size, px)
+                        : top_camera(size, px);
     fx_add_camera(&f, "view", cam, &world);
     f.scene.collider.friction = 1.0f;
     fx_gravity(&f, 9.8f);
