@@ -20,6 +20,7 @@
 #include "gather/texture.h"
 #include "io/exr.h"
 #include "model/image.h"
+#include "gather_fixture.h"
 #include "run_fixture.h"
 #include "sphere_fixture.h"
 
@@ -992,6 +993,107 @@ TEST(huge_and_unusable_uvs_are_bounded_and_counted)
     wx_uv_raster_free(&r);
 }
 
+// Where a camera stops seeing a surface the texture changes continuously
+// (docs/texture.md, "How a texel is computed"). The square of square_mesh, at
+// 4 texture texels per camera texel, is seen head-on by camera A, whose maps
+// put an occluder in front of its left part, and at 45 degrees by camera B,
+// which sees it all. A's plane holds 1, B's 0, so a texel A sees wholly reads
+// 1 / (1 + cos^2 45) = 2/3 and one A does not see reads 0. Across A's edge a
+// camera used to count whole as long as one of its four taps saw the point:
+// a step of 2/3 between two neighbouring texels, placed wherever A's grid put
+// it (what turning a model moves). Now its weight is the share of its taps
+// that see the point, a ramp over one of its texels, wherever its grid lies
+// (three offsets of the occluder's edge within A's texel).
+TEST(texture_fades_out_a_camera_where_it_stops_seeing_the_surface)
+{
+    float positions[12], normals[12], uvs[8];
+    uint32_t indices[12];
+    wx_mesh_data mesh;
+    square_mesh(&mesh, positions, normals, uvs, indices, false);
+    const int N = 256, A_PX = 64;
+    wx_uv_raster_def d = wx_default_uv_raster_def();
+    d.mesh = &mesh;
+    d.uv = 0;
+    d.width = N;
+    d.height = N;
+    d.padding = 0;
+    wx_uv_raster raster;
+    wx_error err;
+    ENSURE(wx_uv_raster_build(&d, &raster, &err) == WX_OK);
+    const quad square = make_quad(0.5, 0.5, 0.0, 0.25, 0.0, 0.0, 0.0, 0.25, 0.0, 0.0, 0.0, 1.0);
+    // B looks along -(1, 0, 1)/sqrt 2: 45 degrees off the square's normal.
+    wx_camera cam_b = make_camera(1.5f, 0.5f, 1.0f, 0.5f, 0.5f, 0.0f, 0.0f, 1.0f, 0.0f, 1.0f, 1.0f,
+                                  A_PX, A_PX);
+    test_maps b = render(cam_b, &square, 1, NULL);
+    float *zero = calloc((size_t)A_PX * A_PX, sizeof *zero);
+    float *one = malloc((size_t)A_PX * A_PX * sizeof *one);
+    float *value = calloc((size_t)N * N, sizeof *value);
+    float *seen = calloc((size_t)N * N, sizeof *seen);
+    ENSURE(zero != NULL && one != NULL && value != NULL && seen != NULL);
+    for (int t = 0; t < A_PX * A_PX; ++t) {
+        one[t] = 1.0f;
+    }
+    const double offsets[3] = { 0.1, 0.4, 0.75 };
+    for (int o = 0; o < 3; ++o) {
+        // The occluder's right edge at x = 0.5 + offset texels of A.
+        double edge = 0.5 + offsets[o] / A_PX;
+        quad scene[2] = { square, make_quad((edge - 0.3) / 2.0, 0.5, 0.3, (edge + 0.3) / 2.0, 0.0,
+                                            0.0, 0.0, 0.6, 0.0, 0.0, 0.0, 1.0) };
+        wx_camera cam_a = make_camera(0.5f, 0.5f, 1.0f, 0.5f, 0.5f, 0.0f, 0.0f, 1.0f, 0.0f, 1.0f,
+                                      1.0f, A_PX, A_PX);
+        test_maps a = render(cam_a, scene, 2, NULL);
+        wx_gather_view views[2] = { view_of(&a), view_of(&b) };
+        const float *planes[2] = { one, zero };
+        wx_texture_def td = { .mesh = &mesh,
+                              .uv = 0,
+                              .raster = &raster,
+                              .inputs = views,
+                              .input_count = 2,
+                              .smoothed = planes,
+                              .channels = 1,
+                              .threads = 1 };
+        float *planes_out[1] = { value };
+        ENSURE(wx_texture_sample(&td, planes_out, seen, NULL, &err) == WX_OK);
+        // Along the rows, two of A's texels from the square's border (where
+        // the taps of both cameras reach past it): the plateaus exact, the
+        // steps between neighbouring texels small.
+        double step = 0.0, plateau = 0.0, rise_start = 1.0, rise_end = 0.0;
+        const int lo = N / 4 + 2 * N / A_PX, hi = 3 * N / 4 - 2 * N / A_PX;
+        for (int j = lo; j < hi; ++j) {
+            for (int i = lo; i < hi; ++i) {
+                size_t t = (size_t)j * N + (size_t)i;
+                ENSURE(seen[t] > 0.5f);
+                double x = (i + 0.5) / N;
+                if (i > lo) {
+                    step = fmax(step, fabs((double)value[t] - value[t - 1]));
+                }
+                if (x < edge - 1.0 / A_PX) {
+                    plateau = fmax(plateau, fabs(value[t]));
+                } else if (x > edge + 1.0 / A_PX) {
+                    plateau = fmax(plateau, fabs(value[t] - 2.0 / 3.0));
+                }
+                if (value[t] > 0.0f && value[t] < 2.0f / 3.0f - 1e-4f) {
+                    rise_start = fmin(rise_start, x);
+                    rise_end = fmax(rise_end, x);
+                }
+            }
+        }
+        printf("        occluder's edge %.2f of A's texel on: largest step between neighbours "
+               "%.3f, rise over %.2f of A's texels, plateaus off by %.1e\n",
+               offsets[o], step, rise_end >= rise_start ? (rise_end - rise_start) * A_PX : 0.0,
+               plateau);
+        ENSURE(step < 0.3);
+        ENSURE(plateau < 1e-5);
+        maps_free(&a);
+    }
+    free(zero);
+    free(one);
+    free(value);
+    free(seen);
+    maps_free(&b);
+    wx_uv_raster_free(&raster);
+}
+
 // The rows-only raster against a brute-force test of every texel centre on
 // random triangles in and around the tile: every covered centre lies inside
 // its triangle (or within rounding of its edge), and every centre clearly
@@ -1421,6 +1523,7 @@ int main(void)
     RUN(texture_through_the_output_camera_equals_the_mask);
     RUN(mesh_without_uvs_is_refused);
     RUN(huge_and_unusable_uvs_are_bounded_and_counted);
+    RUN(texture_fades_out_a_camera_where_it_stops_seeing_the_surface);
     RUN(uv_raster_rows_agree_with_brute_force);
     RUN(obj_faces_without_usable_uvs_are_reported);
     RUN(huge_uvs_end_info_and_run);

@@ -560,9 +560,11 @@ typedef struct sample_job {
 } sample_job;
 
 // The values camera v holds at the point (world p, depth dp there, normal n),
-// into values[c]; false when it does not see the point.
+// into values[c], and in *coverage how much of its four bilinear taps see the
+// point (their weights times the normals' agreement, in (0, 1]); false when it
+// does not see the point.
 static bool sample_view(const sample_job *job, int v, const double p[3], const float n[3],
-                        float *values)
+                        float *values, float *coverage)
 {
     const view_sampler *s = &job->views[v];
     double x = s->cx[0] * p[0] + s->cx[1] * p[1] + s->cx[2] * p[2] + s->cx[3];
@@ -606,6 +608,7 @@ static bool sample_view(const sample_job *job, int v, const double p[3], const f
     for (int c = 0; c < channels; ++c) {
         values[c] /= den;
     }
+    *coverage = den;
     return true;
 }
 
@@ -634,18 +637,25 @@ static void sample_rows(int64_t begin, int64_t end, int worker, void *context)
                 sum[c] = 0.0f;
             }
             for (int v = 0; v < def->input_count; ++v) {
-                if (!sample_view(job, v, p, n, values)) {
+                float coverage = 0.0f;
+                if (!sample_view(job, v, p, n, values, &coverage)) {
                     continue;
                 }
                 // A camera that sees the surface head-on resolves it best:
                 // per unit of surface it has |N.view| texels, each of them
                 // |N.view| times as precise in depth, so its weight is
                 // |N.view|^2 (docs/texture.md: against |N.view| it lowers the
-                // noise, the error and what turning the model changes).
+                // noise, the error and what turning the model changes). And
+                // it counts as much as its taps around the point see it: near
+                // where it stops seeing the surface (its silhouettes, an
+                // occluder's edge, the end of what a layer holds) its value
+                // rests on the taps on one side, and its weight fades there
+                // instead of dropping from whole to nothing between two
+                // texels wherever its grid puts that step.
                 const float *ray = job->views[v].ray;
                 float cv = fabsf(n[0] * ray[0] + n[1] * ray[1] + n[2] * ray[2]);
                 cv = cv > WX_GATHER_AREA_MIN_COS ? cv : WX_GATHER_AREA_MIN_COS;
-                float w = cv * cv;
+                float w = cv * cv * coverage;
                 total += w;
                 for (int c = 0; c < channels; ++c) {
                     sum[c] += w * values[c];

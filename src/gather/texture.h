@@ -146,8 +146,10 @@ typedef struct wx_texture_def {
 
 /// Fills out[c] (width*height floats each, c < channels) and seen (the same
 /// size): at a covered texel whose point some input camera sees, the mean of
-/// the seeing cameras' values weighted by |N . view| (a camera that sees the
-/// surface head-on resolves it best), seen 1; at a covered texel no camera
+/// the seeing cameras' values weighted by |N . view|^2 (a camera that sees the
+/// surface head-on resolves it best) times the share of the camera's bilinear
+/// taps that see the point (it fades out where it stops seeing the surface),
+/// seen 1; at a covered texel no camera
 /// sees, 0 and seen 0; elsewhere 0 (wx_texture_pad fills the padding).
 /// `seen_texels` (may be NULL) gets the covered texels that are seen.
 wx_result wx_texture_sample(const wx_texture_def *def, float *const *out, float *seen,
