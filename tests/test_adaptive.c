@@ -187,7 +187,7 @@ static double one_on_the_left_half(int i, int j)
 // left half and none on the right, max_radius 1 m (10 texels): every texel of
 // the left half is capped (sqrt(937.5 / pi) = 17.3 texels would be needed).
 // The right half is not: beside the edge its texels are clean (an empty
-// half-rectangle where their density would have put 12 impacts), and beyond
+// half-disc where their density would have put 12 impacts), and beyond
 // 1 m no impact comes near them. Beyond 2 m (the reach of a capped kernel
 // from the lit side) it is exactly 0. (Between the clean band and 2 m, the
 // lit side's capped kernels leave a faint trace: docs/mask.md, "Adaptive
@@ -310,6 +310,70 @@ TEST(adaptive_does_not_cross_a_shadow_edge)
     ENSURE_NEAR(lit, 400.0, 400.0 * 0.02);
     ENSURE_NEAR(column[62], 400.0, 400.0 * 0.05); // two texels from the edge
     ENSURE(i90 >= 62 && i10 <= 66);
+}
+
+// A shadow edge across the grid: rain (4 impacts per texel) on one side of a
+// line through the wall's centre at `edge_angle` degrees to the camera's rows.
+static double edge_angle;
+
+static double edge_distance(int i, int j) // texels, positive on the dry side
+{
+    double a = edge_angle * 3.14159265358979323846 / 180.0;
+    return (i + 0.5 - 64.0) * cos(a) + (j + 0.5 - 64.0) * sin(a);
+}
+
+static double dry_beyond_a_slanted_edge(int i, int j)
+{
+    return edge_distance(i, j) < 0.0 ? 4.0 : 0.0;
+}
+
+// The clean side of a shadow edge reaches the edge whichever way the edge
+// crosses the grid: the texels 1.5 to 4.5 texels into the shadow read nothing
+// of the lit side, lined up with the rows or at 30 or 45 degrees to them. (The
+// four half-rectangles of the clean test until 6 December 2026 fitted a
+// slanted edge only some way from it, up to 0.7 times their reach, half the
+// radius: that band read 39% of the lit side at 30 degrees and 35% at 45,
+// lined up 0%, and turning a model moved the edge of every clean region:
+// docs/performance.md.)
+TEST(adaptive_shadow_edge_is_clean_at_any_angle_to_the_grid)
+{
+    static const double angles[3] = { 0.0, 30.0, 45.0 };
+    double band[3];
+    for (int a = 0; a < 3; ++a) {
+        edge_angle = angles[a];
+        quad wall = big_wall();
+        test_maps in = render(wall_camera(), &wall, 1, NULL);
+        test_maps out = render(wall_camera(), &wall, 1, NULL);
+        simulated sim = simulate_hits(&in, dry_beyond_a_slanted_edge, 0.0f, 11);
+        float *mask = run_adaptive(&out, &in, &sim, 0.04f, 3.0f, 2, NULL);
+        ENSURE(mask != NULL);
+        double lit = 0.0, dry = 0.0;
+        int n_lit = 0, n_dry = 0;
+        for (int j = 16; mask != NULL && j < 112; ++j) {
+            for (int i = 16; i < 112; ++i) {
+                double d = edge_distance(i, j);
+                if (d > -30.0 && d < -10.0) {
+                    lit += mask[j * 128 + i];
+                    n_lit++;
+                } else if (d > 1.5 && d < 4.5) {
+                    dry += mask[j * 128 + i];
+                    n_dry++;
+                }
+            }
+        }
+        band[a] = n_lit > 0 && n_dry > 0 ? (dry / n_dry) / (lit / n_lit) : 1.0;
+        printf("        edge at %2.0f degrees: 1.5-4.5 texels into the shadow %.4f of the lit "
+               "side (%.1f)\n",
+               angles[a], band[a], n_lit > 0 ? lit / n_lit : 0.0);
+        free(mask);
+        free(sim.initial);
+        free(sim.hits);
+        maps_free(&in);
+        maps_free(&out);
+    }
+    for (int a = 0; a < 3; ++a) {
+        ENSURE(band[a] <= 0.01);
+    }
 }
 
 // The wall ends at column 100, its edge along the camera's rows (a roof's eave
@@ -445,6 +509,7 @@ int main(void)
     RUN(adaptive_counts_as_capped_only_what_impacts_reach);
     RUN(adaptive_keeps_the_initial_dirt_exact);
     RUN(adaptive_does_not_cross_a_shadow_edge);
+    RUN(adaptive_shadow_edge_is_clean_at_any_angle_to_the_grid);
     RUN(adaptive_keeps_an_empty_last_column_of_a_silhouette);
     RUN(adaptive_keeps_the_dirt_and_its_bytes);
     RUN(adaptive_does_not_cross_creases_or_depth_jumps);

@@ -7,7 +7,7 @@
 //   2. per texel (rows on the pool): its radius h by bisection on the impacts
 //      within h (the rectangle around the texel scaled to the disc), and
 //      whether it lies in a clean region (no impact of its own, and an empty
-//      half-rectangle beside it where its density would put CLEAN_EXPECTED);
+//      half-disc beside it where its density would put CLEAN_EXPECTED);
 //   3. the samples' weights 1 / h^2 and the bounds of the radii per tile;
 //   4. per texel q (rows on the pool): the weighted mean of delta over the
 //      samples p that reach it, added to the initial dirt.
@@ -44,13 +44,29 @@ enum {
 // Slopes steeper than this (|N.view|) count as this one when a radius is chosen.
 #define MIN_SLOPE_COS 0.1f
 // A texel is clean (in a shadow, say) when it holds no impact and a
-// half-rectangle beside it holds none either although the texel's density
-// would put CLEAN_EXPECTED impacts there: the chance that this happens in a
+// half-disc beside it holds none either although the texel's density would
+// put CLEAN_EXPECTED impacts there: the chance that this happens in a
 // uniformly hit region is e^-12 per direction, 6e-6.
 #define CLEAN_EXPECTED 12.0
 // Fewer impacts than this leave a texel or a rectangle empty (the first pass
 // spreads an impact bilinearly over up to four texels).
 #define EMPTY_IMPACTS 0.5
+
+// The clean test's half-discs: the disc around a texel is cut into SECTORS
+// sectors by the angle of each neighbour's centre. A half-disc facing sector
+// m holds the impacts of the SECTORS / 2 + 2 sectors from m (half the disc and
+// one sector beyond each end of its straight side, so that the texels along
+// that side count for both halves), and its surface is that of the SECTORS / 2
+// - 2 sectors inside it (the texels along the straight side, the texel's own
+// line, never make a clean region on their own: see is_clean).
+enum { SECTORS = 64, IMPACT_SECTORS = SECTORS / 2 + 2, SURFACE_SECTORS = SECTORS / 2 - 2 };
+
+// A neighbour of the clean test: its offset, distance and sector.
+typedef struct disc_offset {
+    int di, dj;
+    float r;
+    int sector;
+} disc_offset;
 
 // Step 2's verdict on a texel (job.clean): clean, and, for a texel whose
 // radius reached max_radius, whether some impact lies within it (a surface no
@@ -83,6 +99,11 @@ typedef struct job {
     float *delta;         // change per unit area
     float *radius;        // h (world units) of a sample, 0 elsewhere
     unsigned char *clean; // step 2's verdict: TEXEL_CLEAN, TEXEL_SPARSE bits
+    float *impacts;       // the impacts of each texel (step 1's hits times area)
+    const disc_offset *disc; // the clean test's neighbours, by distance
+    int disc_count;
+    int *half_disc;       // [k]: surface texels of a half-disc of radius k, all surface
+    int k_max;            // the largest radius of a half-disc, texels
     double *sat;          // (width + 1) * (height + 1) summed impacts; in step 4,
                           // the samples with a change (pcoef != 0)
     double *sat_surface;  // the same for the texels with a surface
@@ -138,54 +159,69 @@ static double impacts_within(const job *jb, int i, int j, double h)
     return rect_sum(jb, jb->sat, i - kx, j - ky, i + kx, j + ky) * (disc / full);
 }
 
-// The half-rectangle of size k beside texel (i, j) on side `side` (0: right,
-// 1: left, 2: down, 3: up), the texel's own column or row included.
-static void half_rect(int i, int j, int k, int side, int r[4])
-{
-    r[0] = side == 1 ? i - k : i - (side >= 2 ? k : 0);
-    r[2] = side == 0 ? i + k : i + (side >= 2 ? k : 0);
-    r[1] = side == 3 ? j - k : j - (side < 2 ? k : 0);
-    r[3] = side == 2 ? j + k : j + (side < 2 ? k : 0);
-}
-
 // Whether texel (i, j), holding no impact of its own, lies in a clean region:
-// on some side the largest empty half-rectangle reaches at least k_min texels
-// out and covers enough surface texels beside the texel's own row or column
-// that `density` (impacts per texel) would have put CLEAN_EXPECTED there. (The
-// own line counted too until 6 December 2026: along a silhouette lined up with
-// the grid, whose last row had lost its hits to another camera, that row alone
-// made a long empty half-rectangle, and the texture drew a dark line two texels
-// wide along the model's edge that turning the model took away.) k_min (half
-// the texel's radius) keeps the sparse fringe of a dense region, where empty
-// pockets are small next to the radius, from being cut out of the mask.
-static bool is_clean(const job *jb, int i, int j, double density, int k_min, int k_max)
+// some half-disc around it, of radius k to k_max, holds no impact (under half
+// of one) and enough surface that `density` (impacts per texel) would have put
+// CLEAN_EXPECTED there. Half-discs in SECTORS directions: a straight shadow
+// edge at any angle to the grid has one facing away from it to within half a
+// sector, so the clean region reaches the edge whichever way the grid lies
+// (the half-rectangles of four sides used until 6 December 2026 fitted a
+// slanted edge only some way from it, up to 0.7 times their reach, and turning
+// the model moved the edge of every clean region: docs/performance.md). The
+// surface of the texels along the straight side does not count: a
+// silhouette's last row, with nothing beyond it, is no evidence of a clean
+// region however long it runs empty (and the texture drew a dark line two
+// texels wide along the model's edge that turning the model took away).
+static bool is_clean(const job *jb, int i, int j, double density, int k)
 {
-    for (int side = 0; side < 4; ++side) {
-        int r[4];
-        int lo = 0, hi = k_max; // the largest empty k lies in [lo, hi]
-        half_rect(i, j, hi, side, r);
-        if (rect_sum(jb, jb->sat, r[0], r[1], r[2], r[3]) >= EMPTY_IMPACTS) {
-            while (hi - lo > 1) {
-                int mid = (lo + hi) / 2;
-                half_rect(i, j, mid, side, r);
-                if (rect_sum(jb, jb->sat, r[0], r[1], r[2], r[3]) >= EMPTY_IMPACTS) {
-                    hi = mid;
-                } else {
-                    lo = mid;
+    const int W = jb->width, H = jb->height;
+    // Nothing in the square around the texel, all of it surface: every
+    // half-disc is empty and whole.
+    if (i - k >= 0 && j - k >= 0 && i + k < W && j + k < H &&
+        rect_sum(jb, jb->sat, i - k, j - k, i + k, j + k) < EMPTY_IMPACTS &&
+        rect_sum(jb, jb->sat_surface, i - k, j - k, i + k, j + k) >=
+            (double)(2 * k + 1) * (double)(2 * k + 1)) {
+        return density * jb->half_disc[k] >= CLEAN_EXPECTED;
+    }
+    if (!(density > 0.0)) {
+        return false; // no impact within the radius: unreached, not clean
+    }
+    double impacts[SECTORS] = { 0.0 }, surface[SECTORS] = { 0.0 };
+    const double wanted = CLEAN_EXPECTED / density;
+    for (int r = 1, o = 0; r <= jb->k_max; ++r) {
+        for (; o < jb->disc_count && jb->disc[o].r <= (float)r + 0.5f; ++o) {
+            int x = i + jb->disc[o].di, y = j + jb->disc[o].dj;
+            if (x < 0 || y < 0 || x >= W || y >= H) {
+                continue;
+            }
+            size_t t = (size_t)y * (size_t)W + (size_t)x;
+            if (!wx_depth_is_empty(jb->def->depth[t])) {
+                impacts[jb->disc[o].sector] += jb->impacts[t];
+                surface[jb->disc[o].sector] += 1.0;
+            }
+        }
+        if (r < k) {
+            continue;
+        }
+        // Running sums twice round: sectors m to m + n - 1 hold run[m + n] -
+        // run[m].
+        double run_impacts[2 * SECTORS + 1], run_surface[2 * SECTORS + 1];
+        run_impacts[0] = run_surface[0] = 0.0;
+        for (int m = 0; m < 2 * SECTORS; ++m) {
+            run_impacts[m + 1] = run_impacts[m] + impacts[m % SECTORS];
+            run_surface[m + 1] = run_surface[m] + surface[m % SECTORS];
+        }
+        bool empty_one = false;
+        for (int m = 0; m < SECTORS; ++m) {
+            if (run_impacts[m + IMPACT_SECTORS] - run_impacts[m] < EMPTY_IMPACTS) {
+                empty_one = true;
+                if (run_surface[m + 2 + SURFACE_SECTORS] - run_surface[m + 2] >= wanted) {
+                    return true;
                 }
             }
-        } else {
-            lo = hi;
         }
-        half_rect(i, j, lo, side, r);
-        // The surface beside the texel's own line: a silhouette's last row,
-        // with nothing beyond it, is no evidence of a clean region however
-        // long it runs empty along the row.
-        double surface = rect_sum(jb, jb->sat_surface, r[0], r[1], r[2], r[3]) -
-                         (side < 2 ? rect_sum(jb, jb->sat_surface, i, r[1], i, r[3])
-                                   : rect_sum(jb, jb->sat_surface, r[0], j, r[2], j));
-        if (lo >= k_min && density * surface >= CLEAN_EXPECTED) {
-            return true;
+        if (!empty_one) {
+            return false; // every half-disc holds an impact, and so do larger ones
         }
     }
     return false;
@@ -197,7 +233,7 @@ static bool is_clean(const job *jb, int i, int j, double density, int k_min, int
 // impacts (|N.view| at least MIN_SLOPE_COS).
 static void radii_row(const job *jb, int j)
 {
-    const int k_max = (int)ceil(jb->max_radius / fminf(jb->texel_i, jb->texel_j));
+    const int k_max = jb->k_max;
     for (int i = 0; i < jb->width; ++i) {
         size_t t = (size_t)j * (size_t)jb->width + (size_t)i;
         size_t p = jb->base + (size_t)j * jb->stride + (size_t)i;
@@ -232,8 +268,16 @@ static void radii_row(const job *jb, int j)
         if (own < EMPTY_IMPACTS) {
             double texels = 3.14159265358979323846 * (h / jb->texel_i) * (h / jb->texel_j);
             double density = impacts_within(jb, i, j, h) / texels;
-            int k_min = (int)ceil(0.5 * h / fmax(jb->texel_i, jb->texel_j));
-            jb->clean[t] = is_clean(jb, i, j, density, k_min, k_max) ? TEXEL_CLEAN : 0;
+            // The half-disc reaches at least half the texel's radius (so that
+            // the sparse fringe of a dense region, where empty pockets are
+            // small next to the radius, is not cut out of the mask), and as
+            // far as a whole one must to expect CLEAN_EXPECTED impacts.
+            int k = (int)ceil(0.5 * h / fmax(jb->texel_i, jb->texel_j));
+            k = k < 1 ? 1 : k;
+            while (k < k_max && density * jb->half_disc[k] < CLEAN_EXPECTED) {
+                ++k;
+            }
+            jb->clean[t] = is_clean(jb, i, j, density, k) ? TEXEL_CLEAN : 0;
         }
         jb->clean[t] |= sparse;
     }
@@ -402,6 +446,54 @@ static int build_offsets(const wx_adaptive_def *def, const double px[3], const d
     return count;
 }
 
+static int compare_disc_offsets(const void *a, const void *b)
+{
+    const disc_offset *x = a, *y = b;
+    if (x->r != y->r) {
+        return x->r < y->r ? -1 : 1;
+    }
+    if (x->dj != y->dj) {
+        return x->dj < y->dj ? -1 : 1;
+    }
+    return x->di < y->di ? -1 : x->di > y->di;
+}
+
+// The clean test's neighbours within k_max + 1/2 texels, by distance, each
+// with its sector, and half_disc[k] for k = 0 .. k_max: the most surface texels
+// a half-disc of radius k counts where every texel has a surface.
+static int build_disc(int k_max, disc_offset *out, int *half_disc)
+{
+    const double pi = 3.14159265358979323846;
+    int count = 0;
+    for (int dj = -k_max; dj <= k_max; ++dj) {
+        for (int di = -k_max; di <= k_max; ++di) {
+            float r = sqrtf((float)(di * di + dj * dj));
+            if ((di == 0 && dj == 0) || r > (float)k_max + 0.5f) {
+                continue;
+            }
+            int sector = (int)floor((atan2((double)dj, (double)di) + pi) / (2.0 * pi) * SECTORS);
+            out[count++] = (disc_offset){ di, dj, r, sector < SECTORS ? sector : SECTORS - 1 };
+        }
+    }
+    qsort(out, (size_t)count, sizeof *out, compare_disc_offsets);
+    int per_sector[SECTORS] = { 0 };
+    for (int k = 0, o = 0; k <= k_max; ++k) {
+        for (; o < count && out[o].r <= (float)k + 0.5f; ++o) {
+            per_sector[out[o].sector]++;
+        }
+        int best = 0;
+        for (int m = 0; m < SECTORS; ++m) {
+            int n = 0;
+            for (int q = 0; q < SURFACE_SECTORS; ++q) {
+                n += per_sector[(m + 2 + q) % SECTORS];
+            }
+            best = n > best ? n : best;
+        }
+        half_disc[k] = best;
+    }
+    return count;
+}
+
 // A tile's bound: the largest radius of the samples of the tiles that can
 // reach it.
 static void bound_tiles(job *jb, const float *tile_max)
@@ -483,6 +575,11 @@ wx_result wx_adaptive_smooth(const wx_adaptive_def *def, float *out, wx_adaptive
     jb.delta = wx_big_malloc(texels * sizeof *jb.delta);
     jb.radius = wx_big_calloc(texels, sizeof *jb.radius);
     jb.clean = wx_big_calloc(texels, 1);
+    jb.impacts = wx_big_malloc(texels * sizeof *jb.impacts);
+    const int k_max = (int)ceil(max_r / fmin(texel_i, texel_j));
+    const size_t disc_cap = (size_t)(2 * k_max + 1) * (size_t)(2 * k_max + 1);
+    disc_offset *disc = malloc(disc_cap * sizeof *disc);
+    jb.half_disc = malloc(((size_t)k_max + 1) * sizeof *jb.half_disc);
     jb.sat = wx_big_calloc(2 * sat_size, sizeof *jb.sat);
     jb.tile_bound = calloc(tiles, sizeof *jb.tile_bound);
     float *tile_max = calloc(tiles, sizeof *tile_max);
@@ -490,11 +587,14 @@ wx_result wx_adaptive_smooth(const wx_adaptive_def *def, float *out, wx_adaptive
     wx_result r = WX_OK;
     if (offsets == NULL || jb.reach_i == NULL || scratch == NULL || jb.delta == NULL ||
         jb.radius == NULL || jb.clean == NULL || jb.sat == NULL || jb.tile_bound == NULL ||
-        tile_max == NULL) {
+        tile_max == NULL || jb.impacts == NULL || disc == NULL || jb.half_disc == NULL) {
         r = wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "gather: out of memory (adaptive smoothing)");
         goto done;
     }
     jb.sat_surface = jb.sat + sat_size;
+    jb.k_max = k_max;
+    jb.disc_count = build_disc(k_max, disc, jb.half_disc);
+    jb.disc = disc;
     jb.offset_count = build_offsets(def, px, py, z, pad_x - 1, pad_y - 1, max_r, texel, offsets);
     jb.offsets = offsets;
     for (int o = 0; o < jb.offset_count; ++o) {
@@ -521,6 +621,7 @@ wx_result wx_adaptive_smooth(const wx_adaptive_def *def, float *out, wx_adaptive
             size_t p = jb.base + (size_t)j * jb.stride + (size_t)i;
             const float *n = &def->normal[3 * t];
             jb.delta[t] = 0.0f;
+            jb.impacts[t] = 0.0f;
             if (!wx_depth_is_empty(def->depth[t])) {
                 float cos_view = fabsf(n[0] * view[0] + n[1] * view[1] + n[2] * view[2]);
                 double area = head_area / (cos_view > AREA_MIN_COS ? cos_view : AREA_MIN_COS);
@@ -530,7 +631,9 @@ wx_result wx_adaptive_smooth(const wx_adaptive_def *def, float *out, wx_adaptive
                 jb.pnz[p] = n[2];
                 jb.pzn[p] = (float)(n[0] * z[0] + n[1] * z[1] + n[2] * z[2]);
                 float hits = def->hits[t];
-                row += hits > 0.0f && hits < INFINITY ? (double)hits * area : 0.0;
+                double impacts = hits > 0.0f && hits < INFINITY ? (double)hits * area : 0.0;
+                jb.impacts[t] = (float)impacts;
+                row += impacts;
                 row_surface += 1.0;
                 float change = def->total[t] - def->initial[t];
                 jb.delta[t] = isfinite(change) ? change : 0.0f;
@@ -606,6 +709,9 @@ done:
     free(tile_max);
     free(jb.tile_bound);
     free(jb.sat);
+    free(jb.half_disc);
+    free(disc);
+    free(jb.impacts);
     free(jb.clean);
     free(jb.radius);
     free(jb.delta);

@@ -18,7 +18,7 @@
 // detail (small h), a sparse one becomes smooth (large h), a constant change
 // stays constant up to every border, and nothing crosses a crease (the
 // normals), a depth jump (the distance and the plane test) or a shadow edge: a
-// texel with no impact of its own beside an empty half-rectangle where its
+// texel with no impact of its own beside an empty half-disc where its
 // density would have put 12 impacts is clean, and neither gives nor takes.
 //
 // Computed as a gather over q, in rows on the pool: the same result for any
