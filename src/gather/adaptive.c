@@ -183,8 +183,8 @@ static bool is_clean(const job *jb, int i, int j, double density, int k)
             (double)(2 * k + 1) * (double)(2 * k + 1)) {
         return density * jb->half_disc[k] >= CLEAN_EXPECTED;
     }
-    if (!(density > 0.0)) {
-        return false; // no impact within the radius: unreached, not clean
+    if (!(density * jb->half_disc[jb->k_max] >= CLEAN_EXPECTED)) {
+        return false; // not even the largest half-disc would expect enough
     }
     double impacts[SECTORS] = { 0.0 }, surface[SECTORS] = { 0.0 };
     const double wanted = CLEAN_EXPECTED / density;
