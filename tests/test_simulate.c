@@ -12,6 +12,7 @@
 #include "model/scene.h"
 #include "sim/force_field.h"
 #include "sim_fixture.h"
+#include "sim/collider.h"
 #include "sim/simulate.h"
 #include "core/limits.h"
 #include "io/scene_xml.h"
@@ -280,6 +281,53 @@ TEST(a_slide_inside_a_half_pipe_swings_as_a_pendulum)
         double t = half_pipe_swing(px[k], &speed);
         ENSURE_NEAR(t, 0.5385, 0.5385 * 0.01);
         ENSURE_NEAR(speed, 3.130, 3.130 * 0.025);
+    }
+}
+
+// A slide that meets a bump of the collision surface (where two cameras'
+// surfaces meet) goes back in front of it by a lift (docs/physics.md,
+// "Bumps"). The lift leaves the surface square, along the contact's normal,
+// whichever camera recorded the contact and at whatever angle that camera sees
+// the surface: it moves the particle off the surface, never along it. Along
+// the camera's axis, as until 7 December 2026, a top camera recording a slope
+// of 50 degrees moved the particle 0.77 of the lift uphill, a side camera
+// 0.64 of it downhill, and which camera recorded a slope depended on how the
+// model sat in the camera grid (issue 25's rotation test).
+TEST(a_lift_over_a_bump_leaves_the_surface_square_for_any_camera)
+{
+    const float pi = 3.14159265f;
+    // Cameras looking down, from the side, and obliquely; the back vector is
+    // the unit step towards the camera.
+    const float backs[4][3] = { { 0, 1, 0 }, { 1, 0, 0 }, { 0, 0, -1 }, { 0.6f, 0.64f, 0.48f } };
+    for (int c = 0; c < 4; ++c) {
+        wx_collider_camera cam;
+        memset(&cam, 0, sizeof cam);
+        float bl = sqrtf(backs[c][0] * backs[c][0] + backs[c][1] * backs[c][1] +
+                         backs[c][2] * backs[c][2]);
+        for (int k = 0; k < 3; ++k) {
+            cam.back[k] = backs[c][k] / bl;
+        }
+        cam.texel_ws = 0.004f;
+        for (int tilt = 0; tilt <= 170; tilt += 10) {
+            for (int az = 0; az < 360; az += 45) {
+                float t = (float)tilt * pi / 180.0f, a = (float)az * pi / 180.0f;
+                float n[3] = { sinf(t) * cosf(a), cosf(t), sinf(t) * sinf(a) };
+                float climb = 0.64f, lift[3];
+                wx_collider_bump_lift(&cam, n, climb, lift);
+                float along_n = lift[0] * n[0] + lift[1] * n[1] + lift[2] * n[2];
+                float towards =
+                    lift[0] * cam.back[0] + lift[1] * cam.back[1] + lift[2] * cam.back[2];
+                float facing = n[0] * cam.back[0] + n[1] * cam.back[1] + n[2] * cam.back[2];
+                float tangent = 0.0f;
+                for (int k = 0; k < 3; ++k) {
+                    tangent += powf(lift[k] - along_n * n[k], 2.0f);
+                }
+                ENSURE_NEAR(fabsf(along_n), climb * cam.texel_ws, 1e-7);
+                ENSURE(sqrtf(tangent) <= 1e-7f);  // nothing along the surface
+                ENSURE(facing * along_n >= 0.0f); // the side its camera sees
+                ENSURE(towards >= 0.0f || facing < 0.0f);
+            }
+        }
     }
 }
 
@@ -897,6 +945,7 @@ int main(void)
     RUN(bounce_returns_to_its_height);
     RUN(sliding_down_an_incline);
     RUN(a_slide_inside_a_half_pipe_swings_as_a_pendulum);
+    RUN(a_lift_over_a_bump_leaves_the_surface_square_for_any_camera);
     RUN(box_from_front_back_and_top);
     RUN(fast_particle_stops_at_a_thin_wall);
     RUN(streaks_are_continuous);

@@ -988,3 +988,17 @@ bool wx_collider_sweep(const wx_collider *collider, const float p0[3], const flo
     hit->bounce = cam->impact[2 * at + 1];
     return true;
 }
+
+void wx_collider_bump_lift(const wx_collider_camera *cam, const float n[3], float climb,
+                           float out[3])
+{
+    // Along the camera's axis (until 7 December 2026) the lift also slid the
+    // particle along the surface towards the camera: uphill where the top
+    // camera recorded a slope, downhill where a side camera did, so the camera
+    // grid a slope's slides fell in set how they went.
+    float facing = n[0] * cam->back[0] + n[1] * cam->back[1] + n[2] * cam->back[2];
+    float lift = (facing >= 0.0f ? climb : -climb) * cam->texel_ws;
+    for (int k = 0; k < 3; ++k) {
+        out[k] = lift * n[k];
+    }
+}

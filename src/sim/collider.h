@@ -170,6 +170,14 @@ typedef struct wx_hit {
 bool wx_collider_sweep(const wx_collider *collider, const float p0[3], const float p1[3],
                        wx_hit *hit);
 
+/// How far a slide goes back in front of a bump of the collision surface
+/// (sim/step.c, rest_of_step; docs/physics.md, "Bumps"): `climb` texels of
+/// the contact's camera `cam` along the contact's unit normal `n`, towards the
+/// side of the surface that camera sees; into `out`. Square to the surface,
+/// so the lift moves the particle off it, never along it.
+void wx_collider_bump_lift(const wx_collider_camera *cam, const float n[3], float climb,
+                           float out[3]);
+
 /// The point rule of docs/design.md section 4 for one point (no sweep).
 bool wx_collider_point_collides(const wx_collider *collider, const float p[3]);
 

@@ -107,9 +107,10 @@ enum { SLIDE_CONTACTS = 16 };
 // meet, each right to its own precision, the collider takes the innermost).
 // It takes nothing off the move, so the slide would meet it again at once:
 // the particle goes back a little further in front of it, along that
-// contact's camera axis, 1/100 texel more at the first such contact in a row
-// and twice as far at each next one (where the way there is free), so it
-// climbs a bump of h texels in about log2(100 h) contacts.
+// contact's normal towards the side its camera sees, 1/100 of that camera's
+// texel more at the first such contact in a row and twice as far at each next
+// one (where the way there is free), so it climbs a bump of h texels in about
+// log2(100 h) contacts.
 static void rest_of_step(const wx_sim *sim, const float from[3], float time, const float v[3],
                          int contacts, float out[3])
 {
@@ -142,12 +143,10 @@ static void rest_of_step(const wx_sim *sim, const float from[3], float time, con
             climb = 0.01f;
             continue;
         }
-        const wx_collider_camera *cam = &collider->cameras[again.camera];
-        float back = sqrtf(cam->back[0] * cam->back[0] + cam->back[1] * cam->back[1] +
-                           cam->back[2] * cam->back[2]);
-        float lift = climb * cam->texel_ws / back, up[3];
+        float lift[3], up[3];
+        wx_collider_bump_lift(&collider->cameras[again.camera], n, climb, lift);
         for (int k = 0; k < 3; ++k) {
-            up[k] = at[k] + lift * cam->back[k];
+            up[k] = at[k] + lift[k];
         }
         // Only where the way there is free: a lift must not carry the
         // particle through a slab or a pane between it and the camera.
