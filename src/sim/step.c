@@ -149,7 +149,7 @@ static void rest_of_step(const wx_sim *sim, const float from[3], float time, con
             up[k] = at[k] + lift[k];
         }
         // Only where the way there is free: a lift must not carry the
-        // particle through a slab or a pane between it and the camera.
+        // particle through a slab or a pane.
         wx_hit above;
         if (!meets_surface(collider, at, up, &above)) {
             memcpy(at, up, sizeof up);
