@@ -387,16 +387,23 @@ static void run_rows(int64_t begin, int64_t end, int worker, void *context)
     }
 }
 
+// The order of both neighbour tables: by distance, then row, then column (a
+// fixed order, so ties between equal distances never depend on qsort).
+static int compare_by_distance(float ra, int dja, int dia, float rb, int djb, int dib)
+{
+    if (ra != rb) {
+        return ra < rb ? -1 : 1;
+    }
+    if (dja != djb) {
+        return dja < djb ? -1 : 1;
+    }
+    return dia < dib ? -1 : dia > dib;
+}
+
 static int compare_offsets(const void *a, const void *b)
 {
     const offset *x = a, *y = b;
-    if (x->r != y->r) {
-        return x->r < y->r ? -1 : 1;
-    }
-    if (x->dj != y->dj) {
-        return x->dj < y->dj ? -1 : 1;
-    }
-    return x->di < y->di ? -1 : x->di > y->di;
+    return compare_by_distance(x->r, x->dj, x->di, y->r, y->dj, y->di);
 }
 
 static int compare_floats(const void *a, const void *b)
@@ -449,13 +456,7 @@ static int build_offsets(const wx_adaptive_def *def, const double px[3], const d
 static int compare_disc_offsets(const void *a, const void *b)
 {
     const disc_offset *x = a, *y = b;
-    if (x->r != y->r) {
-        return x->r < y->r ? -1 : 1;
-    }
-    if (x->dj != y->dj) {
-        return x->dj < y->dj ? -1 : 1;
-    }
-    return x->di < y->di ? -1 : x->di > y->di;
+    return compare_by_distance(x->r, x->dj, x->di, y->r, y->dj, y->di);
 }
 
 // The clean test's neighbours within k_max + 1/2 texels, by distance, each
