@@ -24,6 +24,13 @@
 # elevation="90"/>`, the exact density up to a factor where nothing slides)
 # in the same TextureMap; the comparison reads its `dirt.Y`. What the rain's
 # first hits and the gather give, without the slides.
+#
+# TURN=A (default 30): the turn in degrees. SHIFT=X (default 0): the turned
+# copy also moved X along +x (the mesh's unit). TURN=90 meets the same camera
+# grid up to where its texels fall; TURN=0 SHIFT=half a texel asks what that
+# alone does (then the same seed follows nearly the same paths, and the seeds'
+# yardstick does not apply: read the part both seeds share,
+# tests/tools/diagnosis/common_part.py).
 set -eu
 build=$1
 mesh=$2
@@ -35,14 +42,16 @@ esac
 dir=$build/invariance
 rm -rf "$dir"
 mkdir -p "$dir"
-# The mesh turned 30 degrees about +Y around its bounding box's centre.
+# The mesh turned TURN degrees about +Y around its bounding box's centre (and
+# moved SHIFT along +x).
 awk '/^v / { n++; x[n] = $2; z[n] = $4
              if (n == 1 || $2 < x0) x0 = $2; if (n == 1 || $2 > x1) x1 = $2
              if (n == 1 || $4 < z0) z0 = $4; if (n == 1 || $4 > z1) z1 = $4 }
      END { printf "%.9g %.9g\n", (x0 + x1) / 2, (z0 + z1) / 2 }' "$mesh" > "$dir/centre"
 read cx cz < "$dir/centre"
-awk -v cx="$cx" -v cz="$cz" 'BEGIN { c = cos(30 * 3.14159265358979 / 180); s = sin(30 * 3.14159265358979 / 180) }
-     /^v / { x = $2 - cx; z = $4 - cz; printf "v %.9g %s %.9g\n", cx + c * x + s * z, $3, cz - s * x + c * z; next }
+awk -v cx="$cx" -v cz="$cz" -v turn="${TURN:-30}" -v dx="${SHIFT:-0}" \
+    'BEGIN { c = cos(turn * 3.14159265358979 / 180); s = sin(turn * 3.14159265358979 / 180) }
+     /^v / { x = $2 - cx; z = $4 - cz; printf "v %.9g %s %.9g\n", cx + dx + c * x + s * z, $3, cz - s * x + c * z; next }
      /^vn / { x = $2; z = $4; printf "vn %.9g %s %.9g\n", c * x + s * z, $3, -s * x + c * z; next }
      { print }' "$mesh" > "$dir/turned.obj"
 cp "$mesh" "$dir/model.obj"
