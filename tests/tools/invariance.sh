@@ -78,17 +78,8 @@ for m in model turned; do
         (cd "$dir" && "../weathering" run "$m.xml" --out "$m$s" --seed "$s" -q)
     done
 done
+sh "$(dirname "$0")/invariance_compare.sh" "$dir" "$build" "$channel"
 c=$build/tools/texture_compare
-$c "$dir/model1/model_texture.exr" "$dir/model2/model_texture.exr" "$channel" > "$dir/seeds_model"
-$c "$dir/turned1/turned_texture.exr" "$dir/turned2/turned_texture.exr" "$channel" > "$dir/seeds_turned"
-$c "$dir/model1/model_texture.exr" "$dir/turned1/turned_texture.exr" "$channel" > "$dir/turn_1"
-$c "$dir/model2/model_texture.exr" "$dir/turned2/turned_texture.exr" "$channel" > "$dir/turn_2"
-for k in 1 2 4 8 16 32; do
-    get() { awk -v k="$k" '$1 == "block" && $2 + 0 == k { print $4 }' "$dir/$1"; }
-    awk -v k="$k" -v a="$(get seeds_model)" -v b="$(get seeds_turned)" -v c="$(get turn_1)" \
-        -v d="$(get turn_2)" 'BEGIN { s = (a + b) / 2; o = (c + d) / 2
-        printf "block %2d: seeds %.4f  orientations %.4f  ratio %.3f\n", k, s, o, o / s }'
-done
 [ "$seeds" -gt 2 ] || exit 0
 # Every pair: one line per comparison, "kind block rms".
 for m in model turned; do
