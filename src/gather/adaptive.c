@@ -585,10 +585,13 @@ wx_result wx_adaptive_smooth(const wx_adaptive_def *def, float *out, wx_adaptive
     jb.tile_bound = calloc(tiles, sizeof *jb.tile_bound);
     float *tile_max = calloc(tiles, sizeof *tile_max);
     float *sorted = NULL;
+    // The noise each capped texel keeps, for the stats (step 3).
+    float *capped_noise = stats != NULL ? malloc(texels * sizeof *capped_noise) : NULL;
     wx_result r = WX_OK;
     if (offsets == NULL || jb.reach_i == NULL || scratch == NULL || jb.delta == NULL ||
         jb.radius == NULL || jb.clean == NULL || jb.sat == NULL || jb.tile_bound == NULL ||
-        tile_max == NULL || jb.impacts == NULL || disc == NULL || jb.half_disc == NULL) {
+        tile_max == NULL || jb.impacts == NULL || disc == NULL || jb.half_disc == NULL ||
+        (stats != NULL && capped_noise == NULL)) {
         r = wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "gather: out of memory (adaptive smoothing)");
         goto done;
     }
@@ -649,7 +652,8 @@ wx_result wx_adaptive_smooth(const wx_adaptive_def *def, float *out, wx_adaptive
     jb.pass = 2;
     wx_pool_for(def->pool, H, 8, run_rows, &jb);
 
-    // Step 3: the samples.
+    // Step 3: the samples, and the noise the capped ones keep (while the
+    // impacts' table is still there).
     int64_t samples = 0, capped = 0;
     double largest = 0.0;
     for (int j = 0; j < H; ++j) {
@@ -666,7 +670,18 @@ wx_result wx_adaptive_smooth(const wx_adaptive_def *def, float *out, wx_adaptive
                 jb.pweight[p] = 1.0f / (h * h);
                 jb.pcoef[p] = jb.pweight[p] * jb.delta[t];
                 samples++;
-                capped += h >= jb.max_radius && (jb.clean[t] & TEXEL_SPARSE);
+                if (h >= jb.max_radius && (jb.clean[t] & TEXEL_SPARSE)) {
+                    // Its noise: K' impacts give the aim, fewer give it times
+                    // sqrt(K' / impacts) (docs/mask.md, "The radius").
+                    if (capped_noise != NULL) {
+                        float cos_view = fabsf(jb.pzn[p]) * jb.inv_z;
+                        double want =
+                            jb.target_hits / (cos_view > MIN_SLOPE_COS ? cos_view : MIN_SLOPE_COS);
+                        double have = impacts_within(&jb, i, j, jb.max_radius);
+                        capped_noise[capped] = (float)(def->noise * sqrt(want / have));
+                    }
+                    capped++;
+                }
                 largest = h > largest ? h : largest;
                 size_t tile = (size_t)(j / TILE) * (size_t)jb.tiles_x + (size_t)(i / TILE);
                 tile_max[tile] = h > tile_max[tile] ? h : tile_max[tile];
@@ -704,8 +719,13 @@ wx_result wx_adaptive_smooth(const wx_adaptive_def *def, float *out, wx_adaptive
             qsort(sorted, (size_t)samples, sizeof *sorted, compare_floats);
             stats->median_radius = sorted[samples / 2];
         }
+        if (capped > 0 && capped_noise != NULL) {
+            qsort(capped_noise, (size_t)capped, sizeof *capped_noise, compare_floats);
+            stats->capped_noise = capped_noise[capped / 2];
+        }
     }
 done:
+    free(capped_noise);
     free(sorted);
     free(tile_max);
     free(jb.tile_bound);

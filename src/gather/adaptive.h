@@ -56,6 +56,10 @@ typedef struct wx_adaptive_stats {
     /// Such texels whose K impacts lie beyond max_radius, with some impact
     /// within it (a surface no impact comes near is not noisy, only unreached).
     int64_t capped;
+    /// The noise those texels keep (relative standard deviation, as `noise`:
+    /// noise x sqrt(K' / the impacts within max_radius)), the median over
+    /// them; 0 when none is capped.
+    double capped_noise;
 } wx_adaptive_stats;
 
 /// Writes the smoothed mask (dirt per unit area: the initial dirt exactly plus

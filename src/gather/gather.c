@@ -938,6 +938,7 @@ wx_result wx_gather_compute(const wx_gather_def *def, float *mask_out, wx_gather
         stats->median_radius = smoothing.median_radius;
         stats->largest_radius = smoothing.max_radius_used;
         stats->capped_texels = smoothing.capped;
+        stats->capped_noise = smoothing.capped_noise;
     }
     wx_pool_destroy(pool);
     free(scratch);

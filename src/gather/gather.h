@@ -102,6 +102,9 @@ typedef struct wx_gather_stats {
     double median_radius;
     double largest_radius;
     int64_t capped_texels;
+    /// The noise the capped texels keep, their median (relative standard
+    /// deviation; 0 when none is capped).
+    double capped_noise;
 } wx_gather_stats;
 
 /// The rows mapping a point into the texel space of an input camera (texel

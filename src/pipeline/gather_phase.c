@@ -202,10 +202,11 @@ static wx_result write_mask(const wx_scene *scene, const wx_run_def *opts, const
             10 * st.capped_texels > st.surface_texels) {
             wx_note(opts->quiet,
                     "gather: %.0f%% of the mask's surface holds fewer than the %.0f impacts "
-                    "within maxRadius (%g m) that %g%% noise needs: it stays noisier; fly more "
-                    "particles or raise maxRadius",
+                    "within maxRadius (%g m) that %g%% noise needs: its noise there is about "
+                    "%.2g%% (the median); where that shows, fly more particles or raise "
+                    "maxRadius",
                     100.0 * (double)st.capped_texels / (double)st.surface_texels, st.target_hits,
-                    (double)out->max_radius, 100.0 * (double)out->noise);
+                    (double)out->max_radius, 100.0 * (double)out->noise, 100.0 * st.capped_noise);
         }
     }
     // The derived masks after the substances (a Combine reads them).
