@@ -115,13 +115,13 @@ typedef struct wx_memory_need {
 /// channels while it is read; one plane more per channel beyond them) and per
 /// output texel (its depth and normal, the mask, the first pass's three planes,
 /// the adaptive smoothing's eight padded planes, summed-area tables, radii,
-/// changes and impacts, the preview's sorted values and pixels, and in a run the output
+/// changes, impacts and capped texels' noise, the preview's sorted values and pixels, and in a run the output
 /// camera's baked depth and normal kept from the bake; the fixed second pass
 /// needs less). The gather runs once per substance on the same planes; the mask
 /// holds one plane more per substance beyond the first. Measured: 690 MB for a
 /// 2048-px `gather` with three 2048-px input cameras, estimated 920 MB.
 #define WX_GATHER_BYTES_PER_INPUT_TEXEL 36.0
-#define WX_GATHER_BYTES_PER_OUTPUT_TEXEL 116.0
+#define WX_GATHER_BYTES_PER_OUTPUT_TEXEL 120.0
 /// Margin over the measured sizes: allocator rounding and small buffers, and
 /// the peak's variation with the threads' timing from run to run of the same
 /// scene (the bunny's peak: 351, 353 and 420 MiB in three

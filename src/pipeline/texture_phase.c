@@ -564,12 +564,12 @@ int64_t wx_texture_bytes(const wx_scene *scene, const wx_texture_map *t, int64_t
     // The raster (triangle and source) and its build's count; the image's
     // channels and the preview's alpha; the compressed chunks written (at most
     // the image again); every channel but seen on every input camera, and the
-    // gather's planes for one of them (the adaptive pass's 14 floats a texel).
+    // gather's planes for one of them (the adaptive pass's 15 floats a texel).
     // The derived masks' points (and with layers the enclosed faces' test's):
     // a double position, a normal and a flag.
     const int64_t points =
         scene->mask_count > 0 || wx_scene_has_layers(scene) ? texels * (24 + 12 + 1) : 0;
     return points + texels * (4 + 4 + 1) + texels * 4 * (channels + 1) + texels * 4 * channels +
            camera_texels * 4 * (channels - 1) + camera_texels / (scene->input_count > 0 ?
-                                                                 scene->input_count : 1) * 4 * 14;
+                                                                 scene->input_count : 1) * 4 * 15;
 }
