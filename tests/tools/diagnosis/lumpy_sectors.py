@@ -8,7 +8,7 @@ In one run its lumps lie at three angles to the cameras' axes (the axes
 repeat every 90 degrees, the lumps every 120), so how far the thirds differ
 beyond their noise is what the camera grid does to the rain, measured without
 turning the model (issue 25 item 1; docs/performance.md, "Four more variants
-for item 1").
+and two measurements for item 1").
 
 Each argument is the `Y` channel of one seed's TextureMap (1024 x 1024 floats,
 build/tools/exr_channel FILE.exr Y OUT.f32). The texture is binned in cells of
