@@ -159,6 +159,14 @@ static double impacts_within(const job *jb, int i, int j, double h)
     return rect_sum(jb, jb->sat, i - kx, j - ky, i + kx, j + ky) * (disc / full);
 }
 
+// The impacts the disc of the texel at padded index p must hold: K' = K /
+// |N.view| (at least MIN_SLOPE_COS), the disc being taken across the view.
+static double impacts_wanted(const job *jb, size_t p)
+{
+    float cos_view = fabsf(jb->pzn[p]) * jb->inv_z;
+    return jb->target_hits / (cos_view > MIN_SLOPE_COS ? cos_view : MIN_SLOPE_COS);
+}
+
 // Whether texel (i, j), holding no impact of its own, lies in a clean region:
 // some half-disc around it, of radius k to k_max, holds no impact (under half
 // of one) and enough surface that `density` (impacts per texel) would have put
@@ -242,8 +250,7 @@ static void radii_row(const job *jb, int j)
         if (wx_depth_is_empty(jb->def->depth[t])) {
             continue;
         }
-        float cos_view = fabsf(jb->pzn[p]) * jb->inv_z;
-        double want = jb->target_hits / (cos_view > MIN_SLOPE_COS ? cos_view : MIN_SLOPE_COS);
+        double want = impacts_wanted(jb, p);
         double lo = jb->min_radius, hi = jb->max_radius;
         double h, at_max;
         unsigned char sparse = 0;
@@ -674,11 +681,9 @@ wx_result wx_adaptive_smooth(const wx_adaptive_def *def, float *out, wx_adaptive
                     // Its noise: K' impacts give the aim, fewer give it times
                     // sqrt(K' / impacts) (docs/mask.md, "The radius").
                     if (capped_noise != NULL) {
-                        float cos_view = fabsf(jb.pzn[p]) * jb.inv_z;
-                        double want =
-                            jb.target_hits / (cos_view > MIN_SLOPE_COS ? cos_view : MIN_SLOPE_COS);
                         double have = impacts_within(&jb, i, j, jb.max_radius);
-                        capped_noise[capped] = (float)(def->noise * sqrt(want / have));
+                        capped_noise[capped] =
+                            (float)(def->noise * sqrt(impacts_wanted(&jb, p) / have));
                     }
                     capped++;
                 }

@@ -64,6 +64,8 @@ def main():
     seeds = [binned(p) for p in sys.argv[1:]]
     n = len(seeds)
     mean = [[sum(s[r][c] for s in seeds) / n for c in range(COLS)] for r in range(ROWS)]
+    # Each seed's deviation from the seeds' mean, for the noise below.
+    resid = [[[s[r][c] - mean[r][c] for c in range(COLS)] for r in range(ROWS)] for s in seeds]
     print("colatitude   mean       thirds   noise")
     for band in range(0, ROWS, 2):
         rows = (band, band + 1)
@@ -73,7 +75,6 @@ def main():
         dev = deviation(mean, rows)
         # The noise of that figure: each seed's own thirds' deviation about the
         # seeds' mean, over sqrt(seeds).
-        resid = [[[s[r][c] - mean[r][c] for c in range(COLS)] for r in range(ROWS)] for s in seeds]
         noise = math.sqrt(sum(deviation(x, rows) ** 2 for x in resid) / n / max(1, n - 1))
         print("%3d-%3d  %10.1f   %.4f   %.4f" % (band * 5, band * 5 + 10, m, dev / m, noise / m))
 
