@@ -89,13 +89,18 @@ wx_result wx_pilot_run(const wx_scene *scene, const wx_run_def *opts, wx_geometr
 {
     memset(report, 0, sizeof *report);
     double start = wx_now_s();
+    // Every iteration: particles still flying at the end of one fly on into
+    // the next (docs/design.md, "Iterations"), so the share still flying at the
+    // end of the run, which the run warns on, is the last iteration's. The
+    // thinning counts every iteration's particles.
+    const int64_t iterations = scene->iterations > 1 ? scene->iterations : 1;
     double duration = wx_scene_duration(scene), total = 0.0;
     for (int e = 0; e < scene->emitter_count; ++e) {
         // rate x time in double: the count saturates at INT64_MAX (rate="1e300"),
         // which would thin such an emitter too little.
         const wx_emitter *em = &scene->emitters[e];
         double span = fmin(duration, em->end) - em->start;
-        total += span > 0.0 && em->rate > 0.0 ? em->rate * span : 0.0;
+        total += span > 0.0 && em->rate > 0.0 ? em->rate * span * (double)iterations : 0.0;
     }
     if (!(total > 0.0) || scene->input_count == 0) {
         return WX_OK;
@@ -157,7 +162,7 @@ wx_result wx_pilot_run(const wx_scene *scene, const wx_run_def *opts, wx_geometr
         def.maps = maps;
         r = wx_sim_create(&pilot, &def, &sim, err);
     }
-    for (int64_t s = 0; s < pilot.steps && r == WX_OK; ++s) {
+    for (int64_t s = 0; s < pilot.steps * iterations && r == WX_OK; ++s) {
         r = wx_sim_step(sim, err);
     }
     if (r == WX_OK) {

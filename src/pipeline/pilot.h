@@ -1,8 +1,9 @@
 // pilot.h: a small run that `info` flies before any real work, to say what
 // share of a run's particles would leave the bounding box without hitting
-// anything (issue 15): the emitters thinned to about WX_PILOT_PARTICLES
-// particles, the baked cameras rendered in memory at most WX_PILOT_SIDE texels a
-// side, the same physics, nothing written.
+// anything (issue 15), and what share would still fly at the end: the
+// emitters thinned to about WX_PILOT_PARTICLES particles over all the
+// iterations, the baked cameras rendered in memory at most WX_PILOT_SIDE texels
+// a side, the same steps, iterations and physics, nothing written.
 #ifndef WX_PILOT_H
 #define WX_PILOT_H
 
