@@ -17,22 +17,30 @@
 /// Runs `weathering COMMAND SCENE --out DIR -q` (with `--stats STATS` unless
 /// stats is NULL) from the repository's root and returns its peak resident
 /// memory in MiB (wait4's ru_maxrss), or -1 when it did not exit with status 0.
-static inline double command_peak_mib(const char *command, const char *scene, const char *dir,
-                                      const char *stats)
+/// With a log, the run is not quiet and its stderr (warnings, notes, the
+/// summary) goes to that file.
+static inline double command_peak_mib_logged(const char *command, const char *scene,
+                                             const char *dir, const char *stats, const char *log)
 {
     char program[4200];
     snprintf(program, sizeof program, "%s/weathering", ensure_build_dir());
     pid_t pid = fork();
     if (pid == 0) {
         int null = open("/dev/null", O_WRONLY);
+        int err = log != NULL ? open(log, O_WRONLY | O_CREAT | O_TRUNC, 0644) : null;
         dup2(null, STDOUT_FILENO);
-        dup2(null, STDERR_FILENO);
-        if (stats != NULL) {
-            execl(program, program, command, scene, "--out", dir, "-q", "--stats", stats,
-                  (char *)NULL);
-        } else {
-            execl(program, program, command, scene, "--out", dir, "-q", (char *)NULL);
+        dup2(err >= 0 ? err : null, STDERR_FILENO);
+        const char *argv[10] = { program, command, scene, "--out", dir };
+        int n = 5;
+        if (log == NULL) {
+            argv[n++] = "-q";
         }
+        if (stats != NULL) {
+            argv[n++] = "--stats";
+            argv[n++] = stats;
+        }
+        argv[n] = NULL;
+        execv(program, (char *const *)argv);
         _exit(98);
     }
     int status = 0;
@@ -42,6 +50,13 @@ static inline double command_peak_mib(const char *command, const char *scene, co
         return -1.0;
     }
     return (double)usage.ru_maxrss / 1024.0;
+}
+
+/// command_peak_mib_logged without a log: a quiet run.
+static inline double command_peak_mib(const char *command, const char *scene, const char *dir,
+                                      const char *stats)
+{
+    return command_peak_mib_logged(command, scene, dir, stats, NULL);
 }
 
 /// command_peak_mib of `weathering run`.
