@@ -179,6 +179,43 @@ TEST(adaptive_radius_doubles_for_a_quarter_of_the_impacts)
     printf("        capped at 1 m: noise %.4f (the median over the capped texels)\n",
            capped.capped_noise);
     ENSURE_NEAR(capped.capped_noise, 0.04 * 1.727, 0.004);
+    // Counted in bins (what a TextureMap's note merges over its cameras): every
+    // capped texel counted once, and the bins' median within half a bin (a
+    // 64th of an octave, 1.09%) of the exact one.
+    int64_t binned = 0;
+    for (int k = 0; k < WX_NOISE_BINS; ++k) {
+        binned += capped.capped_noise_bins[k];
+    }
+    ENSURE(binned == capped.capped_texels);
+    double from_bins = wx_noise_bins_median(capped.capped_noise_bins);
+    printf("        the same from the bins: %.4f\n", from_bins);
+    ENSURE(fabs(log2(from_bins / capped.capped_noise)) <= 0.5 / WX_NOISE_BINS_PER_OCTAVE + 1e-9);
+}
+
+// The noise bins: a 32nd of an octave from 0.1%, everything below in the first
+// and everything above in the last; the median is the bin of the element a sort
+// puts at count / 2, as the exact median takes it.
+TEST(noise_bins_cover_every_noise_and_give_the_median)
+{
+    ENSURE(wx_noise_bin(0.0) == 0);
+    ENSURE(wx_noise_bin(-1.0) == 0);
+    ENSURE(wx_noise_bin(NAN) == 0);
+    ENSURE(wx_noise_bin(1e300) == WX_NOISE_BINS - 1);
+    ENSURE(wx_noise_bin(INFINITY) == WX_NOISE_BINS - 1);
+    ENSURE(wx_noise_bin(0.002) == WX_NOISE_BINS_PER_OCTAVE); // one octave above 0.1%
+    ENSURE(wx_noise_bin(0.002 * 1.001) == WX_NOISE_BINS_PER_OCTAVE);
+    ENSURE(wx_noise_bin(0.002 * 0.999) == WX_NOISE_BINS_PER_OCTAVE - 1);
+    int64_t bins[WX_NOISE_BINS] = { 0 };
+    ENSURE(wx_noise_bins_median(bins) == 0.0);
+    // 0.01, 0.04, 0.04, 0.5: sorted, element 2 is 0.04.
+    const double values[] = { 0.5, 0.04, 0.01, 0.04 };
+    for (int k = 0; k < 4; ++k) {
+        bins[wx_noise_bin(values[k])]++;
+    }
+    double median = wx_noise_bins_median(bins);
+    ENSURE(fabs(log2(median / 0.04)) <= 1.0 / WX_NOISE_BINS_PER_OCTAVE);
+    bins[wx_noise_bin(0.5)] += 2; // now 0.01, 0.04, 0.04, 0.5, 0.5, 0.5: element 3
+    ENSURE(fabs(log2(wx_noise_bins_median(bins) / 0.5)) <= 1.0 / WX_NOISE_BINS_PER_OCTAVE);
 }
 
 static double one_on_the_left_half(int i, int j)
@@ -511,6 +548,7 @@ int main(void)
 {
     RUN(adaptive_noise_follows_the_impacts);
     RUN(adaptive_radius_doubles_for_a_quarter_of_the_impacts);
+    RUN(noise_bins_cover_every_noise_and_give_the_median);
     RUN(adaptive_counts_as_capped_only_what_impacts_reach);
     RUN(adaptive_keeps_the_initial_dirt_exact);
     RUN(adaptive_does_not_cross_a_shadow_edge);

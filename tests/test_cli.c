@@ -596,6 +596,42 @@ TEST(the_capped_note_says_how_noisy_the_mask_stays)
                                 "raise maxRadius\n"));
 }
 
+// A TextureMap says the same of its own smoothing, which runs on the input
+// cameras' texels with their own largest radius: Spot's dust texture, over the
+// first substance's capped texels of all five cameras (their noise merged in
+// bins of a 32nd of an octave).
+TEST(the_capped_note_says_how_noisy_the_texture_stays)
+{
+    SLOW();
+    ENSURE(ensure_shell(out, sizeof out,
+                        "cd '%s/..' && '%s/weathering' run xml_scenes/spot.xml --out "
+                        "'%s/capped_texture' 2>&1 >/dev/null",
+                        ensure_tests_dir(), build_dir(), ensure_tmpdir()) == 0);
+    // The texture's capped note (its coverage note comes first).
+    static const char lead[] = "note: texture spot_texture.exr: ";
+    const char *at = strstr(out, lead);
+    while (at != NULL) {
+        const char *rest = at + strlen(lead), *pct = strchr(rest, '%');
+        if (pct != NULL && pct - rest < 8 && strncmp(pct, "% of the surface", 16) == 0) {
+            break;
+        }
+        at = strstr(rest, lead);
+    }
+    ENSURE(at != NULL);
+    printf("        the note: ...%s", at != NULL ? at : "(none)\n");
+    double share = at != NULL ? atof(at + strlen(lead)) : 0.0;
+    ENSURE(share > 10.0 && share < 100.0);
+    ENSURE(ensure_contains(at, "% of the surface its input cameras see holds fewer than the 938 "
+                               "impacts within maxRadius (16 texels of each input camera) that "
+                               "4% noise needs: its noise there is about "));
+    static const char about[] = "its noise there is about ";
+    const char *n = at != NULL ? strstr(at, about) : NULL;
+    double noise = n != NULL ? atof(n + strlen(about)) : 0.0;
+    ENSURE(noise > 4.0 && noise < 30.0);
+    ENSURE(ensure_contains(at, "% (the median); where that shows, fly more particles or raise "
+                               "the TextureMap's maxRadius\n"));
+}
+
 // Spot (closed) with every face wound the other way, in the teapot's scene:
 // its OBJ has no normals, so the generated ones point in. info says the
 // import turned it outwards, naming the scene line and the mesh; -q keeps
@@ -650,5 +686,6 @@ int main(void)
     RUN(summary_tells_hits_from_particles_still_flying);
     RUN(a_mesh_wound_inwards_is_turned_with_a_note);
     RUN(the_capped_note_says_how_noisy_the_mask_stays);
+    RUN(the_capped_note_says_how_noisy_the_texture_stays);
     return ensure_summary();
 }

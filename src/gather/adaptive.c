@@ -526,6 +526,32 @@ static void bound_tiles(job *jb, const float *tile_max)
     }
 }
 
+int wx_noise_bin(double noise)
+{
+    if (!(noise > WX_NOISE_BIN_LOW)) {
+        return 0;
+    }
+    double b = floor(WX_NOISE_BINS_PER_OCTAVE * log2(noise / WX_NOISE_BIN_LOW));
+    return b < WX_NOISE_BINS - 1 ? (int)b : WX_NOISE_BINS - 1;
+}
+
+double wx_noise_bins_median(const int64_t bins[WX_NOISE_BINS])
+{
+    int64_t count = 0;
+    for (int b = 0; b < WX_NOISE_BINS; ++b) {
+        count += bins[b];
+    }
+    // The element sorted to count / 2, as the exact median takes it.
+    int64_t below = 0;
+    for (int b = 0; b < WX_NOISE_BINS && count > 0; ++b) {
+        if (below + bins[b] > count / 2) {
+            return WX_NOISE_BIN_LOW * exp2((b + 0.5) / WX_NOISE_BINS_PER_OCTAVE);
+        }
+        below += bins[b];
+    }
+    return 0.0;
+}
+
 wx_result wx_adaptive_smooth(const wx_adaptive_def *def, float *out, wx_adaptive_stats *stats,
                              wx_error *err)
 {
@@ -727,6 +753,9 @@ wx_result wx_adaptive_smooth(const wx_adaptive_def *def, float *out, wx_adaptive
         if (capped > 0 && capped_noise != NULL) {
             qsort(capped_noise, (size_t)capped, sizeof *capped_noise, compare_floats);
             stats->capped_noise = capped_noise[capped / 2];
+            for (int64_t k = 0; k < capped; ++k) {
+                stats->capped_noise_bins[wx_noise_bin(capped_noise[k])]++;
+            }
         }
     }
 done:

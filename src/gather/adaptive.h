@@ -31,6 +31,11 @@
 #include "core/error.h"
 #include "core/parallel.h"
 
+/// Bins of capped_noise_bins (wx_noise_bin): 0.1% to 6 550%.
+#define WX_NOISE_BINS            512
+#define WX_NOISE_BIN_LOW         0.001
+#define WX_NOISE_BINS_PER_OCTAVE 32
+
 /// The inputs, views into memory the caller owns. Planes are width*height, row 0
 /// at the top; texels without a surface have depth +inf (model/maps.h).
 typedef struct wx_adaptive_def {
@@ -60,7 +65,19 @@ typedef struct wx_adaptive_stats {
     /// noise x sqrt(K' / the impacts within max_radius)), the median over
     /// them; 0 when none is capped.
     double capped_noise;
+    /// The same texels counted by their noise (wx_noise_bin), so that several
+    /// gathers' capped texels (a TextureMap's input cameras) give one median.
+    int64_t capped_noise_bins[WX_NOISE_BINS];
 } wx_adaptive_stats;
+
+/// The bin of a noise (relative standard deviation) in capped_noise_bins:
+/// bins a 32nd of an octave wide (2.2%) from 0.1%, the first and the last
+/// holding everything below and above.
+int wx_noise_bin(double noise);
+
+/// The median noise of the texels counted in bins (the geometric middle of its
+/// bin); 0 when the bins are empty.
+double wx_noise_bins_median(const int64_t bins[WX_NOISE_BINS]);
 
 /// Writes the smoothed mask (dirt per unit area: the initial dirt exactly plus
 /// the smoothed change) into out[width*height]; 0 where there is no surface.

@@ -939,6 +939,8 @@ wx_result wx_gather_compute(const wx_gather_def *def, float *mask_out, wx_gather
         stats->largest_radius = smoothing.max_radius_used;
         stats->capped_texels = smoothing.capped;
         stats->capped_noise = smoothing.capped_noise;
+        memcpy(stats->capped_noise_bins, smoothing.capped_noise_bins,
+               sizeof stats->capped_noise_bins);
     }
     wx_pool_destroy(pool);
     free(scratch);

@@ -14,6 +14,7 @@
 #include <stdint.h>
 
 #include "core/error.h"
+#include "gather/adaptive.h"
 #include "gather/target.h"
 #include "model/camera.h"
 #include "model/maps.h"
@@ -103,8 +104,9 @@ typedef struct wx_gather_stats {
     double largest_radius;
     int64_t capped_texels;
     /// The noise the capped texels keep, their median (relative standard
-    /// deviation; 0 when none is capped).
+    /// deviation; 0 when none is capped), and counted by bins (adaptive.h).
     double capped_noise;
+    int64_t capped_noise_bins[WX_NOISE_BINS];
 } wx_gather_stats;
 
 /// The rows mapping a point into the texel space of an input camera (texel

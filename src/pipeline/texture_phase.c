@@ -267,13 +267,42 @@ static bool same_smoothing(const wx_texture_map *a, const wx_texture_map *b)
            a->max_radius == b->max_radius;
 }
 
+// The note of the final texture when much of its surface keeps more noise than
+// it asks for (as the mask's, gather_phase.c): the first substance's capped
+// texels over every input camera's own texels, which the texture samples.
+static void note_capped(const wx_run_def *opts, const wx_texture_map *key,
+                        const wx_gather_stats *sum)
+{
+    if (!key->adaptive || sum->surface_texels <= 0 ||
+        10 * sum->capped_texels <= sum->surface_texels) {
+        return;
+    }
+    char radius[64];
+    if (key->max_radius > 0.0f) {
+        snprintf(radius, sizeof radius, "%g m", (double)key->max_radius);
+    } else {
+        snprintf(radius, sizeof radius, "%g texels of each input camera",
+                 (double)WX_DEFAULT_MAX_RADIUS_TEXELS);
+    }
+    wx_note(opts->quiet,
+            "texture %s: %.0f%% of the surface its input cameras see holds fewer than the %.0f "
+            "impacts within maxRadius (%s) that %g%% noise needs: its noise there is about "
+            "%.2g%% (the median); where that shows, fly more particles or raise the "
+            "TextureMap's maxRadius",
+            key->file, 100.0 * (double)sum->capped_texels / (double)sum->surface_texels,
+            sum->target_hits, radius, 100.0 * (double)key->noise,
+            100.0 * wx_noise_bins_median(sum->capped_noise_bins));
+}
+
 static wx_result compute_planes(const wx_scene *scene, const wx_run_def *opts,
                                 const wx_maps *in_maps, wx_gather_view *views, int channels,
-                                const wx_texture_map *key, float **planes, wx_error *err)
+                                const wx_texture_map *key, bool note, float **planes, wx_error *err)
 {
     const int k_count = scene->input_count;
     wx_result r = WX_OK;
     int k = 0;
+    wx_gather_stats sum, st;
+    memset(&sum, 0, sizeof sum);
     // The mask on every input camera's texels, a channel at a time.
     wx_progress progress;
     wx_progress_begin(&progress, "texture", (int64_t)k_count * channels, opts->quiet);
@@ -307,12 +336,23 @@ static wx_result compute_planes(const wx_scene *scene, const wx_run_def *opts,
                                  : WX_DEFAULT_MAX_RADIUS_TEXELS * frame_w / (float)m->width;
             def.threads = opts->threads;
             def.quiet = true;
-            r = wx_gather_compute(&def, *plane, NULL, err);
+            r = wx_gather_compute(&def, *plane, c == 0 ? &st : NULL, err);
+            if (r == WX_OK && c == 0) {
+                sum.surface_texels += st.surface_texels;
+                sum.capped_texels += st.capped_texels;
+                sum.target_hits = st.target_hits;
+                for (int b = 0; b < WX_NOISE_BINS; ++b) {
+                    sum.capped_noise_bins[b] += st.capped_noise_bins[b];
+                }
+            }
             wx_progress_update(&progress, (int64_t)k * channels + c + 1);
         }
         k++;
     }
     wx_progress_end(&progress);
+    if (r == WX_OK && note) {
+        note_capped(opts, key, &sum);
+    }
     return r;
 }
 
@@ -535,7 +575,7 @@ wx_result wx_textures_write(const wx_scene *scene, const wx_run_def *opts,
             cache[slot].planes = calloc((size_t)planes_per_key + 1, sizeof *cache[slot].planes);
             cached++;
             r = cache[slot].planes != NULL
-                    ? compute_planes(scene, opts, in_maps, views, substances, t->def,
+                    ? compute_planes(scene, opts, in_maps, views, substances, t->def, frame == 0,
                                      cache[slot].planes, err)
                     : wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "texture: out of memory");
             if (detail != NULL) {
