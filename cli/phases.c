@@ -140,11 +140,13 @@ int cli_run_phases(const cli_args *args, unsigned phases)
     }
     run.times.total = wx_now_s() - start;
     if (r == WX_OK && opts.stats_path != NULL) {
-        r = wx_write_stats(opts.stats_path, &run.stats, &run.times, opts.threads, opts.seed, &err);
+        r = wx_write_stats(opts.stats_path, &run.stats, &run.times, &run.noise, opts.threads,
+                           opts.seed, &err);
     }
     if (r == WX_OK && !opts.quiet) {
         print_summary(&scene, &opts, &run, args->command, phases);
     }
+    wx_noise_report_free(&run.noise);
     wx_scene_free(&scene);
     return cli_report(r, &err);
 }

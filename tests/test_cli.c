@@ -584,8 +584,8 @@ TEST(the_capped_note_says_how_noisy_the_mask_stays)
 {
     ENSURE(ensure_shell(out, sizeof out,
                         "cd '%s/..' && '%s/weathering' run xml_scenes/thesis_box.xml --out "
-                        "'%s/capped' 2>&1 >/dev/null",
-                        ensure_tests_dir(), build_dir(), ensure_tmpdir()) == 0);
+                        "'%s/capped' --stats '%s/capped.json' 2>&1 >/dev/null",
+                        ensure_tests_dir(), build_dir(), ensure_tmpdir(), ensure_tmpdir()) == 0);
     static const char lead[] = "that 4% noise needs: its noise there is about ";
     const char *at = strstr(out, lead);
     ENSURE(at != NULL);
@@ -594,6 +594,28 @@ TEST(the_capped_note_says_how_noisy_the_mask_stays)
     ENSURE(noise > 4.0 && noise < 20.0);
     ENSURE(ensure_contains(out, "% (the median); where that shows, fly more particles or "
                                 "raise maxRadius\n"));
+    static const char share_lead[] = "weathering: note: gather: ";
+    const char *share_at = strstr(out, share_lead);
+    ENSURE(share_at != NULL);
+    double share = atof(share_at + strlen(share_lead));
+    // --stats holds the same figures, unrounded, under "noise" and the mask's
+    // file name.
+    char path[4300];
+    snprintf(path, sizeof path, "%s/capped.json", ensure_tmpdir());
+    char *json = ensure_read_file(path);
+    ENSURE(json != NULL);
+    const char *entry = strstr(json, "\"noise\": {\n    \"thesis_box_mask.exr\": { \"aim\": 0.04, "
+                                     "\"impacts_aimed_at\": 937.5, ");
+    const char *median = entry != NULL ? strstr(entry, "\"capped_noise_median\": ") : NULL;
+    const char *capped = entry != NULL ? strstr(entry, "\"capped_share\": ") : NULL;
+    double stats_noise = median != NULL ? atof(median + 23) : -1.0;
+    double stats_share = capped != NULL ? atof(capped + 16) : -1.0;
+    free(json);
+    printf("        --stats: capped_share %.4f, capped_noise_median %.5f\n", stats_share,
+           stats_noise);
+    ENSURE(entry != NULL);
+    ENSURE(fabs(100.0 * stats_noise - noise) <= 0.051);
+    ENSURE(fabs(100.0 * stats_share - share) <= 0.51);
 }
 
 // A TextureMap says the same of its own smoothing, which runs on the input
@@ -605,8 +627,8 @@ TEST(the_capped_note_says_how_noisy_the_texture_stays)
     SLOW();
     ENSURE(ensure_shell(out, sizeof out,
                         "cd '%s/..' && '%s/weathering' run xml_scenes/spot.xml --out "
-                        "'%s/capped_texture' 2>&1 >/dev/null",
-                        ensure_tests_dir(), build_dir(), ensure_tmpdir()) == 0);
+                        "'%s/capped_texture' --stats '%s/capped_texture.json' 2>&1 >/dev/null",
+                        ensure_tests_dir(), build_dir(), ensure_tmpdir(), ensure_tmpdir()) == 0);
     // The texture's capped note (its coverage note comes first).
     static const char lead[] = "note: texture spot_texture.exr: ";
     const char *at = strstr(out, lead);
@@ -630,6 +652,23 @@ TEST(the_capped_note_says_how_noisy_the_texture_stays)
     ENSURE(noise > 4.0 && noise < 30.0);
     ENSURE(ensure_contains(at, "% (the median); where that shows, fly more particles or raise "
                                "the TextureMap's maxRadius\n"));
+    // --stats: the mask's entry, then the texture's with the note's figures.
+    char path[4300];
+    snprintf(path, sizeof path, "%s/capped_texture.json", ensure_tmpdir());
+    char *json = ensure_read_file(path);
+    ENSURE(json != NULL);
+    const char *mask = strstr(json, "\"noise\": {\n    \"mask.exr\": {");
+    const char *entry = mask != NULL ? strstr(mask, "\n    \"spot_texture.exr\": {") : NULL;
+    const char *median = entry != NULL ? strstr(entry, "\"capped_noise_median\": ") : NULL;
+    const char *capped = entry != NULL ? strstr(entry, "\"capped_share\": ") : NULL;
+    double stats_noise = median != NULL ? atof(median + 23) : -1.0;
+    double stats_share = capped != NULL ? atof(capped + 16) : -1.0;
+    free(json);
+    printf("        --stats: capped_share %.4f, capped_noise_median %.5f\n", stats_share,
+           stats_noise);
+    ENSURE(entry != NULL);
+    ENSURE(fabs(100.0 * stats_noise - noise) <= 0.051);
+    ENSURE(fabs(100.0 * stats_share - share) <= 0.51);
 }
 
 // Spot (closed) with every face wound the other way, in the teapot's scene:

@@ -125,7 +125,7 @@ TEST(stats_json_has_the_pinned_keys_and_values)
                            .dirt_final_surface = 60, .dirt_in_flight = 11.5,
                            .dirt_escaped = 30 };
     wx_phase_times times = { .load = 0.25, .simulate = 1.5, .total = 2 };
-    ENSURE(wx_write_stats(path, &stats, &times, 2, 9, NULL) == WX_OK);
+    ENSURE(wx_write_stats(path, &stats, &times, NULL, 2, 9, NULL) == WX_OK);
     char *json = ensure_read_file(path);
     ENSURE(json != NULL);
     ENSURE(ensure_contains(json, "\"particles_emitted\": 100,"));

@@ -79,6 +79,7 @@ static bool fails_in_process_for(const char *path, const ensure_expectation *wan
         def.quiet = true;
         wx_run_report report;
         r = wx_run_phases(&scene, &def, WX_PHASE_ALL, &report, &err);
+        wx_noise_report_free(&report.noise);
     }
     wx_scene_free(&scene);
     if (r == WX_BAD_INPUT && err.cause == want->cause) {

@@ -9,8 +9,9 @@
 #include "core/error.h"
 #include "model/stats.h"
 
-/// Writes the --stats JSON atomically.
+/// Writes the --stats JSON atomically; `noise` (may be NULL or empty) adds the
+/// object "noise", one entry per output smoothed adaptively, keyed by its file.
 wx_result wx_write_stats(const char *path, const wx_sim_stats *stats, const wx_phase_times *times,
-                         int threads, uint64_t seed, wx_error *err);
+                         const wx_noise_report *noise, int threads, uint64_t seed, wx_error *err);
 
 #endif

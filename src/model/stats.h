@@ -7,6 +7,7 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+#include "core/error.h"
 #include "core/limits.h"
 
 /// The ledger of one substance (docs/design.md section 9): exact to rounding,
@@ -65,6 +66,35 @@ typedef struct wx_phase_detail {
     double compute;
     double write;
 } wx_phase_detail;
+
+/// How noisy an output of the adaptive smoothing stays where its radius
+/// reached maxRadius with fewer impacts than its noise needs: the figures of
+/// the gather's note (docs/mask.md, "Notes it prints"), for --stats.
+typedef struct wx_noise_figures {
+    char file[WX_OUTPUT_NAME_MAX]; ///< the mask's or the TextureMap's file
+    double aim;                    ///< `noise`
+    double target_hits;            ///< K: the impacts within a radius the aim needs
+    /// The texels smoothed (a TextureMap's: every input camera's own, the
+    /// first substance's) and those capped.
+    int64_t surface_texels;
+    int64_t capped_texels;
+    double capped_noise; ///< the capped texels' median noise; 0 when none is capped
+} wx_noise_figures;
+
+/// The final gather's wx_noise_figures, one per output smoothed adaptively, in
+/// the order written (the mask first).
+typedef struct wx_noise_report {
+    int count;
+    wx_noise_figures *items;
+} wx_noise_report;
+
+/// Appends `figures` to `report` (NULL: nothing to do). WX_FAIL when out of
+/// memory.
+wx_result wx_noise_report_add(wx_noise_report *report, const wx_noise_figures *figures,
+                              wx_error *err);
+
+/// Frees the report's figures and empties it.
+void wx_noise_report_free(wx_noise_report *report);
 
 /// Wall-clock seconds per phase.
 typedef struct wx_phase_times {

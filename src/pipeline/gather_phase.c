@@ -20,7 +20,7 @@
 
 static wx_result write_mask(const wx_scene *scene, const wx_run_def *opts, const wx_maps *in_maps,
                             const wx_maps *given_out, wx_mask_context *masks, int frame,
-                            wx_phase_detail *detail, wx_error *err);
+                            wx_phase_detail *detail, wx_noise_report *noise, wx_error *err);
 
 wx_result wx_gather_scene(const wx_scene *scene, const wx_run_def *opts, wx_error *err)
 {
@@ -31,7 +31,7 @@ wx_result wx_gather_scene(const wx_scene *scene, const wx_run_def *opts, wx_erro
     }
     wx_result result = wx_load_gather_maps(scene, opts, in_maps, err);
     if (result == WX_OK) {
-        result = wx_gather_maps(scene, opts, in_maps, NULL, NULL, NULL, NULL, err);
+        result = wx_gather_maps(scene, opts, in_maps, NULL, NULL, NULL, NULL, NULL, err);
     }
     for (int c = 0; c < input_count; ++c) {
         wx_maps_free(&in_maps[c]);
@@ -63,15 +63,16 @@ wx_result wx_gather_check(const wx_scene *scene, wx_error *err)
 
 wx_result wx_gather_maps(const wx_scene *scene, const wx_run_def *opts, const wx_maps *in_maps,
                          const wx_maps *given_out, const wx_textures *textures,
-                         wx_mask_context *masks, wx_phase_detail *detail, wx_error *err)
+                         wx_mask_context *masks, wx_phase_detail *detail, wx_noise_report *noise,
+                         wx_error *err)
 {
-    return wx_gather_frame(scene, opts, in_maps, given_out, textures, masks, 0, detail, err);
+    return wx_gather_frame(scene, opts, in_maps, given_out, textures, masks, 0, detail, noise, err);
 }
 
 wx_result wx_gather_frame(const wx_scene *scene, const wx_run_def *opts, const wx_maps *in_maps,
                           const wx_maps *given_out, const wx_textures *textures,
                           wx_mask_context *given_masks, int frame, wx_phase_detail *detail,
-                          wx_error *err)
+                          wx_noise_report *noise, wx_error *err)
 {
     wx_phase_detail local;
     detail = detail != NULL ? detail : &local;
@@ -104,12 +105,12 @@ wx_result wx_gather_frame(const wx_scene *scene, const wx_run_def *opts, const w
         int every = scene->cameras[scene->output_index].every;
         if (frame == 0 || (every > 0 && frame % every == 0)) {
             r = write_mask(&layered.scene, opts, layered.maps, given_out, masks, frame, detail,
-                           err);
+                           noise, err);
         }
     }
     if (r == WX_OK) {
         r = wx_textures_write(&layered.scene, opts, textures, layered.maps, masks, frame, detail,
-                              err);
+                              noise, err);
     }
     wx_layer_scene_free(&layered);
     if (masks == &own) {
@@ -121,7 +122,7 @@ wx_result wx_gather_frame(const wx_scene *scene, const wx_run_def *opts, const w
 // The mask of frame `frame` (0: the final file and its previews).
 static wx_result write_mask(const wx_scene *scene, const wx_run_def *opts, const wx_maps *in_maps,
                             const wx_maps *given_out, wx_mask_context *masks, int frame,
-                            wx_phase_detail *detail, wx_error *err)
+                            wx_phase_detail *detail, wx_noise_report *noise, wx_error *err)
 {
     double t0 = wx_now_s();
     const wx_scene_camera *out = &scene->cameras[scene->output_index];
@@ -198,6 +199,15 @@ static wx_result write_mask(const wx_scene *scene, const wx_run_def *opts, const
         def.quiet = opts->quiet;
         wx_gather_stats st;
         result = wx_gather_compute(&def, image->channels[s], &st, err);
+        if (result == WX_OK && s == 0 && frame == 0 && def.adaptive) {
+            wx_noise_figures figures = { .aim = out->noise,
+                                         .target_hits = st.target_hits,
+                                         .surface_texels = st.surface_texels,
+                                         .capped_texels = st.capped_texels,
+                                         .capped_noise = st.capped_noise };
+            snprintf(figures.file, sizeof figures.file, "%s", out->output_file);
+            result = wx_noise_report_add(noise, &figures, err);
+        }
         if (result == WX_OK && s == 0 && frame == 0 && def.adaptive && st.surface_texels > 0 &&
             10 * st.capped_texels > st.surface_texels) {
             wx_note(opts->quiet,

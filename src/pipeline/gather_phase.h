@@ -38,10 +38,12 @@ wx_result wx_gather_scene(const wx_scene *scene, const wx_run_def *opts, wx_erro
 /// TextureMap of `textures` (may be NULL: none; texture_phase.h). `masks` is
 /// the derived masks' context (masks_phase.h) made from the same in_maps and
 /// kept by the caller over several frames, or NULL: one is made for this call.
-/// `detail` (may be NULL) gets the read, compute and write times.
+/// `detail` (may be NULL) gets the read, compute and write times, `noise`
+/// (may be NULL) the figures of every output smoothed adaptively.
 wx_result wx_gather_maps(const wx_scene *scene, const wx_run_def *opts, const wx_maps *in_maps,
                          const wx_maps *out_maps, const struct wx_textures *textures,
-                         struct wx_mask_context *masks, wx_phase_detail *detail, wx_error *err);
+                         struct wx_mask_context *masks, wx_phase_detail *detail,
+                         wx_noise_report *noise, wx_error *err);
 
 /// wx_gather_maps for frame `frame` of an image sequence (docs/design.md
 /// section 10): frame 0 writes the final BASE.exr and its previews, frame k > 0
@@ -50,6 +52,6 @@ wx_result wx_gather_maps(const wx_scene *scene, const wx_run_def *opts, const wx
 wx_result wx_gather_frame(const wx_scene *scene, const wx_run_def *opts, const wx_maps *in_maps,
                           const wx_maps *out_maps, const struct wx_textures *textures,
                           struct wx_mask_context *masks, int frame, wx_phase_detail *detail,
-                          wx_error *err);
+                          wx_noise_report *noise, wx_error *err);
 
 #endif

@@ -69,6 +69,7 @@ wx_result wx_run_phases(wx_scene *scene, const wx_run_def *opts, unsigned phases
                         wx_run_report *report, wx_error *err)
 {
     double start = wx_now_s();
+    memset(&report->noise, 0, sizeof report->noise);
     wx_geometry geometry;
     memset(&geometry, 0, sizeof geometry);
     wx_maps *maps = NULL;
@@ -235,17 +236,17 @@ wx_result wx_run_phases(wx_scene *scene, const wx_run_def *opts, unsigned phases
         double t0 = wx_now_s();
         if (maps != NULL) {
             r = wx_gather_maps(scene, opts, maps, output_maps.depth != NULL ? &output_maps : NULL,
-                               &textures, masks.ready ? &masks : NULL,
-                               &report->times.gather_detail, err);
+                               &textures, masks.ready ? &masks : NULL, &report->times.gather_detail,
+                               &report->noise, err);
         } else {
             wx_maps *in = calloc((size_t)scene->input_count + 1, sizeof *in);
             r = in != NULL ? wx_load_gather_maps(scene, opts, in, err)
                            : wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (maps)");
             double t1 = wx_now_s();
             if (r == WX_OK) {
-                r = wx_gather_maps(scene, opts, in,
-                                   output_maps.depth != NULL ? &output_maps : NULL, &textures,
-                                   NULL, &report->times.gather_detail, err);
+                r = wx_gather_maps(scene, opts, in, output_maps.depth != NULL ? &output_maps : NULL,
+                                   &textures, NULL, &report->times.gather_detail, &report->noise,
+                                   err);
             }
             report->times.gather_detail.read += t1 - t0;
             free_maps(in, scene->input_count);

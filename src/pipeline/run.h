@@ -13,6 +13,9 @@
 typedef struct wx_run_report {
     wx_sim_stats stats;
     wx_phase_times times; ///< times.load: the caller's scene loading, plus the checks here
+    /// The final gather's noise figures; the caller frees them
+    /// (wx_noise_report_free), whatever the result.
+    wx_noise_report noise;
 } wx_run_report;
 
 /// Runs the phases in `phases` in order, in one process; a phase that is not run

@@ -242,7 +242,7 @@ static wx_result write_frame(const wx_scene *scene, const wx_run_def *opts, cons
     wx_maps *view = NULL;
     wx_result r = simulation_views(scene, opts, sim, maps, &view, err);
     if (r == WX_OK) {
-        r = wx_gather_frame(scene, opts, view, out_maps, textures, masks, frame, NULL, err);
+        r = wx_gather_frame(scene, opts, view, out_maps, textures, masks, frame, NULL, NULL, err);
     }
     free_simulation_views(scene, view);
     return r;
@@ -254,7 +254,7 @@ wx_result wx_gather_simulation(const wx_scene *scene, const wx_run_def *opts, co
     wx_maps *view = NULL;
     wx_result r = simulation_views(scene, opts, sim, maps, &view, err);
     if (r == WX_OK) {
-        r = wx_gather_maps(scene, opts, view, NULL, NULL, NULL, NULL, err);
+        r = wx_gather_maps(scene, opts, view, NULL, NULL, NULL, NULL, NULL, err);
     }
     free_simulation_views(scene, view);
     return r;

@@ -259,6 +259,7 @@ void wx_textures_free(wx_textures *textures)
 typedef struct camera_planes {
     const wx_texture_map *key; // the smoothing of this TextureMap
     float **planes;
+    wx_gather_stats noise; // the first substance's gathers, summed over the cameras
 } camera_planes;
 
 static bool same_smoothing(const wx_texture_map *a, const wx_texture_map *b)
@@ -290,19 +291,19 @@ static void note_capped(const wx_run_def *opts, const wx_texture_map *key,
             "%.2g%% (the median); where that shows, fly more particles or raise the "
             "TextureMap's maxRadius",
             key->file, 100.0 * (double)sum->capped_texels / (double)sum->surface_texels,
-            sum->target_hits, radius, 100.0 * (double)key->noise,
-            100.0 * wx_noise_bins_median(sum->capped_noise_bins));
+            sum->target_hits, radius, 100.0 * (double)key->noise, 100.0 * sum->capped_noise);
 }
 
 static wx_result compute_planes(const wx_scene *scene, const wx_run_def *opts,
                                 const wx_maps *in_maps, wx_gather_view *views, int channels,
-                                const wx_texture_map *key, bool note, float **planes, wx_error *err)
+                                const wx_texture_map *key, bool note, float **planes,
+                                wx_gather_stats *sum, wx_error *err)
 {
     const int k_count = scene->input_count;
     wx_result r = WX_OK;
     int k = 0;
-    wx_gather_stats sum, st;
-    memset(&sum, 0, sizeof sum);
+    wx_gather_stats st;
+    memset(sum, 0, sizeof *sum);
     // The mask on every input camera's texels, a channel at a time.
     wx_progress progress;
     wx_progress_begin(&progress, "texture", (int64_t)k_count * channels, opts->quiet);
@@ -338,11 +339,11 @@ static wx_result compute_planes(const wx_scene *scene, const wx_run_def *opts,
             def.quiet = true;
             r = wx_gather_compute(&def, *plane, c == 0 ? &st : NULL, err);
             if (r == WX_OK && c == 0) {
-                sum.surface_texels += st.surface_texels;
-                sum.capped_texels += st.capped_texels;
-                sum.target_hits = st.target_hits;
+                sum->surface_texels += st.surface_texels;
+                sum->capped_texels += st.capped_texels;
+                sum->target_hits = st.target_hits;
                 for (int b = 0; b < WX_NOISE_BINS; ++b) {
-                    sum.capped_noise_bins[b] += st.capped_noise_bins[b];
+                    sum->capped_noise_bins[b] += st.capped_noise_bins[b];
                 }
             }
             wx_progress_update(&progress, (int64_t)k * channels + c + 1);
@@ -350,8 +351,9 @@ static wx_result compute_planes(const wx_scene *scene, const wx_run_def *opts,
         k++;
     }
     wx_progress_end(&progress);
+    sum->capped_noise = wx_noise_bins_median(sum->capped_noise_bins);
     if (r == WX_OK && note) {
-        note_capped(opts, key, &sum);
+        note_capped(opts, key, sum);
     }
     return r;
 }
@@ -535,7 +537,7 @@ static wx_result write_texture(const wx_scene *scene, const wx_run_def *opts,
 wx_result wx_textures_write(const wx_scene *scene, const wx_run_def *opts,
                             const wx_textures *textures, const wx_maps *in_maps,
                             wx_mask_context *masks, int frame, wx_phase_detail *detail,
-                            wx_error *err)
+                            wx_noise_report *noise, wx_error *err)
 {
     if (textures == NULL || textures->count == 0) {
         return WX_OK;
@@ -576,11 +578,21 @@ wx_result wx_textures_write(const wx_scene *scene, const wx_run_def *opts,
             cached++;
             r = cache[slot].planes != NULL
                     ? compute_planes(scene, opts, in_maps, views, substances, t->def, frame == 0,
-                                     cache[slot].planes, err)
+                                     cache[slot].planes, &cache[slot].noise, err)
                     : wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "texture: out of memory");
             if (detail != NULL) {
                 detail->compute += wx_now_s() - t0;
             }
+        }
+        if (r == WX_OK && frame == 0 && t->def->adaptive) {
+            const wx_gather_stats *st = &cache[slot].noise;
+            wx_noise_figures figures = { .aim = t->def->noise,
+                                         .target_hits = st->target_hits,
+                                         .surface_texels = st->surface_texels,
+                                         .capped_texels = st->capped_texels,
+                                         .capped_noise = st->capped_noise };
+            snprintf(figures.file, sizeof figures.file, "%s", t->def->file);
+            r = wx_noise_report_add(noise, &figures, err);
         }
         for (int f = 0; f < t->file_count && r == WX_OK; ++f) {
             r = write_texture(scene, opts, t, &t->files[f], views, cache[slot].planes, masks,

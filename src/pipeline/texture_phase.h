@@ -63,11 +63,12 @@ void wx_textures_free(wx_textures *textures);
 /// points in the slots wx_mask_slot_texture gives): frame 0 every texture's
 /// BASE.exr and previews, frame k > 0 BASE.NNNN.exr for those whose `every`
 /// divides k; with tiles="udim" each tile's BASE.TTTT.exr, its previews and
-/// frames BASE.TTTT.NNNN.exr. `detail` (may be NULL) gets the compute and write times added.
+/// frames BASE.TTTT.NNNN.exr. `detail` (may be NULL) gets the compute and write times added;
+/// `noise` (may be NULL), for frame 0, the figures of each texture smoothed adaptively.
 wx_result wx_textures_write(const wx_scene *scene, const wx_run_def *opts,
                             const wx_textures *textures, const wx_maps *in_maps,
                             wx_mask_context *masks, int frame, wx_phase_detail *detail,
-                            wx_error *err);
+                            wx_noise_report *noise, wx_error *err);
 
 /// Bytes per texel of a UV raster while it is held (triangle and source).
 #define WX_TEXTURE_RASTER_BYTES_PER_TEXEL 8.0
