@@ -576,6 +576,27 @@ TEST(summary_tells_hits_from_particles_still_flying)
                                 "simulation ends, 4000 of them before any hit"));
 }
 
+// Whether the entry of the "noise" object of --stats file NAME (in the tests'
+// folder) that begins with `anchor` holds a note's figures (percent, as the
+// note rounds them) unrounded: its capped_noise_median and capped_share.
+static bool noise_entry_matches_note(const char *name, const char *anchor, double noise,
+                                     double share)
+{
+    char path[4300];
+    snprintf(path, sizeof path, "%s/%s", ensure_tmpdir(), name);
+    char *json = ensure_read_file(path);
+    const char *entry = json != NULL ? strstr(json, anchor) : NULL;
+    const char *median = entry != NULL ? strstr(entry, "\"capped_noise_median\": ") : NULL;
+    const char *capped = entry != NULL ? strstr(entry, "\"capped_share\": ") : NULL;
+    double stats_noise = median != NULL ? atof(median + 23) : -1.0;
+    double stats_share = capped != NULL ? atof(capped + 16) : -1.0;
+    free(json);
+    printf("        --stats: capped_share %.4f, capped_noise_median %.5f\n", stats_share,
+           stats_noise);
+    return entry != NULL && fabs(100.0 * stats_noise - noise) <= 0.051 &&
+           fabs(100.0 * stats_share - share) <= 0.51;
+}
+
 // The gather's note on a mask the smoothing could not make as quiet as asked
 // says how noisy it stays there (docs/mask.md, "Notes it prints"): on the
 // thesis box 77% of the mask holds fewer impacts than 4% needs, and keeps
@@ -600,22 +621,10 @@ TEST(the_capped_note_says_how_noisy_the_mask_stays)
     double share = atof(share_at + strlen(share_lead));
     // --stats holds the same figures, unrounded, under "noise" and the mask's
     // file name.
-    char path[4300];
-    snprintf(path, sizeof path, "%s/capped.json", ensure_tmpdir());
-    char *json = ensure_read_file(path);
-    ENSURE(json != NULL);
-    const char *entry = strstr(json, "\"noise\": {\n    \"thesis_box_mask.exr\": { \"aim\": 0.04, "
-                                     "\"impacts_aimed_at\": 937.5, ");
-    const char *median = entry != NULL ? strstr(entry, "\"capped_noise_median\": ") : NULL;
-    const char *capped = entry != NULL ? strstr(entry, "\"capped_share\": ") : NULL;
-    double stats_noise = median != NULL ? atof(median + 23) : -1.0;
-    double stats_share = capped != NULL ? atof(capped + 16) : -1.0;
-    free(json);
-    printf("        --stats: capped_share %.4f, capped_noise_median %.5f\n", stats_share,
-           stats_noise);
-    ENSURE(entry != NULL);
-    ENSURE(fabs(100.0 * stats_noise - noise) <= 0.051);
-    ENSURE(fabs(100.0 * stats_share - share) <= 0.51);
+    ENSURE(noise_entry_matches_note("capped.json",
+                                    "\"noise\": {\n    \"thesis_box_mask.exr\": { \"aim\": 0.04, "
+                                    "\"impacts_aimed_at\": 937.5, ",
+                                    noise, share));
 }
 
 // A TextureMap says the same of its own smoothing, which runs on the input
@@ -652,23 +661,11 @@ TEST(the_capped_note_says_how_noisy_the_texture_stays)
     ENSURE(noise > 4.0 && noise < 30.0);
     ENSURE(ensure_contains(at, "% (the median); where that shows, fly more particles or raise "
                                "the TextureMap's maxRadius\n"));
-    // --stats: the mask's entry, then the texture's with the note's figures.
-    char path[4300];
-    snprintf(path, sizeof path, "%s/capped_texture.json", ensure_tmpdir());
-    char *json = ensure_read_file(path);
-    ENSURE(json != NULL);
-    const char *mask = strstr(json, "\"noise\": {\n    \"mask.exr\": {");
-    const char *entry = mask != NULL ? strstr(mask, "\n    \"spot_texture.exr\": {") : NULL;
-    const char *median = entry != NULL ? strstr(entry, "\"capped_noise_median\": ") : NULL;
-    const char *capped = entry != NULL ? strstr(entry, "\"capped_share\": ") : NULL;
-    double stats_noise = median != NULL ? atof(median + 23) : -1.0;
-    double stats_share = capped != NULL ? atof(capped + 16) : -1.0;
-    free(json);
-    printf("        --stats: capped_share %.4f, capped_noise_median %.5f\n", stats_share,
-           stats_noise);
-    ENSURE(entry != NULL);
-    ENSURE(fabs(100.0 * stats_noise - noise) <= 0.051);
-    ENSURE(fabs(100.0 * stats_share - share) <= 0.51);
+    // --stats: the texture's entry, after the mask's, with the note's figures.
+    ENSURE(noise_entry_matches_note("capped_texture.json",
+                                    " },\n    \"spot_texture.exr\": { \"aim\": 0.04, "
+                                    "\"impacts_aimed_at\": 937.5, ",
+                                    noise, share));
 }
 
 // Spot (closed) with every face wound the other way, in the teapot's scene:

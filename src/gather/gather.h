@@ -11,6 +11,7 @@
 #define WX_GATHER_H
 
 #include <stdbool.h>
+#include <stdio.h>
 #include <stdint.h>
 
 #include "core/error.h"
@@ -19,6 +20,7 @@
 #include "model/camera.h"
 #include "model/maps.h"
 #include "model/scene.h"
+#include "model/stats.h"
 
 /// |N.view| is clamped to at least this when the footprint of an input texel on
 /// the surface (head-on texel area / |N.view|) is computed. It must equal the
@@ -108,6 +110,20 @@ typedef struct wx_gather_stats {
     double capped_noise;
     int64_t capped_noise_bins[WX_NOISE_BINS];
 } wx_gather_stats;
+
+/// The --stats figures (model/stats.h) of an output named `file`, smoothed
+/// adaptively at noise `aim`, from its gather's stats.
+static inline wx_noise_figures wx_gather_noise_figures(const char *file, double aim,
+                                                       const wx_gather_stats *st)
+{
+    wx_noise_figures f = { .aim = aim,
+                           .target_hits = st->target_hits,
+                           .surface_texels = st->surface_texels,
+                           .capped_texels = st->capped_texels,
+                           .capped_noise = st->capped_noise };
+    snprintf(f.file, sizeof f.file, "%s", file);
+    return f;
+}
 
 /// The rows mapping a point into the texel space of an input camera (texel
 /// centres at integers, row 0 at the top): x = cx . (p, 1), y = cy . (p, 1),

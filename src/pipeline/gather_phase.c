@@ -200,12 +200,7 @@ static wx_result write_mask(const wx_scene *scene, const wx_run_def *opts, const
         wx_gather_stats st;
         result = wx_gather_compute(&def, image->channels[s], &st, err);
         if (result == WX_OK && s == 0 && frame == 0 && def.adaptive) {
-            wx_noise_figures figures = { .aim = out->noise,
-                                         .target_hits = st.target_hits,
-                                         .surface_texels = st.surface_texels,
-                                         .capped_texels = st.capped_texels,
-                                         .capped_noise = st.capped_noise };
-            snprintf(figures.file, sizeof figures.file, "%s", out->output_file);
+            wx_noise_figures figures = wx_gather_noise_figures(out->output_file, out->noise, &st);
             result = wx_noise_report_add(noise, &figures, err);
         }
         if (result == WX_OK && s == 0 && frame == 0 && def.adaptive && st.surface_texels > 0 &&

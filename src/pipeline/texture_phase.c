@@ -585,13 +585,8 @@ wx_result wx_textures_write(const wx_scene *scene, const wx_run_def *opts,
             }
         }
         if (r == WX_OK && frame == 0 && t->def->adaptive) {
-            const wx_gather_stats *st = &cache[slot].noise;
-            wx_noise_figures figures = { .aim = t->def->noise,
-                                         .target_hits = st->target_hits,
-                                         .surface_texels = st->surface_texels,
-                                         .capped_texels = st->capped_texels,
-                                         .capped_noise = st->capped_noise };
-            snprintf(figures.file, sizeof figures.file, "%s", t->def->file);
+            wx_noise_figures figures =
+                wx_gather_noise_figures(t->def->file, t->def->noise, &cache[slot].noise);
             r = wx_noise_report_add(noise, &figures, err);
         }
         for (int f = 0; f < t->file_count && r == WX_OK; ++f) {
