@@ -902,7 +902,9 @@ wx_result wx_gather_compute(const wx_gather_def *def, float *mask_out, wx_gather
         ad.noise = def->noise;
         ad.max_radius = def->max_radius;
         ad.pool = pool;
-        result = wx_adaptive_smooth(&ad, mask_out, &smoothing, err);
+        // Its statistics (sorting the radii and the capped texels' noise) only
+        // for a caller that reads them.
+        result = wx_adaptive_smooth(&ad, mask_out, stats != NULL ? &smoothing : NULL, err);
         free(adaptive_planes);
         if (result != WX_OK) {
             wx_progress_end(&progress);

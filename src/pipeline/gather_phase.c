@@ -197,13 +197,16 @@ static wx_result write_mask(const wx_scene *scene, const wx_run_def *opts, const
         def.normalize = out->normalize;
         def.threads = opts->threads;
         def.quiet = opts->quiet;
+        // The final mask's first substance reports its noise (--stats, and a
+        // note when much of it is capped).
+        const bool report = s == 0 && frame == 0 && def.adaptive;
         wx_gather_stats st;
-        result = wx_gather_compute(&def, image->channels[s], &st, err);
-        if (result == WX_OK && s == 0 && frame == 0 && def.adaptive) {
+        result = wx_gather_compute(&def, image->channels[s], report ? &st : NULL, err);
+        if (result == WX_OK && report) {
             wx_noise_figures figures = wx_gather_noise_figures(out->output_file, out->noise, &st);
             result = wx_noise_report_add(noise, &figures, err);
         }
-        if (result == WX_OK && s == 0 && frame == 0 && def.adaptive && st.surface_texels > 0 &&
+        if (result == WX_OK && report && st.surface_texels > 0 &&
             10 * st.capped_texels > st.surface_texels) {
             wx_note(opts->quiet,
                     "gather: %.0f%% of the mask's surface holds fewer than the %.0f impacts "
