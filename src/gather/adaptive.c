@@ -10,7 +10,8 @@
 //      half-disc beside it where its density would put CLEAN_EXPECTED);
 //   3. the samples' weights 1 / h^2 and the bounds of the radii per tile;
 //   4. per texel q (rows on the pool): the weighted mean of delta over the
-//      samples p that reach it, added to the initial dirt.
+//      samples p that reach it with no clean texel on the way, added to the
+//      initial dirt.
 // Step 4 runs over padded planes in chunks of CHUNK texels of a row, one
 // neighbour offset at a time (offsets sorted by distance across the view,
 // stopping at the largest radius that can reach the chunk), in a loop the
@@ -26,8 +27,9 @@
 #include "model/maps.h"
 
 enum {
-    CHUNK = 64, // texels of a row processed together
-    TILE = 16,  // texels a side of the tiles that bound the radii
+    LINE_CELLS_MAX = 1 << 20, // the most texels of the offsets' lines kept (4 MiB)
+    CHUNK = 64,               // texels of a row processed together
+    TILE = 16,                // texels a side of the tiles that bound the radii
     BISECTIONS = 24,
 };
 
@@ -79,6 +81,9 @@ enum { TEXEL_CLEAN = 1, TEXEL_SPARSE = 2 };
 // tolerance at that distance.
 typedef struct offset {
     int di, dj;
+    // Its line (line_blocked), when job.line holds the lines: line_count
+    // texels from line_first on, each as (x, y), the texel q - (x, y).
+    int line_first, line_count;
     float r;
     float ax, ay, az;
     float a2, az2;
@@ -95,6 +100,13 @@ typedef struct job {
     float *pinvh;                      // 1 / h of a sample, 0 elsewhere
     float *pweight;                    // 1 / h^2 of a sample, 0 elsewhere
     float *pcoef;                      // pweight * delta
+    // Per tile whether it holds a clean texel.
+    unsigned char *tile_clean;
+    int16_t *line;        // the offsets' lines (pairs), or NULL: walked each time
+    uint64_t *clean_bits; // the padded planes' clean texels, a bit each
+    size_t bit_words;     // words per padded row (one more than it needs)
+    size_t pad_x, pad_y;
+    uint64_t spread[256]; // a byte's 8 bits as 8 bytes of 0 or 1
     // Unpadded.
     float *delta;         // change per unit area
     float *radius;        // h (world units) of a sample, 0 elsewhere
@@ -302,8 +314,125 @@ static float chunk_bound(const job *jb, int j, int x0, int x1)
     return bound;
 }
 
+// The weight sample p's kernel gives texel q at offset `off` from p.
+static inline float kernel_weight(const offset *off, float z2, float dq, float nxq, float nyq,
+                                  float nzq, float dp, float nxp, float nyp, float nzp, float znp,
+                                  float ihp)
+{
+    float dd = dq - dp;
+    float r2 = off->a2 + dd * (off->az2 + dd * z2);
+    float cone = 1.0f - sqrtf(keep_if_positive(r2, r2)) * ihp;
+    float agree = nxp * nxq + nyp * nyq + nzp * nzq;
+    float plane = off->ax * nxp + off->ay * nyp + off->az * nzp + dd * znp;
+    float w = keep_if_positive(keep_if_positive(cone * agree, cone), agree - NORMAL_EPSILON);
+    return keep_if_positive(w, off->tol - fabsf(plane));
+}
+
+// The clean bits of 64 texels of a padded row from column col on (bit x:
+// column col + x).
+static inline uint64_t clean_run(const job *jb, size_t row, size_t col)
+{
+    const uint64_t *w = jb->clean_bits + row * jb->bit_words + col / 64;
+    unsigned shift = (unsigned)(col % 64);
+    return shift == 0 ? w[0] : (w[0] >> shift) | (w[1] << (64 - shift));
+}
+
+// The texels strictly between q and its sample q - (di, dj) that the segment
+// between their centres passes through, from q on; where it passes exactly
+// through a corner, the two texels beside the corner too, so that it cannot
+// slip between the corners of a band one texel thin. Each as (x, y), the
+// texel q - (x, y), into cells when not NULL; returns their number.
+static int line_cells(int di, int dj, int16_t *cells)
+{
+    const int si = di > 0 ? 1 : -1, sj = dj > 0 ? 1 : -1;
+    const long ni = labs((long)di), nj = labs((long)dj);
+    int n = 0, x = 0, y = 0;
+    for (long ki = 0, kj = 0; ki < ni || kj < nj;) {
+        // The next border the segment crosses: i's at (ki + 1/2) / ni of
+        // the way, j's at (kj + 1/2) / nj.
+        long next = (1 + 2 * ki) * nj - (1 + 2 * kj) * ni;
+        if (next == 0) {
+            if (cells != NULL) {
+                cells[2 * n] = (int16_t)(x + si);
+                cells[2 * n + 1] = (int16_t)y;
+                cells[2 * n + 2] = (int16_t)x;
+                cells[2 * n + 3] = (int16_t)(y + sj);
+            }
+            n += 2;
+            x += si;
+            y += sj;
+            ++ki;
+            ++kj;
+        } else if (next < 0) {
+            x += si;
+            ++ki;
+        } else {
+            y += sj;
+            ++kj;
+        }
+        if (x != di || y != dj) {
+            if (cells != NULL) {
+                cells[2 * n] = (int16_t)x;
+                cells[2 * n + 1] = (int16_t)y;
+            }
+            ++n;
+        }
+    }
+    return n;
+}
+
+// For the 64 texels q of a padded row from column col on, bit x: whether a
+// clean texel lies on the line (line_cells) between q + x and its sample at
+// offset `off`.
+static uint64_t line_blocked(const job *jb, size_t row, size_t col, const offset *off)
+{
+    int16_t walked[2 * 1024], *heap = NULL;
+    const int16_t *cells = jb->line != NULL ? jb->line + 2 * (size_t)off->line_first : walked;
+    const int n = off->line_count;
+    if (jb->line == NULL) {
+        int16_t *own = walked;
+        if (n > 1024) { // lines of hundreds of texels: slow anyway
+            own = heap = malloc(2 * (size_t)n * sizeof *heap);
+            if (heap == NULL) {
+                return 0; // out of memory: the kernel as it was before the clip
+            }
+        }
+        line_cells(off->di, off->dj, own);
+        cells = own;
+    }
+    uint64_t bits = 0;
+    for (int k = 0; k < n && bits != ~(uint64_t)0; ++k) {
+        bits |= clean_run(jb, row - (size_t)cells[2 * k + 1], col - (size_t)cells[2 * k]);
+    }
+    free(heap);
+    return bits;
+}
+
+// Whether a clean texel lies within (reach_i, reach_j) of texels of row j,
+// columns [x0, x1) (by the tiles).
+static bool clean_near(const job *jb, int j, int x0, int x1, int reach_i, int reach_j)
+{
+    int tx0 = x0 - reach_i < 0 ? 0 : (x0 - reach_i) / TILE;
+    int ty0 = j - reach_j < 0 ? 0 : (j - reach_j) / TILE;
+    int tx1 = (x1 - 1 + reach_i) / TILE, ty1 = (j + reach_j) / TILE;
+    tx1 = tx1 < jb->tiles_x ? tx1 : jb->tiles_x - 1;
+    ty1 = ty1 < jb->tiles_y ? ty1 : jb->tiles_y - 1;
+    for (int ty = ty0; ty <= ty1; ++ty) {
+        for (int tx = tx0; tx <= tx1; ++tx) {
+            if (jb->tile_clean[(size_t)ty * (size_t)jb->tiles_x + (size_t)tx]) {
+                return true;
+            }
+        }
+    }
+    return false;
+}
+
 // Step 4 for a chunk of texels q: the initial dirt plus the weighted mean of
-// the change over the samples that reach it.
+// the change over the samples that reach it. A kernel does not reach past a
+// clean texel on its way: where a clean texel lies within reach, each
+// offset's line of texels (line_cells) is read from the clean bits for the
+// chunk's 64 texels at once, and a sample whose line from q crosses a clean
+// texel gives nothing (docs/mask.md, "Kernels stop at a clean band").
 static void gather_chunk(const job *jb, int j, int x0)
 {
     const int x1 = x0 + CHUNK < jb->width ? x0 + CHUNK : jb->width;
@@ -342,6 +471,8 @@ static void gather_chunk(const job *jb, int j, int x0)
         return;
     }
     const size_t q = jb->base + (size_t)j * jb->stride + (size_t)x0;
+    const bool clean = clean_near(jb, j, x0, x1, jb->reach_i[reach - 1], jb->reach_j[reach - 1]);
+    const size_t row = jb->pad_y + (size_t)j, col = jb->pad_x + (size_t)x0;
     float num[CHUNK], den[CHUNK];
     for (int x = 0; x < CHUNK; ++x) {
         num[x] = 0.0f;
@@ -358,15 +489,28 @@ static void gather_chunk(const job *jb, int j, int x0)
         const float *restrict nyp = jb->pny + p, *restrict nzp = jb->pnz + p;
         const float *restrict znp = jb->pzn + p, *restrict ihp = jb->pinvh + p;
         const float *restrict cp = jb->pcoef + p, *restrict vp = jb->pweight + p;
+        // Bit x: a clean texel lies strictly between q + x and its sample.
+        const uint64_t bits = clean ? line_blocked(jb, row, col, &off) : 0;
+        if (bits == ~(uint64_t)0) {
+            continue; // every weight 0: the sums stay as they are
+        }
+        if (bits == 0) {
+            for (int x = 0; x < CHUNK; ++x) {
+                float w = kernel_weight(&off, z2, dq[x], nxq[x], nyq[x], nzq[x], dp[x], nxp[x],
+                                        nyp[x], nzp[x], znp[x], ihp[x]);
+                num[x] += w * cp[x];
+                den[x] += w * vp[x];
+            }
+            continue;
+        }
+        unsigned char b[CHUNK];
+        for (int k = 0; k < CHUNK / 8; ++k) {
+            memcpy(b + 8 * k, &jb->spread[(bits >> (8 * k)) & 0xff], 8);
+        }
         for (int x = 0; x < CHUNK; ++x) {
-            float dd = dq[x] - dp[x];
-            float r2 = off.a2 + dd * (off.az2 + dd * z2);
-            float cone = 1.0f - sqrtf(keep_if_positive(r2, r2)) * ihp[x];
-            float agree = nxp[x] * nxq[x] + nyp[x] * nyq[x] + nzp[x] * nzq[x];
-            float plane = off.ax * nxp[x] + off.ay * nyp[x] + off.az * nzp[x] + dd * znp[x];
-            float w = keep_if_positive(keep_if_positive(cone * agree, cone),
-                                       agree - NORMAL_EPSILON);
-            w = keep_if_positive(w, off.tol - fabsf(plane));
+            float w = kernel_weight(&off, z2, dq[x], nxq[x], nyq[x], nzq[x], dp[x], nxp[x], nyp[x],
+                                    nzp[x], znp[x], ihp[x]);
+            w = keep_if_positive(w, 0.5f - (float)b[x]);
             num[x] += w * cp[x];
             den[x] += w * vp[x];
         }
@@ -606,6 +750,19 @@ wx_result wx_adaptive_smooth(const wx_adaptive_def *def, float *out, wx_adaptive
     jb.reach_i = malloc(2 * cap * sizeof *jb.reach_i);
     jb.reach_j = jb.reach_i + cap;
     float *scratch = wx_big_calloc(8 * plane, sizeof *scratch);
+    jb.pad_x = (size_t)pad_x;
+    jb.pad_y = (size_t)pad_y;
+    jb.bit_words = jb.stride / 64 + 2;
+    jb.clean_bits =
+        wx_big_calloc(jb.bit_words * ((size_t)H + 2 * (size_t)pad_y), sizeof *jb.clean_bits);
+    jb.tile_clean = calloc(tiles, 1);
+    for (int v = 0; v < 256; ++v) {
+        uint64_t bytes = 0;
+        for (int k = 0; k < 8; ++k) {
+            bytes |= (uint64_t)((v >> k) & 1) << (8 * k);
+        }
+        jb.spread[v] = bytes; // little-endian: byte k of the word is bit k
+    }
     jb.delta = wx_big_malloc(texels * sizeof *jb.delta);
     jb.radius = wx_big_calloc(texels, sizeof *jb.radius);
     jb.clean = wx_big_calloc(texels, 1);
@@ -624,7 +781,7 @@ wx_result wx_adaptive_smooth(const wx_adaptive_def *def, float *out, wx_adaptive
     if (offsets == NULL || jb.reach_i == NULL || scratch == NULL || jb.delta == NULL ||
         jb.radius == NULL || jb.clean == NULL || jb.sat == NULL || jb.tile_bound == NULL ||
         tile_max == NULL || jb.impacts == NULL || disc == NULL || jb.half_disc == NULL ||
-        (stats != NULL && capped_noise == NULL)) {
+        (stats != NULL && capped_noise == NULL) || jb.clean_bits == NULL || jb.tile_clean == NULL) {
         r = wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "gather: out of memory (adaptive smoothing)");
         goto done;
     }
@@ -634,6 +791,19 @@ wx_result wx_adaptive_smooth(const wx_adaptive_def *def, float *out, wx_adaptive
     jb.disc = disc;
     jb.offset_count = build_offsets(def, px, py, z, pad_x - 1, pad_y - 1, max_r, texel, offsets);
     jb.offsets = offsets;
+    // The lines, kept when they fit in LINE_CELLS_MAX cells (radii up to
+    // about 68 texels), else walked each time they are needed.
+    size_t cells = 0;
+    for (int o = 0; o < jb.offset_count; ++o) {
+        offsets[o].line_first = (int)cells;
+        offsets[o].line_count = line_cells(offsets[o].di, offsets[o].dj, NULL);
+        cells += (size_t)offsets[o].line_count;
+    }
+    jb.line =
+        cells <= LINE_CELLS_MAX ? malloc(2 * (cells > 0 ? cells : 1) * sizeof *jb.line) : NULL;
+    for (int o = 0; jb.line != NULL && o < jb.offset_count; ++o) {
+        line_cells(offsets[o].di, offsets[o].dj, jb.line + 2 * (size_t)offsets[o].line_first);
+    }
     for (int o = 0; o < jb.offset_count; ++o) {
         int di = abs(offsets[o].di), dj = abs(offsets[o].dj);
         jb.reach_i[o] = o > 0 && jb.reach_i[o - 1] > di ? jb.reach_i[o - 1] : di;
@@ -698,6 +868,14 @@ wx_result wx_adaptive_smooth(const wx_adaptive_def *def, float *out, wx_adaptive
                 jb.pnx[p] = jb.pny[p] = jb.pnz[p] = 0.0f; // neither gives nor takes
                 jb.radius[t] = h = 0.0f;
             }
+            if ((jb.clean[t] & TEXEL_CLEAN) && !(def->hits[t] < 0.0f)) {
+                // Nor lets a kernel past, unless no camera saw it (a gap
+                // in what the cameras see is not a shelter).
+                size_t col = jb.pad_x + (size_t)i;
+                jb.clean_bits[(jb.pad_y + (size_t)j) * jb.bit_words + col / 64] |= (uint64_t)1
+                                                                                   << (col % 64);
+                jb.tile_clean[(size_t)(j / TILE) * (size_t)jb.tiles_x + (size_t)(i / TILE)] = 1;
+            }
             if (h > 0.0f) {
                 jb.pinvh[p] = 1.0f / h;
                 jb.pweight[p] = 1.0f / (h * h);
@@ -759,6 +937,9 @@ wx_result wx_adaptive_smooth(const wx_adaptive_def *def, float *out, wx_adaptive
         }
     }
 done:
+    free(jb.tile_clean);
+    free(jb.clean_bits);
+    free(jb.line);
     free(capped_noise);
     free(sorted);
     free(tile_max);

@@ -19,7 +19,10 @@
 // stays constant up to every border, and nothing crosses a crease (the
 // normals), a depth jump (the distance and the plane test) or a shadow edge: a
 // texel with no impact of its own beside an empty half-disc where its
-// density would have put 12 impacts is clean, and neither gives nor takes.
+// density would have put 12 impacts is clean, and neither gives nor takes;
+// nor does a kernel reach past a clean texel on its way (a sample gives
+// nothing to a texel when a clean texel lies on the line of texels between
+// them), so a thin clean band stops the capped kernels of a sparse side.
 //
 // Computed as a gather over q, in rows on the pool: the same result for any
 // number of threads.
@@ -44,7 +47,9 @@ typedef struct wx_adaptive_def {
     const float *normal;  ///< interleaved unit normals
     const float *total;   ///< first pass: dirt per unit area
     const float *initial; ///< first pass: initial dirt per unit area
-    const float *hits;    ///< first pass: impacts per unit area
+    /// First pass: impacts per unit area; negative where no input camera sees
+    /// the surface point (a gap: its clean texels stop no kernel).
+    const float *hits;
     /// World offset of one texel step in i (right) and j (down), and of one unit
     /// of depth (the viewing direction, a unit vector for orthographic targets).
     double step_i[3], step_j[3], step_d[3];

@@ -306,7 +306,10 @@ static void first_pass_tile(const gather_job *job, int tile)
             job->first[job->first_base + (size_t)j * job->first_stride + (size_t)i] = sum.dirt;
             if (job->adaptive) {
                 job->first_initial[q] = sum.initial;
-                job->first_hits[q] = sum.hits;
+                // -1 where no camera sees the surface point: unknown, not
+                // clean (adaptive.h).
+                job->first_hits[q] =
+                    sum.all > 0.0f || wx_depth_is_empty(job->depth[q]) ? sum.hits : -1.0f;
             }
             if (job->second) {
                 size_t p = job->base + (size_t)j * job->stride + (size_t)i;

@@ -115,8 +115,9 @@ typedef struct wx_memory_need {
 /// channels while it is read; one plane more per channel beyond them) and per
 /// output texel (its depth and normal, the mask, the first pass's three planes,
 /// the adaptive smoothing's eight padded planes, summed-area tables, radii,
-/// changes, impacts and capped texels' noise, the preview's sorted values and pixels, and in a run the output
-/// camera's baked depth and normal kept from the bake; the fixed second pass
+/// changes, impacts and capped texels' noise, a bit per texel for its clean
+/// texels (and at most 4 MiB for its kernels' lines), the preview's sorted values and pixels, and
+/// in a run the output camera's baked depth and normal kept from the bake; the fixed second pass
 /// needs less). The gather runs once per substance on the same planes; the mask
 /// holds one plane more per substance beyond the first. Measured: 690 MB for a
 /// 2048-px `gather` with three 2048-px input cameras, estimated 920 MB.
