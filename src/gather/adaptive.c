@@ -795,7 +795,7 @@ wx_result wx_adaptive_smooth(const wx_adaptive_def *def, float *out, wx_adaptive
     // about 68 texels), else walked each time they are needed.
     size_t cells = 0;
     for (int o = 0; o < jb.offset_count; ++o) {
-        offsets[o].line_first = (int)cells;
+        offsets[o].line_first = cells <= LINE_CELLS_MAX ? (int)cells : 0;
         offsets[o].line_count = line_cells(offsets[o].di, offsets[o].dj, NULL);
         cells += (size_t)offsets[o].line_count;
     }
