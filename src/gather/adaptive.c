@@ -100,12 +100,8 @@ typedef struct job {
     float *pinvh;                      // 1 / h of a sample, 0 elsewhere
     float *pweight;                    // 1 / h^2 of a sample, 0 elsewhere
     float *pcoef;                      // pweight * delta
-    // Per tile whether it holds a clean texel.
-    unsigned char *tile_clean;
     int16_t *line;        // the offsets' lines (pairs), or NULL: walked each time
-    uint64_t *clean_bits; // the padded planes' clean texels, a bit each
-    size_t bit_words;     // words per padded row (one more than it needs)
-    size_t pad_x, pad_y;
+    uint64_t *clean_bits; // the clean texels that stop kernels, a bit per padded texel
     uint64_t spread[256]; // a byte's 8 bits as 8 bytes of 0 or 1
     // Unpadded.
     float *delta;         // change per unit area
@@ -118,7 +114,8 @@ typedef struct job {
     int k_max;            // the largest radius of a half-disc, texels
     double *sat;          // (width + 1) * (height + 1) summed impacts; in step 4,
                           // the samples with a change (pcoef != 0)
-    double *sat_surface;  // the same for the texels with a surface
+    double *sat_surface;  // the same for the texels with a surface; in step 4,
+                          // the clean texels that stop kernels (clean_bits)
     float *tile_bound;
     int tiles_x, tiles_y;
     const offset *offsets;
@@ -328,12 +325,12 @@ static inline float kernel_weight(const offset *off, float z2, float dq, float n
     return keep_if_positive(w, off->tol - fabsf(plane));
 }
 
-// The clean bits of 64 texels of a padded row from column col on (bit x:
-// column col + x).
-static inline uint64_t clean_run(const job *jb, size_t row, size_t col)
+// The clean bits of the 64 padded texels from padded index `at` on (bit x:
+// texel at + x).
+static inline uint64_t clean_run(const job *jb, size_t at)
 {
-    const uint64_t *w = jb->clean_bits + row * jb->bit_words + col / 64;
-    unsigned shift = (unsigned)(col % 64);
+    const uint64_t *w = jb->clean_bits + at / 64;
+    unsigned shift = (unsigned)(at % 64);
     return shift == 0 ? w[0] : (w[0] >> shift) | (w[1] << (64 - shift));
 }
 
@@ -381,10 +378,9 @@ static int line_cells(int di, int dj, int16_t *cells)
     return n;
 }
 
-// For the 64 texels q of a padded row from column col on, bit x: whether a
-// clean texel lies on the line (line_cells) between q + x and its sample at
-// offset `off`.
-static uint64_t line_blocked(const job *jb, size_t row, size_t col, const offset *off)
+// For the 64 texels from padded index q on, bit x: whether a clean texel lies
+// on the line (line_cells) between q + x and its sample at offset `off`.
+static uint64_t line_blocked(const job *jb, size_t q, const offset *off)
 {
     int16_t walked[2 * 1024], *heap = NULL;
     const int16_t *cells = jb->line != NULL ? jb->line + 2 * (size_t)off->line_first : walked;
@@ -402,29 +398,12 @@ static uint64_t line_blocked(const job *jb, size_t row, size_t col, const offset
     }
     uint64_t bits = 0;
     for (int k = 0; k < n && bits != ~(uint64_t)0; ++k) {
-        bits |= clean_run(jb, row - (size_t)cells[2 * k + 1], col - (size_t)cells[2 * k]);
+        bits |= clean_run(jb, (size_t)((ptrdiff_t)q -
+                                       (ptrdiff_t)cells[2 * k + 1] * (ptrdiff_t)jb->stride -
+                                       cells[2 * k]));
     }
     free(heap);
     return bits;
-}
-
-// Whether a clean texel lies within (reach_i, reach_j) of texels of row j,
-// columns [x0, x1) (by the tiles).
-static bool clean_near(const job *jb, int j, int x0, int x1, int reach_i, int reach_j)
-{
-    int tx0 = x0 - reach_i < 0 ? 0 : (x0 - reach_i) / TILE;
-    int ty0 = j - reach_j < 0 ? 0 : (j - reach_j) / TILE;
-    int tx1 = (x1 - 1 + reach_i) / TILE, ty1 = (j + reach_j) / TILE;
-    tx1 = tx1 < jb->tiles_x ? tx1 : jb->tiles_x - 1;
-    ty1 = ty1 < jb->tiles_y ? ty1 : jb->tiles_y - 1;
-    for (int ty = ty0; ty <= ty1; ++ty) {
-        for (int tx = tx0; tx <= tx1; ++tx) {
-            if (jb->tile_clean[(size_t)ty * (size_t)jb->tiles_x + (size_t)tx]) {
-                return true;
-            }
-        }
-    }
-    return false;
 }
 
 // Step 4 for a chunk of texels q: the initial dirt plus the weighted mean of
@@ -471,8 +450,11 @@ static void gather_chunk(const job *jb, int j, int x0)
         return;
     }
     const size_t q = jb->base + (size_t)j * jb->stride + (size_t)x0;
-    const bool clean = clean_near(jb, j, x0, x1, jb->reach_i[reach - 1], jb->reach_j[reach - 1]);
-    const size_t row = jb->pad_y + (size_t)j, col = jb->pad_x + (size_t)x0;
+    // As for the samples with a change above: whether a clean texel that stops
+    // kernels lies within reach.
+    const bool clean =
+        rect_sum(jb, jb->sat_surface, x0 - jb->reach_i[reach - 1], j - jb->reach_j[reach - 1],
+                 x1 - 1 + jb->reach_i[reach - 1], j + jb->reach_j[reach - 1]) >= 0.5;
     float num[CHUNK], den[CHUNK];
     for (int x = 0; x < CHUNK; ++x) {
         num[x] = 0.0f;
@@ -490,7 +472,7 @@ static void gather_chunk(const job *jb, int j, int x0)
         const float *restrict znp = jb->pzn + p, *restrict ihp = jb->pinvh + p;
         const float *restrict cp = jb->pcoef + p, *restrict vp = jb->pweight + p;
         // Bit x: a clean texel lies strictly between q + x and its sample.
-        const uint64_t bits = clean ? line_blocked(jb, row, col, &off) : 0;
+        const uint64_t bits = clean ? line_blocked(jb, q, &off) : 0;
         if (bits == ~(uint64_t)0) {
             continue; // every weight 0: the sums stay as they are
         }
@@ -750,12 +732,7 @@ wx_result wx_adaptive_smooth(const wx_adaptive_def *def, float *out, wx_adaptive
     jb.reach_i = malloc(2 * cap * sizeof *jb.reach_i);
     jb.reach_j = jb.reach_i + cap;
     float *scratch = wx_big_calloc(8 * plane, sizeof *scratch);
-    jb.pad_x = (size_t)pad_x;
-    jb.pad_y = (size_t)pad_y;
-    jb.bit_words = jb.stride / 64 + 2;
-    jb.clean_bits =
-        wx_big_calloc(jb.bit_words * ((size_t)H + 2 * (size_t)pad_y), sizeof *jb.clean_bits);
-    jb.tile_clean = calloc(tiles, 1);
+    jb.clean_bits = wx_big_calloc(plane / 64 + 2, sizeof *jb.clean_bits);
     for (int v = 0; v < 256; ++v) {
         uint64_t bytes = 0;
         for (int k = 0; k < 8; ++k) {
@@ -781,7 +758,7 @@ wx_result wx_adaptive_smooth(const wx_adaptive_def *def, float *out, wx_adaptive
     if (offsets == NULL || jb.reach_i == NULL || scratch == NULL || jb.delta == NULL ||
         jb.radius == NULL || jb.clean == NULL || jb.sat == NULL || jb.tile_bound == NULL ||
         tile_max == NULL || jb.impacts == NULL || disc == NULL || jb.half_disc == NULL ||
-        (stats != NULL && capped_noise == NULL) || jb.clean_bits == NULL || jb.tile_clean == NULL) {
+        (stats != NULL && capped_noise == NULL) || jb.clean_bits == NULL) {
         r = wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "gather: out of memory (adaptive smoothing)");
         goto done;
     }
@@ -871,10 +848,7 @@ wx_result wx_adaptive_smooth(const wx_adaptive_def *def, float *out, wx_adaptive
             if ((jb.clean[t] & TEXEL_CLEAN) && !(def->hits[t] < 0.0f)) {
                 // Nor lets a kernel past, unless no camera saw it (a gap
                 // in what the cameras see is not a shelter).
-                size_t col = jb.pad_x + (size_t)i;
-                jb.clean_bits[(jb.pad_y + (size_t)j) * jb.bit_words + col / 64] |= (uint64_t)1
-                                                                                   << (col % 64);
-                jb.tile_clean[(size_t)(j / TILE) * (size_t)jb.tiles_x + (size_t)(i / TILE)] = 1;
+                jb.clean_bits[p / 64] |= (uint64_t)1 << (p % 64);
             }
             if (h > 0.0f) {
                 jb.pinvh[p] = 1.0f / h;
@@ -898,14 +872,17 @@ wx_result wx_adaptive_smooth(const wx_adaptive_def *def, float *out, wx_adaptive
         }
     }
     bound_tiles(&jb, tile_max);
-    // Step 4's table: the samples with a change (the impacts' table is done with).
+    // Step 4's tables: the samples with a change, the clean texels that stop
+    // kernels (the impacts' and the surface's tables are done with).
     for (int j = 0; j < H; ++j) {
-        double row = 0.0;
+        double row = 0.0, row_clean = 0.0;
         for (int i = 0; i < W; ++i) {
             size_t p = jb.base + (size_t)j * jb.stride + (size_t)i;
             row += jb.pcoef[p] != 0.0f ? 1.0 : 0.0;
+            row_clean += (double)((jb.clean_bits[p / 64] >> (p % 64)) & 1);
             size_t s = (size_t)(j + 1) * sw + (size_t)(i + 1);
             jb.sat[s] = jb.sat[s - sw] + row;
+            jb.sat_surface[s] = jb.sat_surface[s - sw] + row_clean;
         }
     }
 
@@ -937,7 +914,6 @@ wx_result wx_adaptive_smooth(const wx_adaptive_def *def, float *out, wx_adaptive
         }
     }
 done:
-    free(jb.tile_clean);
     free(jb.clean_bits);
     free(jb.line);
     free(capped_noise);
