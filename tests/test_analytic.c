@@ -564,7 +564,10 @@ static bool run_lumpy(const char *dir, const char *model, int seed, int layers, 
 // Later the same day, erosion per contact (docs/physics.md, "Dirt
 // exchange"): 0.0217, 0.0237, 1.092; with the old exchange (and the edges'
 // changes since) it reads 0.0222, 0.0256, 1.152: the bound keeps the gain.
-#define MAX_TURN_RATIO 1.12
+// 7 December 2026, the collider's cells curved to second order
+// (docs/physics.md, "Depth between texels"): 0.0219, 0.0231, 1.055, where
+// the chords read 0.0217, 0.0236, 1.090; the bound keeps that gain too.
+#define MAX_TURN_RATIO 1.075
 TEST(lumpy_sphere_turned_slides_as_a_new_seed_does)
 {
     SLOW();

@@ -42,8 +42,9 @@ typedef struct wx_memory_need {
 } wx_memory_need;
 
 /// Bytes per input texel of the derived masks' collider: its depth copy, the
-/// coarse pyramid's levels and the fine test's 3 x 3 bound (near3).
-#define WX_MASK_COLLIDER_BYTES_PER_TEXEL 10.0
+/// coarse pyramid's levels and the fine test's 3 x 3 bound (near3), and on
+/// curved surfaces the cells' curvatures and dips (5).
+#define WX_MASK_COLLIDER_BYTES_PER_TEXEL 15.0
 
 /// The program's own memory before any scene data (code, libraries, heaps).
 #define WX_MEMORY_BASELINE (64.0 * 1024.0 * 1024.0)
@@ -86,10 +87,10 @@ typedef struct wx_memory_need {
 /// One float plane: the bytes per texel of each channel beyond version 1's.
 #define WX_PLANE_BYTES_PER_TEXEL 4.0
 /// Bytes per input texel in the simulation with one substance: the maps (depth,
-/// normal, impact, dirt: 9 floats), the collider's depth and pyramid (5) and
-/// its fine test's bound (4), the dirt texel (dirt in double, its rates and its
-/// hits: 24).
-#define WX_SIM_BYTES_PER_INPUT_TEXEL 69.0
+/// normal, impact, dirt: 9 floats), the collider's depth and pyramid (5), its
+/// fine test's bound (4) and its curved cells (5), the dirt texel (dirt in
+/// double, its rates and its hits: 24).
+#define WX_SIM_BYTES_PER_INPUT_TEXEL 74.0
 /// Bytes per input texel for each substance beyond the first (docs/design.md
 /// section 9): its dirt, deposit and erosion planes in the maps (3 floats) and
 /// its dirt texel (24).

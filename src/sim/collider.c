@@ -45,6 +45,7 @@ static inline int clampi(int v, int lo, int hi)
 // Returns false when the cell's texel holds no surface.
 typedef struct cell_depth {
     double k0, k1, k2, k3;
+    double k4, k5; ///< second-order terms: + k4 fx^2 + k5 fy^2 (curve_terms)
     double ox, oy;
 } cell_depth;
 
@@ -59,6 +60,23 @@ static void bilinear_cell(cell_depth *cd, int i0, int j0, double d00, double d10
     cd->k1 = d10 - d00;
     cd->k2 = d01 - d00;
     cd->k3 = d00 - d10 - d01 + d11;
+    cd->k4 = cd->k5 = 0.0;
+}
+
+// Adds the second-order terms of the cell whose first corner is index `at`
+// (layer plane plus texel) to a bilinear cell: depth += a/2 fx (fx - 1) +
+// b/2 fy (fy - 1), which is 0 at the corners (collider_build.c, curve_cells).
+static inline void curve_terms(const wx_collider_camera *cam, size_t at, cell_depth *cd)
+{
+    if (cam->curve == NULL) {
+        return;
+    }
+    double a = 0.5 * cam->curve_unit * cam->curve[2 * at];
+    double b = 0.5 * cam->curve_unit * cam->curve[2 * at + 1];
+    cd->k4 = a;
+    cd->k5 = b;
+    cd->k1 -= a;
+    cd->k2 -= b;
 }
 
 static bool cell_surface(const wx_collider *collider, const wx_collider_camera *cam, int hx,
@@ -70,7 +88,7 @@ static bool cell_surface(const wx_collider *collider, const wx_collider_camera *
     if (!isfinite(own)) {
         return false;
     }
-    cd->k1 = cd->k2 = cd->k3 = 0.0;
+    cd->k1 = cd->k2 = cd->k3 = cd->k4 = cd->k5 = 0.0;
     cd->k0 = own;
     cd->ox = cd->oy = 0.0;
     if (collider->nearest) {
@@ -97,6 +115,9 @@ static bool cell_surface(const wx_collider *collider, const wx_collider_camera *
         }
     }
     bilinear_cell(cd, i0, j0, d00, d10, d01, d11);
+    if (i0 == ia && j0 == ja && ib == i0 + 1 && jb == j0 + 1) {
+        curve_terms(cam, (size_t)ja * (size_t)W + (size_t)ia, cd);
+    }
     return true;
 }
 
@@ -121,7 +142,7 @@ static inline bool crossing_between(const wx_collider_camera *cam, int k, size_t
 static void layer_cell(const wx_collider *collider, const wx_collider_camera *cam, int k,
                        int hx, int hy, float own, uint8_t own_role, cell_depth *cd)
 {
-    cd->k1 = cd->k2 = cd->k3 = 0.0;
+    cd->k1 = cd->k2 = cd->k3 = cd->k4 = cd->k5 = 0.0;
     cd->k0 = own;
     cd->ox = cd->oy = 0.0;
     if (collider->nearest) {
@@ -133,6 +154,11 @@ static void layer_cell(const wx_collider *collider, const wx_collider_camera *ca
     int ia = clampi(i0, 0, W - 1), ib = clampi(i0 + 1, 0, W - 1);
     int ja = clampi(j0, 0, H - 1), jb = clampi(j0 + 1, 0, H - 1);
     size_t ra = plane + (size_t)ja * (size_t)W, rb = plane + (size_t)jb * (size_t)W;
+    if (cam->curve != NULL) {
+        // Its own cache line: asked for now, it comes while the checks below
+        // read the corners.
+        __builtin_prefetch(cam->curve + 2 * (ra + ia));
+    }
     double d00 = cam->depth[ra + ia], d10 = cam->depth[ra + ib];
     double d01 = cam->depth[rb + ia], d11 = cam->depth[rb + ib];
     if (!isfinite(d00) || !isfinite(d10) || !isfinite(d01) || !isfinite(d11)) {
@@ -161,12 +187,16 @@ static void layer_cell(const wx_collider *collider, const wx_collider_camera *ca
         }
     }
     bilinear_cell(cd, i0, j0, d00, d10, d01, d11);
+    if (i0 == ia && j0 == ja && ib == i0 + 1 && jb == j0 + 1) {
+        curve_terms(cam, ra + ia, cd);
+    }
 }
 
 static inline double cell_value(const cell_depth *cd, double X, double Y)
 {
     double fx = X - cd->ox, fy = Y - cd->oy;
-    return cd->k0 + cd->k1 * fx + cd->k2 * fy + cd->k3 * fx * fy;
+    return cd->k0 + cd->k1 * fx + cd->k2 * fy + cd->k3 * fx * fy + cd->k4 * fx * fx +
+           cd->k5 * fy * fy;
 }
 
 // Where a sheet's slab starts, past its crossing's depth: the slab lies on the
@@ -254,8 +284,7 @@ double wx_collider_depth_at(const wx_collider *collider, int c, double X, double
     if (!cell_surface(collider, cam, hx, hy, &cd)) {
         return INFINITY;
     }
-    double fx = X - cd.ox, fy = Y - cd.oy;
-    return cd.k0 + cd.k1 * fx + cd.k2 * fy + cd.k3 * fx * fy;
+    return cell_value(&cd, X, Y);
 }
 
 // Camera c's answer for a point (X, Y, D) inside its frame: it may collide
@@ -399,14 +428,27 @@ static double next_boundary(double P0, double r, int h)
     return INFINITY;
 }
 
+// The cell's depth along the segment: depth(s) = c[0] + c[1] s + c[2] s^2, from
+// k0 + k1 fx + k2 fy + k3 fx fy + k4 fx^2 + k5 fy^2 with fx = fx0 + s dX,
+// fy = fy0 + s dY.
+static inline void cell_along(const cell_depth *cd, const march *m, double c[3])
+{
+    double fx0 = m->X0 - cd->ox, fy0 = m->Y0 - cd->oy;
+    c[0] = cell_value(cd, m->X0, m->Y0);
+    c[1] = cd->k1 * m->dX + cd->k2 * m->dY + cd->k3 * (fx0 * m->dY + fy0 * m->dX) +
+           2.0 * (cd->k4 * fx0 * m->dX + cd->k5 * fy0 * m->dY);
+    c[2] = cd->k3 * m->dX * m->dY + cd->k4 * m->dX * m->dX + cd->k5 * m->dY * m->dY;
+}
+
 // The cell's functions f_k for a camera with layers.
 // The cell's crossings: how many, and a bound below their depths anywhere in
 // the cell. Every crossing's depth in the cell is bilinear between the four
 // texels around it or the cell texel's own (one of the four), and each
 // texel's crossings lie at or behind its first, so none lies nearer than the
-// least first crossing of the four: a segment in front of that bound (by a
-// sheet's thickness) meets nothing in the cell, and the crossings' functions
-// are not made (make_layers).
+// least first crossing of the four, less the largest dip of any curved cell
+// (`bulge_most`): a segment in front of that bound (by a sheet's thickness)
+// meets nothing in the cell, and the crossings' functions are not made
+// (make_layers).
 static void cell_layers(const wx_collider *collider, march *m)
 {
     const wx_collider_camera *cam = m->cam;
@@ -423,6 +465,7 @@ static void cell_layers(const wx_collider *collider, march *m)
     int ja = clampi(j0, 0, H - 1), jb = clampi(j0 + 1, 0, H - 1);
     const float *ra = cam->depth + (size_t)ja * (size_t)W, *rb = cam->depth + (size_t)jb * (size_t)W;
     m->near = dmin(dmin(ra[ia], ra[ib]), dmin(rb[ia], rb[ib]));
+    m->near -= cam->bulge_most; // curved cells dip in front of their corners
     m->count = n;
     m->surface = n > 0;
     m->ready = false;
@@ -444,14 +487,12 @@ static void make_layers(march *m)
         uint8_t role = cam->role[(size_t)n * texels + t];
         cell_depth cd;
         layer_cell(collider, cam, n, m->hx, m->hy, own, role, &cd);
-        double fx0 = m->X0 - cd.ox, fy0 = m->Y0 - cd.oy;
-        double c0 = cd.k0 + cd.k1 * fx0 + cd.k2 * fy0 + cd.k3 * fx0 * fy0;
-        double c1 = cd.k1 * m->dX + cd.k2 * m->dY + cd.k3 * (fx0 * m->dY + fy0 * m->dX);
-        double c2 = cd.k3 * m->dX * m->dY;
+        double c[3];
+        cell_along(&cd, m, c);
         m->role[n] = role;
-        m->LA[n] = m->D0 - c0;
-        m->LB[n] = m->dD - c1;
-        m->LC[n] = -c2;
+        m->LA[n] = m->D0 - c[0];
+        m->LB[n] = m->dD - c[1];
+        m->LC[n] = -c[2];
     }
     m->ready = true;
 }
@@ -467,14 +508,11 @@ static void cell_function(const wx_collider *collider, march *m)
     if (!m->surface) {
         return;
     }
-    // depth(s) = k0 + k1 fx + k2 fy + k3 fx fy with fx = fx0 + s dX, fy = fy0 + s dY.
-    double fx0 = m->X0 - cd.ox, fy0 = m->Y0 - cd.oy;
-    double c0 = cd.k0 + cd.k1 * fx0 + cd.k2 * fy0 + cd.k3 * fx0 * fy0;
-    double c1 = cd.k1 * m->dX + cd.k2 * m->dY + cd.k3 * (fx0 * m->dY + fy0 * m->dX);
-    double c2 = cd.k3 * m->dX * m->dY;
-    m->A = m->D0 - c0;
-    m->B = m->dD - c1;
-    m->C = -c2;
+    double c[3];
+    cell_along(&cd, m, c);
+    m->A = m->D0 - c[0];
+    m->B = m->dD - c[1];
+    m->C = -c[2];
 }
 
 // Puts the walk in the cell that holds parameter s (s inside the frame).

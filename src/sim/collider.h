@@ -12,8 +12,10 @@
 //
 // Depth between texel centres is bilinear when the four texels around the
 // point all hold a surface (a smooth surface: no terraces, no banding, thesis
-// 5.1.2), and the texel's own depth otherwise (silhouettes, the thesis'
-// nearest-texel rule everywhere when `nearest` is set).
+// 5.1.2), plus second-order terms where the normals say the surface curves
+// (collider_build.c, curve_cells), and the texel's own depth otherwise
+// (silhouettes, the thesis' nearest-texel rule everywhere when `nearest` is
+// set).
 //
 // A camera with layered maps (wx_maps.layers = K > 1, docs/design.md section
 // 14) records each texel's first K crossings with outward normals; it says
@@ -69,6 +71,17 @@ typedef struct wx_collider_camera {
     /// layer of the maps (normal, impact, the hit's layer) it came from.
     uint8_t *origin;
     double sheet;
+    /// Second-order cells (docs/physics.md, "Depth between texels";
+    /// collider_build.c, curve_cells): per layer and texel t, the curvatures
+    /// (a, b) along X and Y of the bilinear cell whose first corner is t, in
+    /// units of `curve_unit` (depth per texel squared); the cell's depth is
+    /// then bilinear + a/2 fx (fx - 1) + b/2 fy (fy - 1). `bulge[t]`: how far
+    /// that cell dips in front of its corners in any layer, in units of
+    /// `bulge_unit`. Both NULL when no cell of the camera curves (planes).
+    int16_t *curve;
+    uint8_t *bulge;
+    double curve_unit, bulge_unit;
+    double bulge_most; ///< the largest dip of any cell (0 without curved cells)
     /// Coarse pyramid: level l has blocks of 4 << 2l texels; its value at block
     /// (bx, by) is the least depth over the 3x3 blocks around it, lowered by a
     /// rounding margin. Levels are stored one after the other in `coarse`.

@@ -80,10 +80,38 @@ static wx_result build_coarse(wx_collider_camera *cam, wx_error *err)
     for (int i = 0; i < total; ++i) {
         blockmin[i] = INFINITY;
     }
+    const float *first = cam->depth;
+    float *lowered = NULL;
+    if (cam->bulge != NULL) {
+        // Second-order cells dip in front of their corners: each texel's
+        // first crossing lowered by the largest dip of the four cells it is a
+        // corner of bounds every cell from below as the corners did.
+        lowered = wx_big_malloc((size_t)W * (size_t)H * sizeof *lowered);
+        if (lowered == NULL) {
+            free(blockmin);
+            return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (collider pyramid)");
+        }
+        for (int j = 0; j < H; ++j) {
+            for (int i = 0; i < W; ++i) {
+                int most = 0;
+                for (int y = j - 1; y <= j; ++y) {
+                    for (int x = i - 1; x <= i; ++x) {
+                        if (x >= 0 && y >= 0) {
+                            int b = cam->bulge[(size_t)y * (size_t)W + (size_t)x];
+                            most = b > most ? b : most;
+                        }
+                    }
+                }
+                size_t t = (size_t)j * (size_t)W + (size_t)i;
+                lowered[t] = (float)(cam->depth[t] - cam->bulge_unit * most);
+            }
+        }
+        first = lowered;
+    }
     // Level 0 from the texels, each further level from the one below.
     float *level0 = blockmin + cam->level_offset[0];
     for (int j = 0; j < H; ++j) {
-        const float *row = cam->depth + (size_t)j * (size_t)W;
+        const float *row = first + (size_t)j * (size_t)W;
         float *out = level0 + (size_t)(j >> WX_COARSE_BLOCK_SHIFT) * (size_t)cam->level_width[0];
         for (int i = 0; i < W; ++i) {
             float d = row[i];
@@ -142,6 +170,7 @@ static wx_result build_coarse(wx_collider_camera *cam, wx_error *err)
     float *across = wx_big_malloc(texels * sizeof *across);
     unsigned char *sheet = wx_big_calloc(texels, 1), *sheet_across = wx_big_calloc(texels, 1);
     if (cam->near3 == NULL || across == NULL || sheet == NULL || sheet_across == NULL) {
+        free(lowered);
         free(across);
         free(sheet);
         free(sheet_across);
@@ -155,7 +184,7 @@ static wx_result build_coarse(wx_collider_camera *cam, wx_error *err)
     }
     for (int j = 0; j < H; ++j) {
         size_t r = (size_t)j * (size_t)W;
-        const float *row = cam->depth + r;
+        const float *row = first + r;
         for (int i = 0; i < W; ++i) {
             float m = row[i];
             m = i > 0 && row[i - 1] < m ? row[i - 1] : m;
@@ -184,6 +213,7 @@ static wx_result build_coarse(wx_collider_camera *cam, wx_error *err)
             cam->near3[at] = m;
         }
     }
+    free(lowered);
     free(across);
     free(sheet);
     free(sheet_across);
@@ -352,6 +382,144 @@ static void widen_crossings(const wx_collider *collider, const double (*axes)[3]
     }
 }
 
+// Second-order cells (docs/physics.md, "Depth between texels"). A bilinear
+// cell is exact on a plane; on a curved surface it is the chord between the
+// four texel centres: behind the surface by up to a/8 between them (a the
+// depth's second derivative, per texel squared) and with a kink in its slope
+// at every row and column of centres, where a slide hops. The normals give
+// the depth's slope at each centre, so the change of slope across the cell
+// gives a and b along X and Y, and depth + a/2 fx (fx - 1) + b/2 fy (fy - 1)
+// (0 at the corners, still a quadratic along a segment) is right to second
+// order. Only where the normals explain the depths: slopes of at most
+// CURVE_TAN texels of depth per texel, the chord's slope along each side
+// within CURVE_TOL of a texel of the mean of its ends' slopes (a depth jump,
+// a widened crossing beside an unwidened one), and slopes that change by at
+// most CURVE_CAP per texel (else a crease or a rim: the cell stays a chord).
+#define CURVE_TAN 6.0
+#define CURVE_TOL 0.5
+#define CURVE_CAP 1.0
+
+// dD/dX at constant Y and dD/dY at constant X on the plane of normal n: along
+// n x my (resp. n x mx), which keeps Y (X), scaled to one texel of X (Y).
+static bool depth_slopes(const wx_collider_camera *cam, const float *n, double *gx, double *gy)
+{
+    const double *mx = cam->mx, *my = cam->my, *md = cam->md;
+    double nx = n[0], ny = n[1], nz = n[2];
+    double a[3] = { ny * my[2] - nz * my[1], nz * my[0] - nx * my[2], nx * my[1] - ny * my[0] };
+    double b[3] = { ny * mx[2] - nz * mx[1], nz * mx[0] - nx * mx[2], nx * mx[1] - ny * mx[0] };
+    double ax = a[0] * mx[0] + a[1] * mx[1] + a[2] * mx[2];
+    double by = b[0] * my[0] + b[1] * my[1] + b[2] * my[2];
+    if (!(fabs(ax) > 1e-12) || !(fabs(by) > 1e-12)) {
+        return false; // seen edge-on
+    }
+    *gx = (a[0] * md[0] + a[1] * md[1] + a[2] * md[2]) / ax;
+    *gy = (b[0] * md[0] + b[1] * md[1] + b[2] * md[2]) / by;
+    return isfinite(*gx) && isfinite(*gy);
+}
+
+// Layer k's slopes per texel into g (2 per texel; NAN where none is usable).
+static void layer_slopes(const wx_collider_camera *cam, int k, double texel, float *g)
+{
+    size_t texels = (size_t)cam->width * (size_t)cam->height;
+    for (size_t t = 0; t < texels; ++t) {
+        size_t at = (size_t)k * texels + t;
+        g[2 * t] = g[2 * t + 1] = NAN;
+        bool fill = cam->layers > 1 ? (cam->role[at] & WX_ROLE_FILL) != 0
+                                    : cam->fill != NULL && cam->fill[t];
+        if (!isfinite(cam->depth[at]) || fill) {
+            continue;
+        }
+        size_t layer = cam->layers > 1 ? cam->origin[at] : 0;
+        double gx, gy;
+        if (depth_slopes(cam, cam->normal + 3 * (layer * texels + t), &gx, &gy) &&
+            fabs(gx) <= CURVE_TAN * texel && fabs(gy) <= CURVE_TAN * texel) {
+            g[2 * t] = (float)gx;
+            g[2 * t + 1] = (float)gy;
+        }
+    }
+}
+
+static wx_result curve_cells(wx_collider_camera *cam, wx_error *err)
+{
+    int W = cam->width, H = cam->height;
+    size_t texels = (size_t)W * (size_t)H;
+    double bl = sqrt((double)cam->back[0] * cam->back[0] + (double)cam->back[1] * cam->back[1] +
+                     (double)cam->back[2] * cam->back[2]);
+    if (!(bl > 0.0) || W < 2 || H < 2) {
+        return WX_OK;
+    }
+    double texel = cam->texel_ws / bl; // a texel, in depth
+    cam->curve_unit = CURVE_CAP * texel / 32767.0;
+    cam->bulge_unit = CURVE_CAP * texel / 4.0 / 255.0;
+    float *g = wx_big_malloc(2 * texels * sizeof *g);
+    int16_t *curve = wx_big_calloc(2 * (size_t)cam->layers * texels, sizeof *curve);
+    uint8_t *bulge = wx_big_calloc(texels, 1);
+    if (g == NULL || curve == NULL || bulge == NULL) {
+        free(g);
+        free(curve);
+        free(bulge);
+        return wx_fail(err, WX_CAUSE_OUT_OF_MEMORY, "out of memory (collider curvature)");
+    }
+    bool any = false;
+    double tol = CURVE_TOL * texel, cap = CURVE_CAP * texel;
+    for (int k = 0; k < cam->layers; ++k) {
+        layer_slopes(cam, k, texel, g);
+        const float *depth = cam->depth + (size_t)k * texels;
+        for (int j = 0; j + 1 < H; ++j) {
+            for (int i = 0; i + 1 < W; ++i) {
+                size_t c[4] = { (size_t)j * (size_t)W + (size_t)i, 0, 0, 0 };
+                c[1] = c[0] + 1;
+                c[2] = c[0] + (size_t)W;
+                c[3] = c[2] + 1;
+                double gx[4], gy[4];
+                bool usable = true, flat = true;
+                for (int q = 0; q < 4; ++q) {
+                    gx[q] = g[2 * c[q]];
+                    gy[q] = g[2 * c[q] + 1];
+                    usable &= !isnan(gx[q]);
+                    flat &= gx[q] == gx[0] && gy[q] == gy[0];
+                }
+                if (!usable || flat) {
+                    continue;
+                }
+                double dx0 = gx[1] - gx[0], dx1 = gx[3] - gx[2];
+                double dy0 = gy[2] - gy[0], dy1 = gy[3] - gy[1];
+                if (fabs(dx0) > cap || fabs(dx1) > cap || fabs(dy0) > cap || fabs(dy1) > cap ||
+                    fabs((depth[c[1]] - depth[c[0]]) - 0.5 * (gx[0] + gx[1])) > tol ||
+                    fabs((depth[c[3]] - depth[c[2]]) - 0.5 * (gx[2] + gx[3])) > tol ||
+                    fabs((depth[c[2]] - depth[c[0]]) - 0.5 * (gy[0] + gy[2])) > tol ||
+                    fabs((depth[c[3]] - depth[c[1]]) - 0.5 * (gy[1] + gy[3])) > tol) {
+                    continue;
+                }
+                long qa = lround(0.5 * (dx0 + dx1) / cam->curve_unit);
+                long qb = lround(0.5 * (dy0 + dy1) / cam->curve_unit);
+                if (qa == 0 && qb == 0) {
+                    continue;
+                }
+                size_t at = (size_t)k * texels + c[0];
+                curve[2 * at] = (int16_t)qa;
+                curve[2 * at + 1] = (int16_t)qb;
+                // The dip in front of the corners: a/8 + b/8 where they are > 0.
+                double dip = ((qa > 0 ? qa : 0) + (qb > 0 ? qb : 0)) * cam->curve_unit / 8.0;
+                double units = ceil(dip / cam->bulge_unit);
+                uint8_t u = (uint8_t)(units < 255.0 ? units : 255.0);
+                bulge[c[0]] = u > bulge[c[0]] ? u : bulge[c[0]];
+                cam->bulge_most = fmax(cam->bulge_most, u * cam->bulge_unit);
+                any = true;
+            }
+        }
+    }
+    free(g);
+    if (!any) {
+        free(curve);
+        free(bulge);
+        return WX_OK;
+    }
+    cam->curve = curve;
+    cam->bulge = bulge;
+    return WX_OK;
+}
+
 wx_result wx_collider_init(wx_collider *collider, const wx_camera *cameras, const wx_maps *maps,
                            int count, bool nearest, wx_error *err)
 {
@@ -447,6 +615,13 @@ wx_result wx_collider_init(wx_collider *collider, const wx_camera *cameras, cons
         wx_collider_free(collider);
         return filled;
     }
+    for (int c = 0; c < count && !nearest; ++c) {
+        wx_result r = curve_cells(&collider->cameras[c], err);
+        if (r != WX_OK) {
+            wx_collider_free(collider);
+            return r;
+        }
+    }
     for (int c = 0; c < count; ++c) {
         wx_result r = build_coarse(&collider->cameras[c], err);
         if (r != WX_OK) {
@@ -501,6 +676,8 @@ void wx_collider_free(wx_collider *collider)
         free(collider->cameras[c].coarse);
         free(collider->cameras[c].near3);
         free(collider->cameras[c].fill);
+        free(collider->cameras[c].curve);
+        free(collider->cameras[c].bulge);
     }
     free(collider->cameras);
     memset(collider, 0, sizeof *collider);
