@@ -63,14 +63,17 @@ static void bilinear_cell(cell_depth *cd, int i0, int j0, double d00, double d10
     cd->k4 = cd->k5 = 0.0;
 }
 
-// Adds the second-order terms of the cell whose first corner is index `at`
-// (layer plane plus texel) to a bilinear cell: depth += a/2 fx (fx - 1) +
+// Adds the second-order terms of the cell whose first corner is texel (i0, j0)
+// of the layer at index `plane` to a bilinear cell: depth += a/2 fx (fx - 1) +
 // b/2 fy (fy - 1), which is 0 at the corners (collider_build.c, curve_cells).
-static inline void curve_terms(const wx_collider_camera *cam, size_t at, cell_depth *cd)
+// A cell by the map's border (corners clamped onto one texel) has none.
+static inline void curve_terms(const wx_collider_camera *cam, size_t plane, int i0, int j0,
+                               cell_depth *cd)
 {
-    if (cam->curve == NULL) {
+    if (cam->curve == NULL || i0 < 0 || j0 < 0 || i0 + 1 >= cam->width || j0 + 1 >= cam->height) {
         return;
     }
+    size_t at = plane + (size_t)j0 * (size_t)cam->width + (size_t)i0;
     double a = 0.5 * cam->curve_unit * cam->curve[2 * at];
     double b = 0.5 * cam->curve_unit * cam->curve[2 * at + 1];
     cd->k4 = a;
@@ -115,9 +118,7 @@ static bool cell_surface(const wx_collider *collider, const wx_collider_camera *
         }
     }
     bilinear_cell(cd, i0, j0, d00, d10, d01, d11);
-    if (i0 == ia && j0 == ja && ib == i0 + 1 && jb == j0 + 1) {
-        curve_terms(cam, (size_t)ja * (size_t)W + (size_t)ia, cd);
-    }
+    curve_terms(cam, 0, i0, j0, cd);
     return true;
 }
 
@@ -187,9 +188,7 @@ static void layer_cell(const wx_collider *collider, const wx_collider_camera *ca
         }
     }
     bilinear_cell(cd, i0, j0, d00, d10, d01, d11);
-    if (i0 == ia && j0 == ja && ib == i0 + 1 && jb == j0 + 1) {
-        curve_terms(cam, ra + ia, cd);
-    }
+    curve_terms(cam, plane, i0, j0, cd);
 }
 
 static inline double cell_value(const cell_depth *cd, double X, double Y)

@@ -75,13 +75,13 @@ typedef struct wx_collider_camera {
     /// collider_build.c, curve_cells): per layer and texel t, the curvatures
     /// (a, b) along X and Y of the bilinear cell whose first corner is t, in
     /// units of `curve_unit` (depth per texel squared); the cell's depth is
-    /// then bilinear + a/2 fx (fx - 1) + b/2 fy (fy - 1). `bulge[t]`: how far
-    /// that cell dips in front of its corners in any layer, in units of
-    /// `bulge_unit`. Both NULL when no cell of the camera curves (planes).
+    /// then bilinear + a/2 fx (fx - 1) + b/2 fy (fy - 1). NULL when no cell of
+    /// the camera curves (planes).
     int16_t *curve;
-    uint8_t *bulge;
-    double curve_unit, bulge_unit;
-    double bulge_most; ///< the largest dip of any cell (0 without curved cells)
+    double curve_unit;
+    /// The farthest any curved cell dips in front of its corners (0 without
+    /// curved cells); the coarse pyramid and near3 are lowered texel by texel.
+    double bulge_most;
     /// Coarse pyramid: level l has blocks of 4 << 2l texels; its value at block
     /// (bx, by) is the least depth over the 3x3 blocks around it, lowered by a
     /// rounding margin. Levels are stored one after the other in `coarse`.

@@ -57,9 +57,17 @@ static wx_result setup_matrices(wx_collider_camera *cam, const float wtc[16], in
     return WX_OK;
 }
 
+// How far each curved cell dips in front of its corners (curve_cells), for
+// the bounds build_coarse makes: per texel, the cell whose first corner it
+// is, in units of `unit`; `q` NULL where no cell curves.
+typedef struct cell_dips {
+    uint8_t *q;
+    double unit;
+} cell_dips;
+
 // The coarse pyramid: block minima per level, then the minimum over the 3x3
 // blocks around each block, lowered by a margin for float rounding.
-static wx_result build_coarse(wx_collider_camera *cam, wx_error *err)
+static wx_result build_coarse(wx_collider_camera *cam, const cell_dips *dips, wx_error *err)
 {
     int W = cam->width, H = cam->height;
     int total = 0;
@@ -82,7 +90,7 @@ static wx_result build_coarse(wx_collider_camera *cam, wx_error *err)
     }
     const float *first = cam->depth;
     float *lowered = NULL;
-    if (cam->bulge != NULL) {
+    if (dips->q != NULL) {
         // Second-order cells dip in front of their corners: each texel's
         // first crossing lowered by the largest dip of the four cells it is a
         // corner of bounds every cell from below as the corners did.
@@ -97,13 +105,13 @@ static wx_result build_coarse(wx_collider_camera *cam, wx_error *err)
                 for (int y = j - 1; y <= j; ++y) {
                     for (int x = i - 1; x <= i; ++x) {
                         if (x >= 0 && y >= 0) {
-                            int b = cam->bulge[(size_t)y * (size_t)W + (size_t)x];
+                            int b = dips->q[(size_t)y * (size_t)W + (size_t)x];
                             most = b > most ? b : most;
                         }
                     }
                 }
                 size_t t = (size_t)j * (size_t)W + (size_t)i;
-                lowered[t] = (float)(cam->depth[t] - cam->bulge_unit * most);
+                lowered[t] = (float)(cam->depth[t] - dips->unit * most);
             }
         }
         first = lowered;
@@ -439,8 +447,9 @@ static void layer_slopes(const wx_collider_camera *cam, int k, double texel, flo
     }
 }
 
-static wx_result curve_cells(wx_collider_camera *cam, wx_error *err)
+static wx_result curve_cells(wx_collider_camera *cam, cell_dips *dips, wx_error *err)
 {
+    dips->q = NULL;
     int W = cam->width, H = cam->height;
     size_t texels = (size_t)W * (size_t)H;
     double bl = sqrt((double)cam->back[0] * cam->back[0] + (double)cam->back[1] * cam->back[1] +
@@ -450,7 +459,7 @@ static wx_result curve_cells(wx_collider_camera *cam, wx_error *err)
     }
     double texel = cam->texel_ws / bl; // a texel, in depth
     cam->curve_unit = CURVE_CAP * texel / 32767.0;
-    cam->bulge_unit = CURVE_CAP * texel / 4.0 / 255.0;
+    dips->unit = CURVE_CAP * texel / 4.0 / 255.0;
     float *g = wx_big_malloc(2 * texels * sizeof *g);
     int16_t *curve = wx_big_calloc(2 * (size_t)cam->layers * texels, sizeof *curve);
     uint8_t *bulge = wx_big_calloc(texels, 1);
@@ -501,10 +510,10 @@ static wx_result curve_cells(wx_collider_camera *cam, wx_error *err)
                 curve[2 * at + 1] = (int16_t)qb;
                 // The dip in front of the corners: a/8 + b/8 where they are > 0.
                 double dip = ((qa > 0 ? qa : 0) + (qb > 0 ? qb : 0)) * cam->curve_unit / 8.0;
-                double units = ceil(dip / cam->bulge_unit);
+                double units = ceil(dip / dips->unit);
                 uint8_t u = (uint8_t)(units < 255.0 ? units : 255.0);
                 bulge[c[0]] = u > bulge[c[0]] ? u : bulge[c[0]];
-                cam->bulge_most = fmax(cam->bulge_most, u * cam->bulge_unit);
+                cam->bulge_most = fmax(cam->bulge_most, u * dips->unit);
                 any = true;
             }
         }
@@ -516,7 +525,7 @@ static wx_result curve_cells(wx_collider_camera *cam, wx_error *err)
         return WX_OK;
     }
     cam->curve = curve;
-    cam->bulge = bulge;
+    dips->q = bulge;
     return WX_OK;
 }
 
@@ -615,15 +624,13 @@ wx_result wx_collider_init(wx_collider *collider, const wx_camera *cameras, cons
         wx_collider_free(collider);
         return filled;
     }
-    for (int c = 0; c < count && !nearest; ++c) {
-        wx_result r = curve_cells(&collider->cameras[c], err);
-        if (r != WX_OK) {
-            wx_collider_free(collider);
-            return r;
-        }
-    }
     for (int c = 0; c < count; ++c) {
-        wx_result r = build_coarse(&collider->cameras[c], err);
+        cell_dips dips = { NULL, 0.0 };
+        wx_result r = nearest ? WX_OK : curve_cells(&collider->cameras[c], &dips, err);
+        if (r == WX_OK) {
+            r = build_coarse(&collider->cameras[c], &dips, err);
+        }
+        free(dips.q);
         if (r != WX_OK) {
             wx_collider_free(collider);
             return r;
@@ -677,7 +684,6 @@ void wx_collider_free(wx_collider *collider)
         free(collider->cameras[c].near3);
         free(collider->cameras[c].fill);
         free(collider->cameras[c].curve);
-        free(collider->cameras[c].bulge);
     }
     free(collider->cameras);
     memset(collider, 0, sizeof *collider);
