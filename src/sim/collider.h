@@ -194,6 +194,13 @@ void wx_collider_bump_lift(const wx_collider_camera *cam, const float n[3], floa
 /// The point rule of docs/design.md section 4 for one point (no sweep).
 bool wx_collider_point_collides(const wx_collider *collider, const float p[3]);
 
+/// Camera c's part of that rule at texel-space (X, Y, D) inside its frame: it
+/// may collide there (behind its surface, or inside one of its solids).
+/// wx_collider_point_collides asks it of every camera whose frame holds the
+/// point (tests/tools/surface_probe.c names the cameras that say no).
+bool wx_collider_camera_may_collide(const wx_collider *collider, int c, double X, double Y,
+                                    double D);
+
 /// Coarse test of WX_PARTICLE_BLOCK segments (x0, y0, z0) -> (x1, y1, z1) against
 /// the `count` cameras listed in `cams`: bit k of the result is set when one of
 /// them sees all of segment k in front of its surfaces (then it cannot collide);

@@ -29,11 +29,6 @@ enum {
     WX_ROLE_FILL = 16,
 };
 
-/// Camera c's point rule at texel-space (X, Y, D) inside its frame: it may
-/// collide there (behind its surface, or inside one of its solids).
-bool wx_collider_camera_may_collide(const wx_collider *collider, int c, double X, double Y,
-                                    double D);
-
 /// Adds the fills every camera needs where it sees a surface edge-on and says
 /// "not behind" inside it (collider_fill.c); axes[c] is camera c's unit axis
 /// towards it. Runs once, after the crossings are widened and before the
