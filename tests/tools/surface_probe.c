@@ -41,15 +41,18 @@
 #include "pipeline/outputs.h"
 #include "pipeline/pipeline.h"
 #include "sim/collider.h"
+#include "sim/particles.h"
 
 typedef struct probe_totals {
     long long points, hits, notches, bumps;
     double sum, sum2;
 } probe_totals;
 
+// The tests' generator (tests/bench/bench_embree.c): the particles' mixer on
+// a Weyl sequence, 53 bits of it.
 static double next_uniform(uint64_t *state)
 {
-    *state = *state * 6364136223846793005ULL + 1442695040888963407ULL;
+    *state = wx_mix64(*state + UINT64_C(0x9e3779b97f4a7c15));
     return (double)(*state >> 11) * (1.0 / 9007199254740992.0);
 }
 
