@@ -1,0 +1,138 @@
+#!/usr/bin/python3
+"""turn_map.py BUILD DIR SEEDS [CHANNEL]: where on the model the turn lives.
+
+DIR is the folder tests/tools/invariance.sh left (BUILD/invariance/, with
+SEEDS=N runs model1..N and turned1..N). For seeds i != j the differences
+D_i = model_i - turned_i and D_j share only what does not depend on the seed,
+so mean(D_i D_j) over the pairs estimates, texel by texel, the square of what
+turning the model changes (T^2; tests/tools/diagnosis/common_part.py takes
+the same product over the whole texture). The same product of the seeds'
+differences, (model_i - model_j)(turned_i - turned_j), has no such part: its
+map shows what the estimate's own noise looks like.
+
+Prints T^2 and that null over the texels every run sees, as a ratio the
+issue reads (sqrt(1 + T^2 / S^2), S^2 the seeds' mean square difference), and
+their shares by the texel's distance (in texels, 8-neighbour steps) to the
+edge of what is seen: island borders and what no camera sees. Writes, in DIR,
+turn_map.exr and turn_null.exr: `Y` the two products averaged over 9 x 9
+texels, over the mean squared (negative values as 0), `seen` as the runs'.
+Look at them on the model with build/tools/render_texture (`--white 0.01`):
+
+    build/tools/render_texture MESH DIR/turn_map.exr --view "..." --png map.png
+
+Needs numpy (python3-numpy; run it with /usr/bin/python3) and
+BUILD/tools/exr_channel. docs/performance.md, "Which pairs the turn is read
+from", shows Spot's: speckle like the null's, plus lines along the neck, the
+eyes and the roots of the ears.
+"""
+import itertools
+import os
+import struct
+import subprocess
+import sys
+import tempfile
+
+import numpy as np
+
+
+def read(tool, path, channel, scratch):
+    out = os.path.join(scratch, "c.f32")
+    r = subprocess.run([tool, path, channel, out], capture_output=True, text=True)
+    if r.returncode != 0:
+        sys.exit("turn_map.py: %s: %s" % (path, r.stderr.strip() or "cannot read " + channel))
+    w, h = (int(x) for x in r.stdout.split())
+    return np.fromfile(out, dtype=np.float32).reshape(h, w).astype(np.float64)
+
+
+def write_exr(path, channels):
+    """An uncompressed scanline EXR of FLOAT channels (name -> H x W array)."""
+
+    def attr(name, kind, data):
+        return name.encode() + b"\0" + kind.encode() + b"\0" + struct.pack("<i", len(data)) + data
+
+    names = sorted(channels)
+    h, w = channels[names[0]].shape
+    chlist = b"".join(n.encode() + b"\0" + struct.pack("<iB3xii", 2, 0, 1, 1) for n in names)
+    box = struct.pack("<4i", 0, 0, w - 1, h - 1)
+    header = (b"\x76\x2f\x31\x01" + struct.pack("<i", 2)
+              + attr("channels", "chlist", chlist + b"\0")
+              + attr("compression", "compression", b"\0")
+              + attr("dataWindow", "box2i", box) + attr("displayWindow", "box2i", box)
+              + attr("lineOrder", "lineOrder", b"\0")
+              + attr("pixelAspectRatio", "float", struct.pack("<f", 1.0))
+              + attr("screenWindowCenter", "v2f", struct.pack("<2f", 0.0, 0.0))
+              + attr("screenWindowWidth", "float", struct.pack("<f", 1.0)) + b"\0")
+    blocks, offsets, at = [], [], len(header) + 8 * h
+    for y in range(h):
+        data = b"".join(channels[n][y].astype("<f4").tobytes() for n in names)
+        offsets.append(at)
+        blocks.append(struct.pack("<ii", y, len(data)) + data)
+        at += len(blocks[-1])
+    with open(path, "wb") as f:
+        f.write(header + struct.pack("<%dQ" % h, *offsets) + b"".join(blocks))
+
+
+def box_mean(a, k=9):
+    p = np.pad(a, k // 2, mode="edge")
+    c = np.pad(p.cumsum(0).cumsum(1), ((1, 0), (1, 0)))
+    return (c[k:, k:] - c[:-k, k:] - c[k:, :-k] + c[:-k, :-k]) / (k * k)
+
+
+def distance_to_edge(seen):
+    dist = np.zeros(seen.shape, int)
+    cur, r = seen.copy(), 0
+    while cur.any() and r < 64:
+        r += 1
+        inner = cur.copy()
+        inner[1:] &= cur[:-1]
+        inner[:-1] &= cur[1:]
+        inner[:, 1:] &= cur[:, :-1]
+        inner[:, :-1] &= cur[:, 1:]
+        dist[cur & ~inner] = r
+        cur = inner
+    dist[cur] = r + 1
+    return dist
+
+
+def main():
+    if len(sys.argv) not in (4, 5) or not sys.argv[3].isdigit() or int(sys.argv[3]) < 3:
+        sys.exit("usage: turn_map.py BUILD DIR SEEDS [CHANNEL]  (SEEDS >= 3: two pairs at least)")
+    build, d, n = sys.argv[1], sys.argv[2], int(sys.argv[3])
+    channel = sys.argv[4] if len(sys.argv) == 5 else "Y"
+    tool = os.path.join(build, "tools", "exr_channel")
+    with tempfile.TemporaryDirectory() as scratch:
+        tex = lambda m, s: os.path.join(d, "%s%d" % (m, s), "%s_texture.exr" % m)
+        model = [read(tool, tex("model", s), channel, scratch) for s in range(1, n + 1)]
+        turned = [read(tool, tex("turned", s), channel, scratch) for s in range(1, n + 1)]
+        seen = np.ones(model[0].shape, bool)
+        for s in range(1, n + 1):
+            seen &= read(tool, tex("model", s), "seen", scratch) > 0
+            seen &= read(tool, tex("turned", s), "seen", scratch) > 0
+    mean = np.mean([a[seen].mean() for a in model + turned])
+    pairs = list(itertools.combinations(range(n), 2))
+    turn = np.mean([(model[i] - turned[i]) * (model[j] - turned[j]) for i, j in pairs], axis=0)
+    null = np.mean([(model[i] - model[j]) * (turned[i] - turned[j]) for i, j in pairs], axis=0)
+    seeds = np.mean([(a[i] - a[j]) ** 2 for a in (model, turned) for i, j in pairs], axis=0)
+    turn, null, seeds = turn / mean ** 2, null / mean ** 2, seeds / mean ** 2
+    t2, n2, s2 = turn[seen].mean(), null[seen].mean(), seeds[seen].mean()
+    print("per texel over %d seen texels: T^2 %.3g (null %+.3g), seeds' S^2 %.3g: ratio %.3f"
+          % (seen.sum(), t2, n2, s2, np.sqrt(1.0 + t2 / s2)))
+    dist = distance_to_edge(seen)
+    print("texels from the edge of what is seen: share of texels, of T^2, of the null, of S^2")
+    for lo, hi in ((1, 2), (3, 4), (5, 8), (9, 16), (17, 1 << 30)):
+        sel = seen & (dist >= lo) & (dist <= hi)
+        if sel.any():
+            print("  %2d-%-3s %.3f  T^2 %+.3f  null %+.3f  S^2 %.3f" % (
+                lo, str(hi) if hi < 1 << 30 else "", sel.sum() / seen.sum(),
+                turn[sel].sum() / turn[seen].sum(), null[sel].sum() / turn[seen].sum(),
+                seeds[sel].sum() / seeds[seen].sum()))
+    weight = np.maximum(box_mean(seen.astype(float)), 1e-6)
+    for name, a in (("turn_map.exr", turn), ("turn_null.exr", null)):
+        smooth = np.where(seen, np.maximum(box_mean(np.where(seen, a, 0.0)) / weight, 0.0), 0.0)
+        write_exr(os.path.join(d, name),
+                  {"Y": smooth.astype(np.float32), "seen": seen.astype(np.float32)})
+    print("wrote %s and %s" % (os.path.join(d, "turn_map.exr"), os.path.join(d, "turn_null.exr")))
+
+
+if __name__ == "__main__":
+    main()
