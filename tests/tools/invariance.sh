@@ -105,12 +105,12 @@ for s in $(seq 1 "$seeds"); do
     done
 done >> "$dir/pairs"
 if [ "$seeds" -gt 2 ]; then
-echo "over every pair of seeds 1 to $seeds:"
-awk '{ q[$1, $2] += $3 * $3; n[$1, $2]++
-       if ($1 == "seeds") { if (!(($2) in lo) || $3 < lo[$2]) lo[$2] = $3; if ($3 > hi[$2]) hi[$2] = $3 } }
-     END { for (k = 1; k <= 32; k *= 2) if (n["seeds", k] > 0) {
-               s = sqrt(q["seeds", k] / n["seeds", k]); o = sqrt(q["orientations", k] / n["orientations", k])
-               printf "block %2d: seeds %.4f (pairs %.4f to %.4f)  orientations %.4f  ratio %.3f\n", k, s, lo[k], hi[k], o, o / s } }' "$dir/pairs"
+    echo "over every pair of seeds 1 to $seeds:"
+    awk '{ q[$1, $2] += $3 * $3; n[$1, $2]++
+           if ($1 == "seeds") { if (!(($2) in lo) || $3 < lo[$2]) lo[$2] = $3; if ($3 > hi[$2]) hi[$2] = $3 } }
+         END { for (k = 1; k <= 32; k *= 2) if (n["seeds", k] > 0) {
+                   s = sqrt(q["seeds", k] / n["seeds", k]); o = sqrt(q["orientations", k] / n["orientations", k])
+                   printf "block %2d: seeds %.4f (pairs %.4f to %.4f)  orientations %.4f  ratio %.3f\n", k, s, lo[k], hi[k], o, o / s } }' "$dir/pairs"
 fi
 # Every model seed against every turned seed (N^2 pairs, the same seed and
 # different ones) against the seeds over every pair.

@@ -2,7 +2,7 @@
 """turn_map.py BUILD DIR SEEDS [CHANNEL]: where on the model the turn lives.
 
 DIR is the folder tests/tools/invariance.sh left (BUILD/invariance/, with
-SEEDS=N runs model1..N and turned1..N). For seeds i != j the differences
+SEEDS=N runs model1..N and turned1..N; N >= 2, and the more the quieter). For seeds i != j the differences
 D_i = model_i - turned_i and D_j share only what does not depend on the seed,
 so mean(D_i D_j) over the pairs estimates, texel by texel, the square of what
 turning the model changes (T^2; tests/tools/diagnosis/common_part.py takes
@@ -95,8 +95,8 @@ def distance_to_edge(seen):
 
 
 def main():
-    if len(sys.argv) not in (4, 5) or not sys.argv[3].isdigit() or int(sys.argv[3]) < 3:
-        sys.exit("usage: turn_map.py BUILD DIR SEEDS [CHANNEL]  (SEEDS >= 3: two pairs at least)")
+    if len(sys.argv) not in (4, 5) or not sys.argv[3].isdigit() or int(sys.argv[3]) < 2:
+        sys.exit("usage: turn_map.py BUILD DIR SEEDS [CHANNEL]  (SEEDS >= 2)")
     build, d, n = sys.argv[1], sys.argv[2], int(sys.argv[3])
     channel = sys.argv[4] if len(sys.argv) == 5 else "Y"
     tool = os.path.join(build, "tools", "exr_channel")
