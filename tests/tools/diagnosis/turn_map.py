@@ -39,7 +39,7 @@ def read(tool, path, channel, scratch):
     out = os.path.join(scratch, "c.f32")
     r = subprocess.run([tool, path, channel, out], capture_output=True, text=True)
     if r.returncode != 0:
-        sys.exit("turn_map.py: %s: %s" % (path, r.stderr.strip() or "cannot read " + channel))
+        sys.exit("turn_map.py: " + (r.stderr.strip() or "%s: cannot read %s" % (path, channel)))
     w, h = (int(x) for x in r.stdout.split())
     return np.fromfile(out, dtype=np.float32).reshape(h, w).astype(np.float64)
 
@@ -96,7 +96,8 @@ def distance_to_edge(seen):
 
 def main():
     if len(sys.argv) not in (4, 5) or not sys.argv[3].isdigit() or int(sys.argv[3]) < 2:
-        sys.exit("usage: turn_map.py BUILD DIR SEEDS [CHANNEL]  (SEEDS >= 2)")
+        print("usage: turn_map.py BUILD DIR SEEDS [CHANNEL]  (SEEDS >= 2)", file=sys.stderr)
+        sys.exit(2)
     build, d, n = sys.argv[1], sys.argv[2], int(sys.argv[3])
     channel = sys.argv[4] if len(sys.argv) == 5 else "Y"
     tool = os.path.join(build, "tools", "exr_channel")
