@@ -2,10 +2,10 @@
 """turn_map.py BUILD DIR SEEDS [CHANNEL]: where on the model the turn lives.
 
 DIR is the folder tests/tools/invariance.sh left (BUILD/invariance/, with
-SEEDS=N runs model1..N and turned1..N; N >= 2, and the more the quieter). For seeds i != j the differences
-D_i = model_i - turned_i and D_j share only what does not depend on the seed,
-so mean(D_i D_j) over the pairs estimates, texel by texel, the square of what
-turning the model changes (T^2; tests/tools/diagnosis/common_part.py takes
+SEEDS=N runs model1..N and turned1..N; N >= 2, and the more the quieter).
+For seeds i != j the differences D_i = model_i - turned_i and D_j share
+only what does not depend on the seed, so mean(D_i D_j) over the pairs
+estimates, texel by texel, the square of what turning the model changes (T^2; tests/tools/diagnosis/common_part.py takes
 the same product over the whole texture). The same product of the seeds'
 differences, (model_i - model_j)(turned_i - turned_j), has no such part: its
 map shows what the estimate's own noise looks like.
