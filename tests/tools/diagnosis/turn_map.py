@@ -1,19 +1,23 @@
 #!/usr/bin/python3
-"""turn_map.py BUILD DIR SEEDS [CHANNEL]: where on the model the turn lives.
+"""turn_map.py BUILD DIR SEEDS [CHANNEL] [--mesh MODEL.obj]: where on the model the turn lives.
 
 DIR is the folder tests/tools/invariance.sh left (BUILD/invariance/, with
 SEEDS=N runs model1..N and turned1..N; N >= 2, and the more the quieter).
 For seeds i != j the differences D_i = model_i - turned_i and D_j share
 only what does not depend on the seed, so mean(D_i D_j) over the pairs
-estimates, texel by texel, the square of what turning the model changes (T^2; tests/tools/diagnosis/common_part.py takes
-the same product over the whole texture). The same product of the seeds'
+estimates, texel by texel, the square of what turning the model changes
+(T^2; tests/tools/diagnosis/common_part.py takes the same product over the
+whole texture). The same product of the seeds'
 differences, (model_i - model_j)(turned_i - turned_j), has no such part: its
 map shows what the estimate's own noise looks like.
 
 Prints T^2 and that null over the texels every run sees, as a ratio the
 issue reads (sqrt(1 + T^2 / S^2), S^2 the seeds' mean square difference), and
 their shares by the texel's distance (in texels, 8-neighbour steps) to the
-edge of what is seen: island borders and what no camera sees. Writes, in DIR,
+edge of what is seen: island borders and what no camera sees; then how few
+blocks of 32 x 32 texels hold half of T^2, and the eight that hold the most,
+each by the UV of its texel with the most (with --mesh, the model's point
+there: DIR/model.obj is the model unturned). Writes, in DIR,
 turn_map.exr and turn_null.exr: `Y` the two products averaged over 9 x 9
 texels, over the mean squared (negative values as 0), `seen` as the runs'.
 Look at them on the model with build/tools/render_texture (`--white 0.01`):
@@ -23,7 +27,8 @@ Look at them on the model with build/tools/render_texture (`--white 0.01`):
 Needs numpy (python3-numpy; run it with /usr/bin/python3) and
 BUILD/tools/exr_channel. docs/performance.md, "Which pairs the turn is read
 from", shows Spot's: speckle like the null's, plus lines along the neck, the
-eyes and the roots of the ears.
+eyes and the roots of the ears; "Where Spot's turn sits" (fourteenth
+session) finds half of it in 16 blocks, at the roots of the horns and ears.
 """
 import itertools
 import os
@@ -94,12 +99,54 @@ def distance_to_edge(seen):
     return dist
 
 
+def obj_point(path, u, v):
+    """The point of the OBJ mesh at UV (u, v): the first triangle whose UVs
+    hold it (a UV point inside none, or on a face without UVs: None)."""
+    vs, vts, faces = [], [], []
+    with open(path) as f:
+        for line in f:
+            p = line.split()
+            if not p:
+                continue
+            if p[0] == "v":
+                vs.append([float(x) for x in p[1:4]])
+            elif p[0] == "vt":
+                vts.append([float(x) for x in p[1:3]])
+            elif p[0] == "f":
+                corners = [(c.split("/") + [""])[:2] for c in p[1:]]
+                for k in range(1, len(corners) - 1):  # fans: OBJ faces may have more than 3
+                    tri = [corners[0], corners[k], corners[k + 1]]
+                    if all(t[1] for t in tri):
+                        faces.append([[int(t[0]) - 1, int(t[1]) - 1] for t in tri])
+    if not faces:
+        return None
+    V, T, F = np.array(vs), np.array(vts), np.array(faces)
+    a, b, c = T[F[:, 0, 1]], T[F[:, 1, 1]], T[F[:, 2, 1]]
+    d = (b[:, 1] - c[:, 1]) * (a[:, 0] - c[:, 0]) + (c[:, 0] - b[:, 0]) * (a[:, 1] - c[:, 1])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        l1 = ((b[:, 1] - c[:, 1]) * (u - c[:, 0]) + (c[:, 0] - b[:, 0]) * (v - c[:, 1])) / d
+        l2 = ((c[:, 1] - a[:, 1]) * (u - c[:, 0]) + (a[:, 0] - c[:, 0]) * (v - c[:, 1])) / d
+    l3 = 1.0 - l1 - l2
+    inside = np.flatnonzero((l1 >= -1e-6) & (l2 >= -1e-6) & (l3 >= -1e-6))
+    if inside.size == 0:
+        return None
+    k = inside[0]
+    return l1[k] * V[F[k, 0, 0]] + l2[k] * V[F[k, 1, 0]] + l3[k] * V[F[k, 2, 0]]
+
+
 def main():
-    if len(sys.argv) not in (4, 5) or not sys.argv[3].isdigit() or int(sys.argv[3]) < 2:
-        print("usage: turn_map.py BUILD DIR SEEDS [CHANNEL]  (SEEDS >= 2)", file=sys.stderr)
+    args = sys.argv[1:]
+    mesh = None
+    if len(args) >= 2 and args[-2] == "--mesh":
+        mesh, args = args[-1], args[:-2]
+    if len(args) not in (3, 4) or not args[2].isdigit() or int(args[2]) < 2:
+        print("usage: turn_map.py BUILD DIR SEEDS [CHANNEL] [--mesh MODEL.obj]  (SEEDS >= 2)",
+              file=sys.stderr)
         sys.exit(2)
-    build, d, n = sys.argv[1], sys.argv[2], int(sys.argv[3])
-    channel = sys.argv[4] if len(sys.argv) == 5 else "Y"
+    if mesh is not None and not os.path.isfile(mesh):
+        sys.exit("turn_map.py: %s: no such file" % mesh)
+    build, d, n = args[0], args[1], int(args[2])
+    channel = args[3] if len(args) == 4 else "Y"
     tool = os.path.join(build, "tools", "exr_channel")
     with tempfile.TemporaryDirectory() as scratch:
         tex = lambda m, s: os.path.join(d, "%s%d" % (m, s), "%s_texture.exr" % m)
@@ -127,6 +174,32 @@ def main():
                 lo, str(hi) if hi < 1 << 30 else "", sel.sum() / seen.sum(),
                 turn[sel].sum() / turn[seen].sum(), null[sel].sum() / turn[seen].sum(),
                 seeds[sel].sum() / seeds[seen].sum()))
+    # Hot spots: blocks of 32 x 32 texels by their share of T^2.
+    b = 32
+    h, w = seen.shape
+    hb, wb = (h + b - 1) // b, (w + b - 1) // b
+    padded = np.zeros((hb * b, wb * b))
+    padded[:h, :w] = np.where(seen, turn, 0.0)
+    blocks = padded.reshape(hb, b, wb, b).sum(axis=(1, 3))
+    total = turn[seen].sum()
+    order = np.argsort(blocks.ravel())[::-1]
+    share = np.cumsum(blocks.ravel()[order]) / total
+    used = int(np.count_nonzero(padded.reshape(hb, b, wb, b).any(axis=(1, 3))))
+    half = int(np.searchsorted(share, 0.5)) + 1
+    print("blocks of %d x %d texels: %d of the %d with a seen texel hold half of T^2;"
+          " the largest eight (share of T^2, UV of the block's texel with the most%s):"
+          % (b, b, half, used, ", the point there" if mesh else ""))
+    smooth_turn = box_mean(np.where(seen, turn, 0.0), 5)
+    for k in order[:8]:
+        by, bx = divmod(int(k), wb)
+        part = np.where(seen, smooth_turn, -np.inf)[by * b:(by + 1) * b, bx * b:(bx + 1) * b]
+        ty, tx = np.unravel_index(int(np.argmax(part)), part.shape)
+        u, v = (bx * b + tx + 0.5) / w, 1.0 - (by * b + ty + 0.5) / h
+        where = ""
+        if mesh:
+            point = obj_point(mesh, u, v)
+            where = "  (padding: no triangle there)" if point is None else "  at (%.3f, %.3f, %.3f)" % tuple(point)
+        print("  %+.3f  u %.3f v %.3f%s" % (blocks.ravel()[k] / total, u, v, where))
     weight = np.maximum(box_mean(seen.astype(float)), 1e-6)
     for name, a in (("turn_map.exr", turn), ("turn_null.exr", null)):
         smooth = np.where(seen, np.maximum(box_mean(np.where(seen, a, 0.0)) / weight, 0.0), 0.0)
