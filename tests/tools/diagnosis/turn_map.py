@@ -99,10 +99,16 @@ def distance_to_edge(seen):
     return dist
 
 
-def obj_point(path, u, v):
-    """The point of the OBJ mesh at UV (u, v): the first triangle whose UVs
-    hold it (a UV point inside none, or on a face without UVs: None)."""
+def load_obj(path):
+    """An OBJ's positions, UVs and triangles (fans of its faces; faces whose
+    corners lack a UV are left out) as arrays: V, T and F[triangle, corner] =
+    (position index, UV index)."""
     vs, vts, faces = [], [], []
+
+    def index(text, count):
+        i = int(text)
+        return i - 1 if i > 0 else count + i  # OBJ's negative indices count back
+
     with open(path) as f:
         for line in f:
             p = line.split()
@@ -114,24 +120,38 @@ def obj_point(path, u, v):
                 vts.append([float(x) for x in p[1:3]])
             elif p[0] == "f":
                 corners = [(c.split("/") + [""])[:2] for c in p[1:]]
-                for k in range(1, len(corners) - 1):  # fans: OBJ faces may have more than 3
-                    tri = [corners[0], corners[k], corners[k + 1]]
-                    if all(t[1] for t in tri):
-                        faces.append([[int(t[0]) - 1, int(t[1]) - 1] for t in tri])
-    if not faces:
+                if not all(t[1] for t in corners):
+                    continue
+                corners = [(index(t[0], len(vs)), index(t[1], len(vts))) for t in corners]
+                for k in range(1, len(corners) - 1):
+                    faces.append([corners[0], corners[k], corners[k + 1]])
+    return np.array(vs), np.array(vts), np.array(faces, dtype=np.int64).reshape(-1, 3, 2)
+
+
+def obj_point(mesh, u, v):
+    """The point of the mesh at texture UV (u, v) in [0, 1): the first
+    triangle that holds it, its UVs read as the texture reads them (REPEAT:
+    each triangle moved by whole tiles so that its lowest corner lies in the
+    first tile, then asked at (u, v) and one tile further along each axis).
+    None where no triangle holds it (padding)."""
+    V, T, F = mesh
+    if len(F) == 0:
         return None
-    V, T, F = np.array(vs), np.array(vts), np.array(faces)
-    a, b, c = T[F[:, 0, 1]], T[F[:, 1, 1]], T[F[:, 2, 1]]
+    uv = T[F[:, :, 1]]  # triangle, corner, (u, v)
+    uv = uv - np.floor(uv.min(axis=1, keepdims=True))
+    a, b, c = uv[:, 0], uv[:, 1], uv[:, 2]
     d = (b[:, 1] - c[:, 1]) * (a[:, 0] - c[:, 0]) + (c[:, 0] - b[:, 0]) * (a[:, 1] - c[:, 1])
-    with np.errstate(divide="ignore", invalid="ignore"):
-        l1 = ((b[:, 1] - c[:, 1]) * (u - c[:, 0]) + (c[:, 0] - b[:, 0]) * (v - c[:, 1])) / d
-        l2 = ((c[:, 1] - a[:, 1]) * (u - c[:, 0]) + (a[:, 0] - c[:, 0]) * (v - c[:, 1])) / d
-    l3 = 1.0 - l1 - l2
-    inside = np.flatnonzero((l1 >= -1e-6) & (l2 >= -1e-6) & (l3 >= -1e-6))
-    if inside.size == 0:
-        return None
-    k = inside[0]
-    return l1[k] * V[F[k, 0, 0]] + l2[k] * V[F[k, 1, 0]] + l3[k] * V[F[k, 2, 0]]
+    for du, dv in ((0, 0), (1, 0), (0, 1), (1, 1)):
+        x, y = u + du, v + dv
+        with np.errstate(divide="ignore", invalid="ignore"):
+            l1 = ((b[:, 1] - c[:, 1]) * (x - c[:, 0]) + (c[:, 0] - b[:, 0]) * (y - c[:, 1])) / d
+            l2 = ((c[:, 1] - a[:, 1]) * (x - c[:, 0]) + (a[:, 0] - c[:, 0]) * (y - c[:, 1])) / d
+        l3 = 1.0 - l1 - l2
+        inside = np.flatnonzero((l1 >= -1e-6) & (l2 >= -1e-6) & (l3 >= -1e-6))
+        if inside.size:
+            k = inside[0]
+            return l1[k] * V[F[k, 0, 0]] + l2[k] * V[F[k, 1, 0]] + l3[k] * V[F[k, 2, 0]]
+    return None
 
 
 def main():
@@ -184,21 +204,25 @@ def main():
     total = turn[seen].sum()
     order = np.argsort(blocks.ravel())[::-1]
     share = np.cumsum(blocks.ravel()[order]) / total
-    used = int(np.count_nonzero(padded.reshape(hb, b, wb, b).any(axis=(1, 3))))
+    cover = np.zeros((hb * b, wb * b), bool)
+    cover[:h, :w] = seen
+    used = int(np.count_nonzero(cover.reshape(hb, b, wb, b).any(axis=(1, 3))))
     half = int(np.searchsorted(share, 0.5)) + 1
     print("blocks of %d x %d texels: %d of the %d with a seen texel hold half of T^2;"
           " the largest eight (share of T^2, UV of the block's texel with the most%s):"
           % (b, b, half, used, ", the point there" if mesh else ""))
     smooth_turn = box_mean(np.where(seen, turn, 0.0), 5)
+    model = load_obj(mesh) if mesh else None
     for k in order[:8]:
         by, bx = divmod(int(k), wb)
         part = np.where(seen, smooth_turn, -np.inf)[by * b:(by + 1) * b, bx * b:(bx + 1) * b]
         ty, tx = np.unravel_index(int(np.argmax(part)), part.shape)
         u, v = (bx * b + tx + 0.5) / w, 1.0 - (by * b + ty + 0.5) / h
         where = ""
-        if mesh:
-            point = obj_point(mesh, u, v)
-            where = "  (padding: no triangle there)" if point is None else "  at (%.3f, %.3f, %.3f)" % tuple(point)
+        if model is not None:
+            point = obj_point(model, u, v)
+            where = ("  (no triangle there: padding)" if point is None
+                     else "  at (%.3f, %.3f, %.3f)" % tuple(point))
         print("  %+.3f  u %.3f v %.3f%s" % (blocks.ravel()[k] / total, u, v, where))
     weight = np.maximum(box_mean(seen.astype(float)), 1e-6)
     for name, a in (("turn_map.exr", turn), ("turn_null.exr", null)):
