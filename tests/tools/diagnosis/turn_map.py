@@ -159,7 +159,8 @@ def main():
     mesh = None
     if len(args) >= 2 and args[-2] == "--mesh":
         mesh, args = args[-1], args[:-2]
-    if len(args) not in (3, 4) or not args[2].isdigit() or int(args[2]) < 2:
+    if (len(args) not in (3, 4) or not args[2].isdigit() or int(args[2]) < 2
+            or "--mesh" in args):
         print("usage: turn_map.py BUILD DIR SEEDS [CHANNEL] [--mesh MODEL.obj]  (SEEDS >= 2)",
               file=sys.stderr)
         sys.exit(2)
