@@ -199,29 +199,31 @@ def main():
     b = 32
     h, w = seen.shape
     hb, wb = (h + b - 1) // b, (w + b - 1) // b
-    padded = np.zeros((hb * b, wb * b))
-    padded[:h, :w] = np.where(seen, turn, 0.0)
-    blocks = padded.reshape(hb, b, wb, b).sum(axis=(1, 3))
+
+    def block_sums(a):
+        padded = np.zeros((hb * b, wb * b))
+        padded[:h, :w] = a
+        return padded.reshape(hb, b, wb, b).sum(axis=(1, 3))
+
+    blocks = block_sums(np.where(seen, turn, 0.0))
     total = turn[seen].sum()
     order = np.argsort(blocks.ravel())[::-1]
     share = np.cumsum(blocks.ravel()[order]) / total
-    cover = np.zeros((hb * b, wb * b), bool)
-    cover[:h, :w] = seen
-    used = int(np.count_nonzero(cover.reshape(hb, b, wb, b).any(axis=(1, 3))))
+    used = int(np.count_nonzero(block_sums(seen)))
     half = int(np.searchsorted(share, 0.5)) + 1
     print("blocks of %d x %d texels: %d of the %d with a seen texel hold half of T^2;"
           " the largest eight (share of T^2, UV of the block's texel with the most%s):"
           % (b, b, half, used, ", the point there" if mesh else ""))
     smooth_turn = box_mean(np.where(seen, turn, 0.0), 5)
-    model = load_obj(mesh) if mesh else None
+    obj = load_obj(mesh) if mesh else None
     for k in order[:8]:
         by, bx = divmod(int(k), wb)
         part = np.where(seen, smooth_turn, -np.inf)[by * b:(by + 1) * b, bx * b:(bx + 1) * b]
         ty, tx = np.unravel_index(int(np.argmax(part)), part.shape)
         u, v = (bx * b + tx + 0.5) / w, 1.0 - (by * b + ty + 0.5) / h
         where = ""
-        if model is not None:
-            point = obj_point(model, u, v)
+        if obj is not None:
+            point = obj_point(obj, u, v)
             where = ("  (no triangle there: padding)" if point is None
                      else "  at (%.3f, %.3f, %.3f)" % tuple(point))
         print("  %+.3f  u %.3f v %.3f%s" % (blocks.ravel()[k] / total, u, v, where))
