@@ -1211,6 +1211,79 @@ TEST(a_grazing_silhouette_owns_nothing_another_view_sees_head_on)
     ENSURE(wrong_side == 0);
 }
 
+// The same cylinder under the top camera and the side camera, both of two
+// layers: drops falling onto its upper left quarter, around where the two
+// cameras see it equally head-on (the normal at 45 degrees). The collider
+// gives each hit to the camera that sees it most head-on by that camera's own
+// texel's normal; the gather divides what a texel holds by the share of its
+// surface its camera owns (wx_owned_fraction). Both must draw the border
+// between the cameras' parts in the same place: when the shares compared
+// every view by the normal of the texel whose share was asked, a band of a
+// fraction of a texel along the border went to one camera's hits and to the
+// other's share, so the first read too much there and the second too little,
+// wherever the texel grids put that band; on Spot, whose horns and ears meet
+// the head in tight curves, that turned with the model in the camera grid
+// (docs/performance.md, "One border for the collider and the gather").
+TEST(a_hit_on_a_curve_lands_where_its_camera_owns_the_surface)
+{
+    enum { PX = 128, LAYERS = 2, DROPS = 4000 };
+    wx_camera cams[2] = { fx_camera(0, 10, 0, 0, 0, 0, 0, 0, -1, 2.56f, PX),
+                          fx_camera(-10, 0, 0, 0, 0, 0, 0, 1, 0, 2.56f, PX) };
+    size_t texels = (size_t)PX * PX;
+    wx_maps maps[2];
+    wx_owner_view views[2 * LAYERS];
+    float *owned = malloc(2 * LAYERS * texels * sizeof *owned);
+    ENSURE(owned != NULL);
+    for (int c = 0; c < 2; ++c) {
+        layered_maps(&cams[c], LAYERS, &maps[c]);
+        render_cylinder(&cams[c], LAYERS, maps[c].depth, maps[c].normal);
+        for (size_t q = 0; q < LAYERS * texels; ++q) {
+            maps[c].impact[2 * q + 1] = 0.5f;
+        }
+        for (int k = 0; k < LAYERS; ++k) {
+            wx_owner_view *v = &views[c * LAYERS + k];
+            wx_owner_view_init(v, &cams[c], maps[c].depth + k * texels, PX, PX);
+            v->normal = maps[c].normal + 3 * k * texels;
+        }
+    }
+    wx_error err;
+    for (int v = 0; v < 2 * LAYERS; ++v) {
+        const float *n = views[v].normal;
+        ENSURE(wx_owned_fraction(views, 2 * LAYERS, v, n, n + 1, n + 2, 3, 1,
+                                 owned + (size_t)v * texels, &err) == WX_OK);
+    }
+    wx_collider col;
+    ENSURE(wx_collider_init(&col, cams, maps, 2, false, &err) == WX_OK);
+    // x from -0.85 to -0.55 (the normal from 58 to 34 degrees above the
+    // horizontal), z across the middle of the frames.
+    uint64_t state = 25;
+    int hits = 0, by_side = 0, unowned = 0;
+    for (int q = 0; q < DROPS; ++q) {
+        float r[2];
+        uniforms(&state, r, 2);
+        float x = -0.85f + 0.3f * ((float)q + r[0]) / DROPS, z = -0.8f + 1.6f * r[1];
+        float a[3] = { x, 2.0f, z }, b[3] = { x, 0.0f, z };
+        wx_hit hit;
+        if (!wx_collider_sweep(&col, a, b, &hit)) {
+            continue;
+        }
+        hits++;
+        by_side += hit.camera == 1;
+        int v = hit.camera * LAYERS + hit.layer;
+        unowned += owned[(size_t)v * texels + hit.texel] == 0.0f;
+    }
+    printf("        %d drops: %d hits, %d recorded by the side camera, %d in a texel whose "
+           "camera owns none of it\n",
+           DROPS, hits, by_side, unowned);
+    wx_collider_free(&col);
+    wx_maps_free(&maps[0]);
+    wx_maps_free(&maps[1]);
+    free(owned);
+    ENSURE(hits == DROPS);
+    ENSURE(by_side > DROPS / 4 && by_side < 3 * DROPS / 4); // the border lies in the range
+    ENSURE(unowned == 0);
+}
+
 // 40 drops falling straight down from height `top` to below the floor
 // (y = 0), at x across -1.5..1.35 and z = z0 + dz * i: those that hit the
 // floor, to within the front camera's texel (its ramp from the floor's front
@@ -1654,6 +1727,7 @@ int main(void)
     RUN(a_drop_by_an_edge_is_recorded_on_the_face_it_lands_on);
     RUN(ownership_ties_go_to_the_view_outside_the_surface);
     RUN(a_grazing_silhouette_owns_nothing_another_view_sees_head_on);
+    RUN(a_hit_on_a_curve_lands_where_its_camera_owns_the_surface);
     RUN(layer_ramp_does_not_jump_from_a_handrail_to_the_wall_behind);
     RUN(edge_on_sign_stops_the_drops_through_it);
     RUN(a_face_on_a_silhouette_is_hit_where_it_is);

@@ -164,6 +164,42 @@ static bool sees_cached(const wx_owner_view *view, const double p[3], const floa
     return sees_projected(view, cache->uvd, n, slack);
 }
 
+// How head-on view v sees p: N . view with the normal v itself records at p's
+// texel when v is a layer holding a surface there on p's side (a layer's
+// normals are its own), else with n. The collider's pick_camera compares the
+// cameras that may take a hit each by its own texel's normal, so the border
+// between two views' parts is drawn where the collider draws it: with one
+// normal for every view, on a curved surface (the roots of Spot's horns and
+// ears) the two borders parted by a fraction of a texel times the curvature,
+// and the band between them was counted by one view's hits and the other's
+// share (docs/cameras.md, "Initial dirt and ownership").
+static float view_along(const wx_owner_view *v, const double p[3], const float n[3],
+                        projection *cache)
+{
+    float along = n[0] * v->view[0] + n[1] * v->view[1] + n[2] * v->view[2];
+    if (v->normal == NULL) {
+        return along;
+    }
+    if (cache->camera == NULL ||
+        (cache->camera != v->camera &&
+         memcmp(cache->camera->wtc, v->camera->wtc, sizeof v->camera->wtc) != 0)) {
+        wx_matrix_apply_affine(v->camera->wtc, p, cache->uvd);
+        cache->camera = v->camera;
+    }
+    int i = (int)floor(cache->uvd[0] * v->width), j = (int)floor((1.0 - cache->uvd[1]) * v->height);
+    if (i < 0 || j < 0 || i >= v->width || j >= v->height) {
+        return along;
+    }
+    size_t t = (size_t)j * (size_t)v->width + (size_t)i;
+    const float *m = v->normal + 3 * t;
+    float len = sqrtf(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
+    if (wx_depth_is_empty(v->depth[t]) || !(len > 1e-6f) || !isfinite(len) ||
+        !(n[0] * m[0] + n[1] * m[1] + n[2] * m[2] > 0.0f)) {
+        return along; // another surface, or none: sees_projected rejects it
+    }
+    return (m[0] * v->view[0] + m[1] * v->view[1] + m[2] * v->view[2]) / len;
+}
+
 // wx_owner_of for a point known to within `slack` (sees_projected).
 static int owner_within(const wx_owner_view *views, int count, const double p[3], const float n[3],
                         int known, double slack)
@@ -174,7 +210,7 @@ static int owner_within(const wx_owner_view *views, int count, const double p[3]
     projection cache = { NULL, { 0.0, 0.0, 0.0 } };
     for (int k = 0; k < count; ++k) {
         const wx_owner_view *v = &views[k];
-        float along = n[0] * v->view[0] + n[1] * v->view[1] + n[2] * v->view[2];
+        float along = view_along(v, p, n, &cache);
         float c = fabsf(along);
         // Two cameras facing each other see every surface equally head-on;
         // with layers one sees it from outside (its normal towards the

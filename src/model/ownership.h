@@ -48,7 +48,9 @@ void wx_owner_view_init(wx_owner_view *view, const wx_camera *camera, const floa
 bool wx_owner_sees(const wx_owner_view *view, const double p[3], const float n[3]);
 
 /// The view that owns p: of the views that see it, the one that sees it most
-/// head-on (largest |n . view|), ties within 1e-4 to a view outside the
+/// head-on (largest |N . view|, N read for a layer as the normal it records at
+/// p's texel, as the collider's pick_camera reads each camera, else n), ties
+/// within 1e-4 to a view outside the
 /// surface (a layer whose camera n faces, n . view < 0, over one that sees it
 /// through the solid: two cameras facing each other always tie), then to the
 /// one listed first; -1
