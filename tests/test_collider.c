@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/matrix.h"
 #include "model/ownership.h"
 #include "sim/collider.h"
 #include "ensure.h"
@@ -1284,6 +1285,55 @@ TEST(a_hit_on_a_curve_lands_where_its_camera_owns_the_surface)
     ENSURE(unowned == 0);
 }
 
+// A wall seen at 40 degrees by a side camera of two layers, just below a roof
+// sloping at 30 degrees that a top camera of two layers holds 15 cm (1.5 of
+// its texels) above the wall's point. The top camera sees the roof more
+// head-on than the side camera sees the wall, but it does not see the wall:
+// its layer's precision is that of the roof it records there. Read with the
+// wall's normal (nearly along the top camera's rays: a precision of tens of
+// texels) the roof's layer took the wall under the eave, which the collider
+// never gives it a hit on (the tank's walls under its roof and its ring went
+// dark in the soot preset's mask).
+TEST(a_wall_below_an_eave_is_not_owned_by_the_roof_above_it)
+{
+    enum { PX = 16, LAYERS = 2 };
+    wx_camera cams[2] = { fx_camera(0, 10, 0, 0, 0, 0, 0, 0, -1, 1.6f, PX),
+                          fx_camera(-10, 0, 0, 0, 0, 0, 0, 1, 0, 1.6f, PX) };
+    const double p[3] = { 0.0, 0.0, 0.0 }, roof[3] = { 0.0, 0.15, 0.0 };
+    const float wall_n[3] = { -0.766044f, 0.0f, 0.642788f };  // 40 degrees off the side's axis
+    const float roof_n[3] = { -0.5f, 0.866025f, 0.0f };       // 30 degrees off the top's
+    size_t texels = (size_t)PX * PX;
+    float *depth = malloc(2 * LAYERS * texels * sizeof *depth);
+    float *normal = malloc(6 * LAYERS * texels * sizeof *normal);
+    ENSURE(depth != NULL && normal != NULL);
+    wx_owner_view views[2 * LAYERS];
+    for (int c = 0; c < 2; ++c) {
+        double uvd[3];
+        wx_matrix_apply_affine(cams[c].wtc, c == 0 ? roof : p, uvd);
+        const float *n = c == 0 ? roof_n : wall_n;
+        for (int k = 0; k < LAYERS; ++k) {
+            size_t at = ((size_t)c * LAYERS + (size_t)k) * texels;
+            for (size_t t = 0; t < texels; ++t) {
+                depth[at + t] = k == 0 ? (float)uvd[2] : INFINITY;
+                for (int e = 0; e < 3; ++e) {
+                    normal[3 * (at + t) + (size_t)e] = k == 0 ? n[e] : 0.0f;
+                }
+            }
+            wx_owner_view *v = &views[c * LAYERS + k];
+            wx_owner_view_init(v, &cams[c], depth + at, PX, PX);
+            v->normal = normal + 3 * at;
+        }
+    }
+    int owner = wx_owner_of(views, 2 * LAYERS, p, wall_n, -1);
+    bool side_sees = wx_owner_sees(&views[LAYERS], p, wall_n);
+    bool top_sees = wx_owner_sees(&views[0], p, wall_n);
+    free(depth);
+    free(normal);
+    ENSURE(side_sees);
+    ENSURE(!top_sees);
+    ENSURE(owner == LAYERS); // the side camera's first layer
+}
+
 // 40 drops falling straight down from height `top` to below the floor
 // (y = 0), at x across -1.5..1.35 and z = z0 + dz * i: those that hit the
 // floor, to within the front camera's texel (its ramp from the floor's front
@@ -1728,6 +1778,7 @@ int main(void)
     RUN(ownership_ties_go_to_the_view_outside_the_surface);
     RUN(a_grazing_silhouette_owns_nothing_another_view_sees_head_on);
     RUN(a_hit_on_a_curve_lands_where_its_camera_owns_the_surface);
+    RUN(a_wall_below_an_eave_is_not_owned_by_the_roof_above_it);
     RUN(layer_ramp_does_not_jump_from_a_handrail_to_the_wall_behind);
     RUN(edge_on_sign_stops_the_drops_through_it);
     RUN(a_face_on_a_silhouette_is_hit_where_it_is);

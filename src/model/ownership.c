@@ -82,6 +82,8 @@ static double tolerance(const wx_owner_view *view, const float n[3], double d, d
 static bool sees_projected(const wx_owner_view *view, const double uvd[3], const float n[3],
                            double slack)
 {
+    float mu[3];
+    const float *slope = n; // the surface whose slope sets the precision
     if (view->normal != NULL) {
         // A layer's normals point out of the solid, either way along the view:
         // the point's surface must face the way the layer's texel does. Most
@@ -100,13 +102,28 @@ static bool sees_projected(const wx_owner_view *view, const double uvd[3], const
         if (!(n[0] * m[0] + n[1] * m[1] + n[2] * m[2] > 0.0f)) {
             return false;
         }
+        // The layer's precision is that of the surface it records there (the
+        // collider's candidate test reads each camera's own normal): with the
+        // point's, a wall just below a roof's eave lay within a top camera's
+        // tolerance for a vertical surface (tens of texels) of the roof that
+        // camera holds, and the roof's normal made it the most head-on.
+        float len = sqrtf(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
+        if (len > 1e-6f && isfinite(len)) {
+            for (int k = 0; k < 3; ++k) {
+                mu[k] = m[k] / len;
+            }
+            if (!(fabs(uvd[2] - own) <= fmax(tolerance(view, mu, uvd[2], own), slack))) {
+                return false;
+            }
+            slope = mu;
+        }
     }
     double x = uvd[0] * view->width - 0.5, y = (1.0 - uvd[1]) * view->height - 0.5;
     double own, between;
     if (!depth_at(view->depth, view->width, view->height, x, y, &own, &between)) {
         return false;
     }
-    double precision = fmax(tolerance(view, n, uvd[2], own), slack);
+    double precision = fmax(tolerance(view, slope, uvd[2], own), slack);
     return fabs(uvd[2] - own) <= precision && fabs(uvd[2] - between) <= precision;
 }
 
@@ -148,6 +165,18 @@ typedef struct projection {
     double uvd[3];
 } projection;
 
+// p in view's map space, projected once per camera.
+static const double *projected(const wx_owner_view *view, const double p[3], projection *cache)
+{
+    if (cache->camera == NULL ||
+        (cache->camera != view->camera &&
+         memcmp(cache->camera->wtc, view->camera->wtc, sizeof view->camera->wtc) != 0)) {
+        wx_matrix_apply_affine(view->camera->wtc, p, cache->uvd);
+        cache->camera = view->camera;
+    }
+    return cache->uvd;
+}
+
 static bool sees_cached(const wx_owner_view *view, const double p[3], const float n[3],
                         double slack, projection *cache)
 {
@@ -155,13 +184,7 @@ static bool sees_cached(const wx_owner_view *view, const double p[3], const floa
     if (view->normal == NULL && !(facing < FACING_SLACK)) {
         return false;
     }
-    if (cache->camera == NULL ||
-        (cache->camera != view->camera &&
-         memcmp(cache->camera->wtc, view->camera->wtc, sizeof view->camera->wtc) != 0)) {
-        wx_matrix_apply_affine(view->camera->wtc, p, cache->uvd);
-        cache->camera = view->camera;
-    }
-    return sees_projected(view, cache->uvd, n, slack);
+    return sees_projected(view, projected(view, p, cache), n, slack);
 }
 
 // How head-on view v sees p: N . view with the normal v itself records at p's
@@ -180,13 +203,8 @@ static float view_along(const wx_owner_view *v, const double p[3], const float n
     if (v->normal == NULL) {
         return along;
     }
-    if (cache->camera == NULL ||
-        (cache->camera != v->camera &&
-         memcmp(cache->camera->wtc, v->camera->wtc, sizeof v->camera->wtc) != 0)) {
-        wx_matrix_apply_affine(v->camera->wtc, p, cache->uvd);
-        cache->camera = v->camera;
-    }
-    int i = (int)floor(cache->uvd[0] * v->width), j = (int)floor((1.0 - cache->uvd[1]) * v->height);
+    const double *uvd = projected(v, p, cache);
+    int i = (int)floor(uvd[0] * v->width), j = (int)floor((1.0 - uvd[1]) * v->height);
     if (i < 0 || j < 0 || i >= v->width || j >= v->height) {
         return along;
     }

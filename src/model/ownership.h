@@ -44,12 +44,14 @@ void wx_owner_view_init(wx_owner_view *view, const wx_camera *camera, const floa
 /// texel with a surface, and both that texel's
 /// depth and the depth between texel centres (bilinear where the four texels
 /// around p hold a surface) agree with p's within half a texel plus one
-/// texel's worth of the surface's slope in this view (the collider's rule).
+/// texel's worth of the surface's slope in this view (the collider's rule; for
+/// a layer, the slope of the surface it records there, else of n).
 bool wx_owner_sees(const wx_owner_view *view, const double p[3], const float n[3]);
 
 /// The view that owns p: of the views that see it, the one that sees it most
 /// head-on (largest |N . view|, N read for a layer as the normal it records at
-/// p's texel, as the collider's pick_camera reads each camera, else n), ties
+/// p's texel, as the collider's pick_camera reads each camera, else n; a
+/// layer sees p to the precision of the surface it records there), ties
 /// within 1e-4 to a view outside the
 /// surface (a layer whose camera n faces, n . view < 0, over one that sees it
 /// through the solid: two cameras facing each other always tie), then to the
