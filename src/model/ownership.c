@@ -79,6 +79,17 @@ static double tolerance(const wx_owner_view *view, const float n[3], double d, d
 
 // wx_owner_sees with p already in the view's map space (uvd), its depth known
 // to within `slack` (world units; 0: exactly) besides the view's own tolerance.
+// The texel of `view` that map-space point uvd falls in (false outside).
+static bool texel_of(const wx_owner_view *view, const double uvd[3], size_t *t)
+{
+    int i = (int)floor(uvd[0] * view->width), j = (int)floor((1.0 - uvd[1]) * view->height);
+    if (i < 0 || j < 0 || i >= view->width || j >= view->height) {
+        return false;
+    }
+    *t = (size_t)j * (size_t)view->width + (size_t)i;
+    return true;
+}
+
 static bool sees_projected(const wx_owner_view *view, const double uvd[3], const float n[3],
                            double slack)
 {
@@ -88,11 +99,10 @@ static bool sees_projected(const wx_owner_view *view, const double uvd[3], const
         // A layer's normals point out of the solid, either way along the view:
         // the point's surface must face the way the layer's texel does. Most
         // layers hold another surface at p's texel: the depth tells first.
-        int i = (int)floor(uvd[0] * view->width), j = (int)floor((1.0 - uvd[1]) * view->height);
-        if (i < 0 || j < 0 || i >= view->width || j >= view->height) {
+        size_t t;
+        if (!texel_of(view, uvd, &t)) {
             return false;
         }
-        size_t t = (size_t)j * (size_t)view->width + (size_t)i;
         double own = view->depth[t];
         if (wx_depth_is_empty(view->depth[t]) ||
             !(fabs(uvd[2] - own) <= fmax(tolerance(view, n, uvd[2], own), slack))) {
@@ -144,11 +154,11 @@ static double depth_error(const wx_owner_view *view, const double p[3])
 {
     double uvd[3];
     wx_matrix_apply_affine(view->camera->wtc, p, uvd);
-    int i = (int)floor(uvd[0] * view->width), j = (int)floor((1.0 - uvd[1]) * view->height);
-    if (i < 0 || j < 0 || i >= view->width || j >= view->height) {
+    size_t t;
+    if (!texel_of(view, uvd, &t)) {
         return INFINITY;
     }
-    float own = view->depth[(size_t)j * (size_t)view->width + (size_t)i];
+    float own = view->depth[t];
     return wx_depth_is_empty(own) ? INFINITY : fabs(uvd[2] - own);
 }
 
@@ -203,12 +213,10 @@ static float view_along(const wx_owner_view *v, const double p[3], const float n
     if (v->normal == NULL) {
         return along;
     }
-    const double *uvd = projected(v, p, cache);
-    int i = (int)floor(uvd[0] * v->width), j = (int)floor((1.0 - uvd[1]) * v->height);
-    if (i < 0 || j < 0 || i >= v->width || j >= v->height) {
+    size_t t;
+    if (!texel_of(v, projected(v, p, cache), &t)) {
         return along;
     }
-    size_t t = (size_t)j * (size_t)v->width + (size_t)i;
     const float *m = v->normal + 3 * t;
     float len = sqrtf(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
     if (wx_depth_is_empty(v->depth[t]) || !(len > 1e-6f) || !isfinite(len) ||
