@@ -214,11 +214,11 @@ def main():
     print("blocks of %d x %d texels: %d of the %d with a seen texel hold half of T^2;"
           " the largest eight (share of T^2, UV of the block's texel with the most%s):"
           % (b, b, half, used, ", the point there" if mesh else ""))
-    smooth_turn = box_mean(np.where(seen, turn, 0.0), 5)
+    smooth_turn = np.where(seen, box_mean(np.where(seen, turn, 0.0), 5), -np.inf)
     obj = load_obj(mesh) if mesh else None
     for k in order[:8]:
         by, bx = divmod(int(k), wb)
-        part = np.where(seen, smooth_turn, -np.inf)[by * b:(by + 1) * b, bx * b:(bx + 1) * b]
+        part = smooth_turn[by * b:(by + 1) * b, bx * b:(bx + 1) * b]
         ty, tx = np.unravel_index(int(np.argmax(part)), part.shape)
         u, v = (bx * b + tx + 0.5) / w, 1.0 - (by * b + ty + 0.5) / h
         where = ""
