@@ -25,6 +25,13 @@
 # of the same seed is not the only yardstick the issue's words allow, and on
 # Spot it reads low: with four seeds 1.061 per texel over the same-seed pairs,
 # 1.081 over all (docs/performance.md, "Which pairs the turn is read from").
+# Then the orientations over the N(N-1) pairs of different seeds only: on
+# Spot a model run and the turned run of its own seed share part of their
+# noise (with four seeds each of the four same-seed pairs does, and the
+# same-seed pairing has the largest shared part of all 24 pairings), so only
+# pairs of different seeds hold the seeds' noise twice over, as the seeds'
+# yardstick does (docs/performance.md, "Pairs of different seeds",
+# sixteenth session).
 #
 # ABSORB=1: every drop absorbed at its first hit (every Surface's absorption
 # 1), with the exposure from straight above (`<Exposure name="exp"
@@ -121,3 +128,10 @@ awk '{ q[$1, $2] += $3 * $3; n[$1, $2]++ }
                o = sqrt((q["orientations", k] + q["across", k]) / (n["orientations", k] + n["across", k]))
                printf "block %2d: seeds %.4f  orientations %.4f (%d pairs)  ratio %.3f\n", k, s, o,
                       n["orientations", k] + n["across", k], o / s } }' "$dir/pairs"
+# Every model seed against every turned seed of another seed (N(N-1) pairs).
+echo "every model seed against every turned seed of another seed:"
+awk '{ q[$1, $2] += $3 * $3; n[$1, $2]++ }
+     END { for (k = 1; k <= 32; k *= 2) if (n["seeds", k] > 0) {
+               s = sqrt(q["seeds", k] / n["seeds", k]); o = sqrt(q["across", k] / n["across", k])
+               printf "block %2d: seeds %.4f  orientations %.4f (%d pairs)  ratio %.3f\n", k, s, o,
+                      n["across", k], o / s } }' "$dir/pairs"
