@@ -120,18 +120,16 @@ if [ "$seeds" -gt 2 ]; then
                    printf "block %2d: seeds %.4f (pairs %.4f to %.4f)  orientations %.4f  ratio %.3f\n", k, s, lo[k], hi[k], o, o / s } }' "$dir/pairs"
 fi
 # Every model seed against every turned seed (N^2 pairs, the same seed and
-# different ones) against the seeds over every pair.
-echo "every model seed against every turned seed:"
+# different ones), then against those of another seed only (N(N-1) pairs),
+# both against the seeds over every pair.
 awk '{ q[$1, $2] += $3 * $3; n[$1, $2]++ }
-     END { for (k = 1; k <= 32; k *= 2) if (n["seeds", k] > 0) {
-               s = sqrt(q["seeds", k] / n["seeds", k])
-               o = sqrt((q["orientations", k] + q["across", k]) / (n["orientations", k] + n["across", k]))
-               printf "block %2d: seeds %.4f  orientations %.4f (%d pairs)  ratio %.3f\n", k, s, o,
-                      n["orientations", k] + n["across", k], o / s } }' "$dir/pairs"
-# Every model seed against every turned seed of another seed (N(N-1) pairs).
-echo "every model seed against every turned seed of another seed:"
-awk '{ q[$1, $2] += $3 * $3; n[$1, $2]++ }
-     END { for (k = 1; k <= 32; k *= 2) if (n["seeds", k] > 0) {
-               s = sqrt(q["seeds", k] / n["seeds", k]); o = sqrt(q["across", k] / n["across", k])
-               printf "block %2d: seeds %.4f  orientations %.4f (%d pairs)  ratio %.3f\n", k, s, o,
-                      n["across", k], o / s } }' "$dir/pairs"
+     function line(k, s, sq, count) {
+         printf "block %2d: seeds %.4f  orientations %.4f (%d pairs)  ratio %.3f\n", k, s,
+                sqrt(sq / count), count, sqrt(sq / count) / s }
+     END { print "every model seed against every turned seed:"
+           for (k = 1; k <= 32; k *= 2) if (n["seeds", k] > 0)
+               line(k, sqrt(q["seeds", k] / n["seeds", k]), q["orientations", k] + q["across", k],
+                    n["orientations", k] + n["across", k])
+           print "every model seed against every turned seed of another seed:"
+           for (k = 1; k <= 32; k *= 2) if (n["seeds", k] > 0)
+               line(k, sqrt(q["seeds", k] / n["seeds", k]), q["across", k], n["across", k]) }' "$dir/pairs"
