@@ -77,8 +77,6 @@ static double tolerance(const wx_owner_view *view, const float n[3], double d, d
     return view->texel_ws * (0.5 + tan_view) + 4e-6 * (fabs(d) + fabs(own));
 }
 
-// wx_owner_sees with p already in the view's map space (uvd), its depth known
-// to within `slack` (world units; 0: exactly) besides the view's own tolerance.
 // The texel of `view` that map-space point uvd falls in (false outside).
 static bool texel_of(const wx_owner_view *view, const double uvd[3], size_t *t)
 {
@@ -90,6 +88,15 @@ static bool texel_of(const wx_owner_view *view, const double uvd[3], size_t *t)
     return true;
 }
 
+// The length of a normal m a layer records, 0 where it records none usable.
+static float normal_length(const float m[3])
+{
+    float len = sqrtf(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
+    return len > 1e-6f && isfinite(len) ? len : 0.0f;
+}
+
+// wx_owner_sees with p already in the view's map space (uvd), its depth known
+// to within `slack` (world units; 0: exactly) besides the view's own tolerance.
 static bool sees_projected(const wx_owner_view *view, const double uvd[3], const float n[3],
                            double slack)
 {
@@ -117,8 +124,8 @@ static bool sees_projected(const wx_owner_view *view, const double uvd[3], const
         // point's, a wall just below a roof's eave lay within a top camera's
         // tolerance for a vertical surface (tens of texels) of the roof that
         // camera holds, and the roof's normal made it the most head-on.
-        float len = sqrtf(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
-        if (len > 1e-6f && isfinite(len)) {
+        float len = normal_length(m);
+        if (len > 0.0f) {
             for (int k = 0; k < 3; ++k) {
                 mu[k] = m[k] / len;
             }
@@ -218,8 +225,8 @@ static float view_along(const wx_owner_view *v, const double p[3], const float n
         return along;
     }
     const float *m = v->normal + 3 * t;
-    float len = sqrtf(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
-    if (wx_depth_is_empty(v->depth[t]) || !(len > 1e-6f) || !isfinite(len) ||
+    float len = normal_length(m);
+    if (wx_depth_is_empty(v->depth[t]) || len == 0.0f ||
         !(n[0] * m[0] + n[1] * m[1] + n[2] * m[2] > 0.0f)) {
         return along; // another surface, or none: sees_projected rejects it
     }
