@@ -237,7 +237,7 @@ static int parse_args(int argc, char **argv, cli_args *args)
 // their final names (atomic rename); no output is ever half there.
 static void on_interrupt(int sig)
 {
-    wx_temp_remove_all();
+    wx_temp_interrupt();
     static const char message[] = "\nweathering: interrupted; temporary files removed\n";
     ssize_t ignored = write(STDERR_FILENO, message, sizeof message - 1);
     (void)ignored;

@@ -75,6 +75,28 @@ void wx_temp_remove_all(void)
     }
 }
 
+// Set by wx_temp_interrupt before its sweep. A writer checks it after creating
+// its temporary: either the check comes first in the flag's order, and then
+// the file already exists when the sweep runs, or it sees the flag and removes
+// its own file.
+static atomic_int temp_interrupted;
+
+void wx_temp_interrupt(void)
+{
+    atomic_store(&temp_interrupted, 1);
+    wx_temp_remove_all();
+}
+
+void wx_temp_created(const char *tmp)
+{
+    if (atomic_load(&temp_interrupted)) {
+        unlink(tmp);
+        for (;;) {
+            pause(); // the handler's _exit ends the process
+        }
+    }
+}
+
 // True when `name` is ".<something>.tmp<digits>"; stores the digits as a pid and
 // <something> in `base`.
 static int temp_name_pid(const char *name, long *pid, char base[WX_PATH_MAX])
@@ -171,6 +193,7 @@ wx_result wx_write_file_atomic(const char *path, const void *data, size_t size, 
         wx_temp_forget(tmp);
         return wx_fail(err, WX_CAUSE_IO, "%s: cannot write (%s)", path, strerror(errno));
     }
+    wx_temp_created(tmp);
     size_t written = fwrite(data, 1, size, f);
     int closed = fclose(f);
     if (written != size || closed != 0) {

@@ -27,6 +27,18 @@ void wx_temp_forget(const char *tmp);
 /// signal handler that exits right after.
 void wx_temp_remove_all(void);
 
+/// An interrupt's handler: from now on a temporary created by another thread
+/// is removed at once (wx_temp_created), then removes every remembered one.
+/// Async-signal-safe; the handler exits right after.
+void wx_temp_interrupt(void);
+
+/// Called by a writer right after it created `tmp`: when an interrupt came
+/// first, removes it and waits for the handler to end the process. Without
+/// this a thread that created its temporary after the handler's sweep (a
+/// loaded machine can pause the handler between its sweep and its exit) left
+/// it behind.
+void wx_temp_created(const char *tmp);
+
 /// Removes the temporary files ".<name>.tmp<pid>" in `folder` whose process no
 /// longer runs (left by a run that was killed) and whose <name> `is_ours` accepts
 /// (only the program's own output names: a user's ".draft.txt.tmp42" stays).

@@ -355,6 +355,7 @@ wx_result wx_exr_write(const char *path, const wx_image *image, wx_error *err)
         return wx_fail(err, WX_CAUSE_IO, "%s: cannot create %s (%s)", path, tmp_path,
                        strerror(errno));
     }
+    wx_temp_created(tmp_path);
     exr_stream *outer = wx_exr_stream_bind(&s);
     result = write_body(&s, path, tmp_path, image, err);
     wx_exr_stream_unbind(outer);

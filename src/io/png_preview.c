@@ -152,6 +152,7 @@ wx_result wx_png_write(const char *path, const uint8_t *pixels, int width, int h
     if (w.file == NULL) {
         return wx_fail(err, WX_CAUSE_IO, "%s: cannot write (%s)", path, strerror(errno));
     }
+    wx_temp_created(tmp);
     w.png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &w.failure, on_png_error,
                                     on_png_warning);
     w.info = w.png != NULL ? png_create_info_struct(w.png) : NULL;
